@@ -1,0 +1,39 @@
+// The GPU-visible structs for C++, with compile-time proof that their layout is the std430
+// layout GLSL sees (sizes and offsets), so one declaration serves both languages.
+#pragma once
+
+#include <cstddef>
+
+#include "../../shaders/shared_types.h"
+#include "../../shaders/sampling.h"
+
+namespace pt {
+
+static_assert(sizeof(vec3) == 12 && alignof(vec3) == 4, "GLM must not pad vec3");
+
+static_assert(sizeof(BvhNode) == 32);
+static_assert(offsetof(BvhNode, boundsMin) == 0 && offsetof(BvhNode, offset) == 12);
+static_assert(offsetof(BvhNode, boundsMax) == 16 && offsetof(BvhNode, count) == 28);
+
+static_assert(sizeof(Triangle) == 48);
+static_assert(offsetof(Triangle, v0) == 0 && offsetof(Triangle, material) == 12);
+static_assert(offsetof(Triangle, v1) == 16 && offsetof(Triangle, emitter) == 28);
+static_assert(offsetof(Triangle, v2) == 32 && offsetof(Triangle, primitive) == 44);
+
+static_assert(sizeof(Material) == 32);
+static_assert(offsetof(Material, reflectance) == 0 && offsetof(Material, type) == 12);
+static_assert(offsetof(Material, emission) == 16 && offsetof(Material, reserved) == 28);
+
+static_assert(sizeof(Emitter) == 16);
+static_assert(offsetof(Emitter, pmf) == 4 && offsetof(Emitter, aliasThreshold) == 8);
+static_assert(offsetof(Emitter, alias) == 12);
+
+static_assert(sizeof(Camera) == 64);
+static_assert(offsetof(Camera, forward) == 16 && offsetof(Camera, right) == 32);
+static_assert(offsetof(Camera, up) == 48 && offsetof(Camera, height) == 60);
+
+static_assert(sizeof(RenderParams) == 96);
+static_assert(offsetof(RenderParams, maxDepth) == 64 && offsetof(RenderParams, seed) == 76);
+static_assert(offsetof(RenderParams, russianRoulette) == 84);
+
+}  // namespace pt

@@ -1,0 +1,121 @@
+// Every struct and constant that crosses between the host and the GPU, declared once.
+// Read by C++ (through GLM, which spells vectors as GLSL does) and by GLSL (#include).
+// Structs are built from 16-byte rows (a vec3 followed by a 4-byte scalar), so the std430
+// layout equals the C++ layout with no padding members; host/common/shared.h checks that
+// with static_asserts on every size and offset.
+#ifndef PT_SHARED_TYPES_H
+#define PT_SHARED_TYPES_H
+
+#ifdef __cplusplus
+#include <cstdint>
+#include <glm/glm.hpp>
+namespace pt {
+using uint = std::uint32_t;
+using namespace glm;  // so that shared code reads as GLSL: dot, cross, floatBitsToInt...
+#define PT_CONST inline constexpr
+#define PT_INLINE inline
+#else
+#define PT_CONST const
+#define PT_INLINE
+#endif
+
+// ---- BVH -------------------------------------------------------------------------------
+
+// One node of the depth-first linearized BVH. The left child of an interior node is the
+// node that follows it in the array; only the right child's index is stored.
+struct BvhNode {
+  vec3 boundsMin;  // 12 bytes: lower corner of the box
+  uint offset;     //  4 bytes: interior: index of the right child; leaf: first triangle
+  vec3 boundsMax;  // 12 bytes: upper corner of the box
+  uint count;      //  4 bytes: number of triangles in a leaf, 0 for an interior node
+};                 // 32 bytes
+
+// Traversal stack entries per ray. The builder refuses trees deeper than this.
+PT_CONST uint kBvhStackSize = 64u;
+
+// ---- Geometry and materials ------------------------------------------------------------
+
+PT_CONST uint kNoEmitter = 0xFFFFFFFFu;
+
+// One triangle, stored in BVH leaf order. Vertices are kept (not edges) because the
+// watertight intersection test (Woop et al. 2013) works on vertices relative to the ray.
+struct Triangle {
+  vec3 v0;         // 12 bytes
+  uint material;   //  4 bytes: index into the material buffer
+  vec3 v1;         // 12 bytes
+  uint emitter;    //  4 bytes: index into the emitter buffer, or kNoEmitter
+  vec3 v2;         // 12 bytes
+  uint primitive;  //  4 bytes: index of the triangle in scene (load) order
+};                 // 48 bytes
+
+PT_CONST uint kMaterialDiffuse = 0u;  // ideal Lambertian, BRDF = reflectance / pi, two-sided
+PT_CONST uint kMaterialMirror = 1u;   // ideal specular reflection, no Fresnel, two-sided
+
+struct Material {
+  vec3 reflectance;  // 12 bytes: diffuse albedo or mirror reflectance, linear RGB
+  uint type;         //  4 bytes: kMaterialDiffuse or kMaterialMirror
+  vec3 emission;     // 12 bytes: radiance emitted on the front side (geometric normal side)
+  uint reserved;      //  4 bytes: zero (keeps the 16-byte row)
+};                   // 32 bytes
+
+// One entry of the emitter alias table (Walker 1977, Vose 1991): emitter i is picked with
+// probability pmf; sampling draws a slot uniformly and keeps it with probability
+// aliasThreshold, else takes slot alias.
+struct Emitter {
+  uint triangle;         // 4 bytes: index into the triangle buffer (leaf order)
+  float pmf;             // 4 bytes: probability of choosing this emitter
+  float aliasThreshold;  // 4 bytes
+  uint alias;            // 4 bytes
+};                       // 16 bytes
+
+// ---- Camera and per-render parameters --------------------------------------------------
+
+// Pinhole camera. Film point (x, y) in [0, width) x [0, height), row 0 at the top, maps to
+// the direction normalize(forward + u * tanHalfFovY * aspect * right + v * tanHalfFovY * up)
+// with u = 2x / width - 1, v = 1 - 2y / height.
+struct Camera {
+  vec3 position;      // 12 bytes
+  float tanHalfFovY;  //  4 bytes: tan(vertical field of view / 2)
+  vec3 forward;       // 12 bytes: unit view direction
+  float aspect;       //  4 bytes: width / height
+  vec3 right;         // 12 bytes: unit, forward x up
+  uint width;         //  4 bytes
+  vec3 up;            // 12 bytes: unit, right x forward
+  uint height;        //  4 bytes
+};                    // 64 bytes
+
+// Sampling strategies for direct light (the MIS knob).
+PT_CONST uint kStrategyMis = 0u;   // light sampling + BSDF sampling, power heuristic
+PT_CONST uint kStrategyNee = 1u;   // light sampling only (emission hit by BSDF rays ignored)
+PT_CONST uint kStrategyBsdf = 2u;  // BSDF sampling only (no shadow rays)
+
+struct RenderParams {
+  Camera camera;      // 64 bytes
+  uint maxDepth;      //  4 bytes: maximum number of scattering events on a path
+  uint rrStartDepth;  //  4 bytes: Russian roulette from this many scattering events on
+  uint emitterCount;  //  4 bytes
+  uint seed;          //  4 bytes
+  uint strategy;      //  4 bytes: kStrategyMis, kStrategyNee or kStrategyBsdf
+  uint russianRoulette;  // 4 bytes: 0 or 1
+  uint reserved0;     //  4 bytes: zero (std430 rounds the struct to 16 bytes)
+  uint reserved1;     //  4 bytes: zero
+};                    // 96 bytes
+
+// ---- Random-number dimensions ----------------------------------------------------------
+// Random numbers are a pure function of (pixel, sample index, dimension, seed); see
+// sampling.h. One dimension yields up to two numbers. Each path uses dimension kDimPixel for
+// the pixel jitter, then kDimsPerBounce dimensions per scattering event, starting at
+// kDimFirstBounce + kDimsPerBounce * bounce.
+PT_CONST uint kDimPixel = 0u;
+PT_CONST uint kDimFirstBounce = 1u;
+PT_CONST uint kDimsPerBounce = 4u;
+PT_CONST uint kDimLightChoose = 0u;  // +0: alias-table slot and coin
+PT_CONST uint kDimLightPoint = 1u;   // +1: point on the emitter triangle
+PT_CONST uint kDimBsdf = 2u;         // +2: BSDF direction
+PT_CONST uint kDimRoulette = 3u;     // +3: Russian roulette
+
+#ifdef __cplusplus
+}  // namespace pt
+#endif
+
+#endif  // PT_SHARED_TYPES_H
