@@ -1,0 +1,32 @@
+// Linear BVH over triangles: Morton codes of centroids, radix sort, split at the highest
+// differing bit (Karras 2012), DFS-linearized into the 32-byte BvhNode the GPU reads.
+// Knows nothing of materials, cameras or Vulkan.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common/shared.h"
+
+namespace pt {
+
+struct BvhBuildOptions {
+  int maxLeafSize = 4;  // a range of at most this many triangles becomes a leaf (>= 1)
+};
+
+struct Bvh {
+  std::vector<BvhNode> nodes;       // nodes[0] is the root; depth-first order
+  std::vector<Triangle> triangles;  // reordered so that every leaf is a contiguous range
+  int maxDepth = 0;                 // depth of the deepest leaf (root = 0), <= kBvhStackSize
+  double buildSeconds = 0.0;
+};
+
+// Builds the BVH. Triangles keep their fields; only their order changes.
+// Requires at least one triangle.
+Bvh buildBvh(std::vector<Triangle> triangles, const BvhBuildOptions& options = {});
+
+// 63-bit Morton code of a point with coordinates in [0, 1]: 21 bits per axis, interleaved
+// as ... z1 y1 x1 z0 y0 x0 (x in the lowest bit of each triple).
+uint64_t mortonCode63(vec3 unitPoint);
+
+}  // namespace pt

@@ -1,0 +1,161 @@
+// CPU traversal of the flat BVH; see traverse.h.
+#include "bvh/traverse.h"
+
+#include <cmath>
+#include <utility>
+
+namespace pt {
+namespace {
+
+// Smallest |direction| component used for 1/direction: keeps 1/d finite, so the slab
+// products (lo - o) * (1/d) are never 0 * inf = NaN, and a ray lying in a box's face plane
+// counts as inside that slab. Components this small only arise as exact zeros in practice.
+constexpr float kMinDirection = 1e-30f;
+
+// gamma(3) of Pharr et al. (3 ulp relative error bound); Ize 2013 widens the far distance
+// by 1 + 2 gamma(3) so that rounding in the slab test never loses a hit.
+constexpr float kGamma3 = 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
+constexpr float kFarScale = 1.0f + 2.0f * kGamma3;
+
+float safeInverse(float d) {
+  return 1.0f / (std::fabs(d) < kMinDirection ? std::copysign(kMinDirection, d) : d);
+}
+
+}  // namespace
+
+RayPrecomputed::RayPrecomputed(const Ray& ray) : origin(ray.origin) {
+  const vec3 d = ray.direction;
+  invDirection = vec3(safeInverse(d.x), safeInverse(d.y), safeInverse(d.z));
+  // Woop et al. 2013: make the largest axis z, and swap x and y when it points down z so
+  // that the triangle's winding, and so the sign of the edge functions, is kept.
+  const vec3 a = abs(d);
+  kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
+  kx = (kz + 1) % 3;
+  ky = (kx + 1) % 3;
+  if (d[kz] < 0.0f) std::swap(kx, ky);
+  sx = d[kx] / d[kz];
+  sy = d[ky] / d[kz];
+  sz = 1.0f / d[kz];
+}
+
+bool intersectTriangle(const RayPrecomputed& ray, const Triangle& tri, float tMax, Hit& hit) {
+  // Vertices relative to the origin, sheared so the ray becomes the +z axis.
+  const vec3 a = tri.v0 - ray.origin;
+  const vec3 b = tri.v1 - ray.origin;
+  const vec3 c = tri.v2 - ray.origin;
+  const float ax = a[ray.kx] - ray.sx * a[ray.kz];
+  const float ay = a[ray.ky] - ray.sy * a[ray.kz];
+  const float bx = b[ray.kx] - ray.sx * b[ray.kz];
+  const float by = b[ray.ky] - ray.sy * b[ray.kz];
+  const float cx = c[ray.kx] - ray.sx * c[ray.kz];
+  const float cy = c[ray.ky] - ray.sy * c[ray.kz];
+  // Scaled barycentrics: 2D edge functions of the projected edges against the origin.
+  float u = cx * by - cy * bx;
+  float v = ax * cy - ay * cx;
+  float w = bx * ay - by * ax;
+  // An edge function of exactly zero may be a rounding artefact; the paper recomputes it in
+  // double precision so that neighbouring triangles agree on which side the ray passes.
+  if (u == 0.0f || v == 0.0f || w == 0.0f) {
+    u = float(double(cx) * double(by) - double(cy) * double(bx));
+    v = float(double(ax) * double(cy) - double(ay) * double(cx));
+    w = float(double(bx) * double(ay) - double(by) * double(ax));
+  }
+  // Both faces are hit: reject only when the signs are mixed.
+  if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
+  const float det = u + v + w;
+  if (det == 0.0f) return false;
+  // Scaled hit distance; compare against the range scaled by det to avoid a division.
+  const float az = ray.sz * a[ray.kz];
+  const float bz = ray.sz * b[ray.kz];
+  const float cz = ray.sz * c[ray.kz];
+  const float t = u * az + v * bz + w * cz;
+  if (det > 0.0f ? (t <= 0.0f || t >= tMax * det) : (t >= 0.0f || t <= tMax * det)) return false;
+  const float invDet = 1.0f / det;
+  hit.t = t * invDet;
+  hit.barycentrics = vec3(u, v, w) * invDet;
+  return true;
+}
+
+bool intersectBox(const RayPrecomputed& ray, vec3 lo, vec3 hi, float tMax, float& tNear) {
+  const vec3 t0 = (lo - ray.origin) * ray.invDirection;
+  const vec3 t1 = (hi - ray.origin) * ray.invDirection;
+  const vec3 tMin = min(t0, t1);
+  const vec3 tMaxV = max(t0, t1);
+  const float enter = std::max(std::max(tMin.x, tMin.y), std::max(tMin.z, 0.0f));
+  const float exit = std::min(std::min(tMaxV.x, tMaxV.y), std::min(tMaxV.z, tMax)) * kFarScale;
+  tNear = enter;
+  return enter <= exit;
+}
+
+namespace {
+
+// One loop for both query kinds. Near child first: both children's boxes are tested, the
+// nearer is visited next and the farther pushed. A popped node is visited without
+// re-testing its box (it was hit when pushed).
+template <bool kAnyHit>
+bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best, TraversalStats* stats) {
+  const RayPrecomputed r(ray);
+  float tNear = 0.0f;
+  const BvhNode& root = bvh.nodes[0];
+  if (!intersectBox(r, root.boundsMin, root.boundsMax, tMax, tNear)) return false;
+  uint32_t stack[kBvhStackSize];
+  uint32_t stackSize = 0;
+  uint32_t nodeIndex = 0;
+  bool found = false;
+  float closest = tMax;
+  for (;;) {
+    const BvhNode& node = bvh.nodes[nodeIndex];
+    if (stats) stats->nodes++;
+    if (node.count > 0) {
+      // Leaf: test its triangles, shrinking the search range as hits are found.
+      for (uint32_t i = node.offset; i < node.offset + node.count; ++i) {
+        if (stats) stats->triangleTests++;
+        Hit hit;
+        if (intersectTriangle(r, bvh.triangles[i], closest, hit)) {
+          hit.triangle = i;
+          best = hit;
+          closest = hit.t;
+          found = true;
+          if constexpr (kAnyHit) return true;
+        }
+      }
+    } else {
+      // Interior: visit the nearer child that the ray enters, push the other.
+      const uint32_t left = nodeIndex + 1;
+      const uint32_t right = node.offset;
+      float tLeft = 0.0f, tRight = 0.0f;
+      const bool hitLeft = intersectBox(r, bvh.nodes[left].boundsMin, bvh.nodes[left].boundsMax,
+                                        closest, tLeft);
+      const bool hitRight = intersectBox(r, bvh.nodes[right].boundsMin,
+                                         bvh.nodes[right].boundsMax, closest, tRight);
+      if (hitLeft && hitRight) {
+        const bool leftFirst = tLeft <= tRight;
+        stack[stackSize++] = leftFirst ? right : left;
+        nodeIndex = leftFirst ? left : right;
+        continue;
+      }
+      if (hitLeft || hitRight) {
+        nodeIndex = hitLeft ? left : right;
+        continue;
+      }
+    }
+    if (stackSize == 0) break;
+    nodeIndex = stack[--stackSize];
+  }
+  return found;
+}
+
+}  // namespace
+
+std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats) {
+  Hit hit;
+  if (traverse</*kAnyHit=*/false>(bvh, ray, tMax, hit, stats)) return hit;
+  return std::nullopt;
+}
+
+bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats) {
+  Hit hit;
+  return traverse</*kAnyHit=*/true>(bvh, ray, tMax, hit, stats);
+}
+
+}  // namespace pt

@@ -1,0 +1,52 @@
+// Ray queries on the flat BVH: watertight ray/triangle intersection (Woop, Benthin and Wald
+// 2013), a slab test that stays correct for axis-parallel rays (Ize 2013 for the rounding of
+// the far distance), and iterative stack-based traversal, near child first, with a
+// closest-hit and an any-hit (shadow ray) mode. The shader implements the same algorithms
+// in GLSL; this is the CPU reference's own copy.
+#pragma once
+
+#include <optional>
+
+#include "bvh/bvh.h"
+
+namespace pt {
+
+struct Ray {
+  vec3 origin;
+  vec3 direction;  // need not be unit length; t is measured in units of |direction|
+};
+
+// Per-ray constants of the watertight test and the slab test, computed once per ray.
+struct RayPrecomputed {
+  vec3 origin;
+  vec3 invDirection;  // 1 / direction, with |direction| clamped away from 0 (no inf, no NaN)
+  int kx, ky, kz;     // kz: axis of the largest |direction|; (kx, ky) keep the winding
+  float sx, sy, sz;   // shear constants
+  explicit RayPrecomputed(const Ray& ray);
+};
+
+struct Hit {
+  float t = 0.0f;
+  vec3 barycentrics{0.0f};  // weights of v0, v1, v2
+  uint triangle = 0;        // index into Bvh::triangles
+};
+
+// Watertight intersection; accepts hits from both sides with 0 < t < tMax.
+bool intersectTriangle(const RayPrecomputed& ray, const Triangle& tri, float tMax, Hit& hit);
+
+// Slab test; on a hit, tNear is the entry distance (clamped to 0).
+bool intersectBox(const RayPrecomputed& ray, vec3 lo, vec3 hi, float tMax, float& tNear);
+
+// Counters for statistics and tests: nodes visited and triangles tested.
+struct TraversalStats {
+  uint64_t nodes = 0;
+  uint64_t triangleTests = 0;
+};
+
+std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax = INFINITY,
+                              TraversalStats* stats = nullptr);
+
+// True if anything lies on the ray with 0 < t < tMax. Stops at the first hit found.
+bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats = nullptr);
+
+}  // namespace pt

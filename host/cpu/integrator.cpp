@@ -1,0 +1,208 @@
+// CPU reference integrator: unbiased path tracing with next-event estimation, BSDF sampling
+// and multiple importance sampling (power heuristic), Russian roulette. Follows the outline
+// of pbrt's PathIntegrator::Li; the shader's loop is a separate GLSL transcription.
+#include "cpu/integrator.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "bvh/traverse.h"
+#include "common/check.h"
+
+namespace pt {
+namespace {
+
+float maxComponent(vec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
+
+}  // namespace
+
+Ray cameraRay(const Camera& cam, vec2 filmPoint) {
+  const float u = 2.0f * filmPoint.x / float(cam.width) - 1.0f;
+  const float v = 1.0f - 2.0f * filmPoint.y / float(cam.height);
+  const vec3 d = cam.forward + (u * cam.tanHalfFovY * cam.aspect) * cam.right +
+                 (v * cam.tanHalfFovY) * cam.up;
+  return Ray{cam.position, normalize(d)};
+}
+
+vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays) {
+  const RenderParams& params = scene.params;
+  const Bvh& bvh = scene.bvh;
+  const uint seed = params.seed;
+  const bool misOn = params.strategy == kStrategyMis;
+  const bool neeOn = params.strategy != kStrategyBsdf && params.emitterCount > 0;
+  const bool bsdfEmissionOn = params.strategy != kStrategyNee;
+
+  // Primary ray through a uniformly jittered point of the pixel (box filter of width 1).
+  Ray ray = cameraRay(params.camera,
+                      vec2(pixel) + random2(pixel, sampleIndex, kDimPixel, seed));
+  vec3 L(0.0f);     // radiance gathered so far
+  vec3 beta(1.0f);  // path throughput
+  // The camera ray counts as specular: emission it finds is taken at full weight.
+  bool specularBounce = true;
+  float bsdfPdf = 0.0f;  // solid-angle pdf of the BSDF sample that produced `ray`
+
+  for (uint depth = 0;;) {
+    // Find the closest surface along the ray; the background is black.
+    ++rays;
+    const std::optional<Hit> hit = closestHit(bvh, ray);
+    if (!hit) break;
+    const Triangle& tri = bvh.triangles[hit->triangle];
+    const Material& material = scene.materials[tri.material];
+    // Hit point from barycentrics (more accurate than origin + t * direction).
+    const vec3 p = hit->barycentrics.x * tri.v0 + hit->barycentrics.y * tri.v1 +
+                   hit->barycentrics.z * tri.v2;
+    const vec3 edgeCross = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
+    const vec3 ng = normalize(edgeCross);
+    const vec3 wo = -ray.direction;
+    const float cosOut = dot(ng, wo);
+
+    // Add emitted light found by this ray: one-sided, on the geometric normal's side.
+    if (tri.emitter != kNoEmitter && cosOut > 0.0f) {
+      const vec3 Le = material.emission;
+      if (specularBounce) {
+        L += beta * Le;
+      } else if (bsdfEmissionOn) {
+        // Weigh against the chance that light sampling had produced this point.
+        float weight = 1.0f;
+        if (misOn) {
+          const float area = 0.5f * length(edgeCross);
+          const float lightPdf = scene.emitters[tri.emitter].pmf * hit->t * hit->t /
+                                 (cosOut * area);  // |direction| = 1, so t is the distance
+          weight = powerHeuristic(bsdfPdf, lightPdf);
+        }
+        L += beta * weight * Le;
+      }
+    }
+
+    // Stop after maxDepth scattering events.
+    if (depth == params.maxDepth) break;
+    const uint dim = kDimFirstBounce + kDimsPerBounce * depth;
+    ++depth;
+
+    // Both materials are two-sided: shade with the normal facing the incoming ray.
+    const vec3 n = cosOut >= 0.0f ? ng : -ng;
+    vec3 wi;
+    if (material.type == kMaterialMirror) {
+      // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
+      wi = ray.direction - 2.0f * dot(ray.direction, n) * n;
+      beta *= material.reflectance;
+      specularBounce = true;
+    } else {
+      const vec3 f = material.reflectance * kInvPi;
+      // Sample direct illumination from an emitter (next-event estimation).
+      if (neeOn && material.reflectance != vec3(0.0f)) {
+        // Pick an emitter from the alias table, then a uniform point on its triangle.
+        const vec2 uChoose = random2(pixel, sampleIndex, dim + kDimLightChoose, seed);
+        const uint slot = std::min(uint(uChoose.x * float(params.emitterCount)),
+                                   params.emitterCount - 1u);
+        const Emitter& chosen = scene.emitters[slot];
+        const Emitter& emitter =
+            uChoose.y < chosen.aliasThreshold ? chosen : scene.emitters[chosen.alias];
+        const Triangle& light = bvh.triangles[emitter.triangle];
+        const vec2 b = sampleTriangleBarycentrics(
+            random2(pixel, sampleIndex, dim + kDimLightPoint, seed));
+        const vec3 lightPoint = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
+        const vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
+        const float lightArea = 0.5f * length(lightCross);
+        const vec3 lightNormal = normalize(lightCross);
+
+        const vec3 toLight = lightPoint - p;
+        const float dist2 = dot(toLight, toLight);
+        const vec3 wl = toLight / std::sqrt(dist2);
+        const float cosLight = -dot(lightNormal, wl);  // > 0: we see the emitting side
+        const float cosSurface = dot(n, wl);
+        if (cosLight > 0.0f && cosSurface > 0.0f) {
+          // Shadow ray between the two offset points; t in [0, 1) spans the segment.
+          const vec3 from = offsetRayOrigin(p, n);
+          const vec3 to = offsetRayOrigin(lightPoint, lightNormal);
+          ++rays;
+          if (!anyHit(bvh, Ray{from, to - from}, 1.0f)) {
+            const float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
+            const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
+            const vec3 Le = scene.materials[light.material].emission;
+            L += beta * f * Le * (cosSurface * weight / lightPdf);
+          }
+        }
+      }
+      // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
+      wi = localToWorld(sampleCosineHemisphere(random2(pixel, sampleIndex, dim + kDimBsdf, seed)),
+                        n);
+      bsdfPdf = dot(wi, n) * kInvPi;
+      if (!(bsdfPdf > 0.0f)) break;  // direction in the tangent plane: zero contribution
+      beta *= material.reflectance;
+      specularBounce = false;
+    }
+    if (maxComponent(beta) <= 0.0f) break;
+
+    // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
+    if (params.russianRoulette != 0u && depth >= params.rrStartDepth) {
+      const float q = std::max(0.0f, 1.0f - maxComponent(beta));
+      if (random1(pixel, sampleIndex, dim + kDimRoulette, seed) < q) break;
+      beta /= 1.0f - q;
+    }
+
+    // Leave the surface on the side of the new direction.
+    ray = Ray{offsetRayOrigin(p, n), wi};
+  }
+  return L;
+}
+
+RenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film) {
+  const Camera& cam = scene.params.camera;
+  PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
+  const auto start = std::chrono::steady_clock::now();
+  RenderStats stats;
+  stats.threads = options.threads > 0 ? options.threads
+                                      : int(std::max(1u, std::thread::hardware_concurrency()));
+
+  // Tiles are handed out through an atomic counter; each pixel belongs to one tile, so
+  // threads write disjoint film pixels. Random numbers depend on (pixel, sample) only, so
+  // the image does not depend on the thread count or the tile order.
+  constexpr int kTile = 16;
+  const int tilesX = (film.width + kTile - 1) / kTile;
+  const int tilesY = (film.height + kTile - 1) / kTile;
+  const int tileCount = tilesX * tilesY;
+  std::atomic<int> nextTile{0};
+  std::atomic<int> tilesDone{0};
+  std::atomic<uint64_t> totalRays{0};
+  std::mutex progressMutex;
+
+  auto worker = [&]() {
+    uint64_t rays = 0;
+    for (int tile; (tile = nextTile.fetch_add(1)) < tileCount;) {
+      const int x0 = (tile % tilesX) * kTile;
+      const int y0 = (tile / tilesX) * kTile;
+      for (int y = y0; y < std::min(y0 + kTile, film.height); ++y) {
+        for (int x = x0; x < std::min(x0 + kTile, film.width); ++x) {
+          for (int s = 0; s < options.spp; ++s) {
+            const uint32_t sampleIndex = options.firstSample + uint32_t(s);
+            film.add(x, y, sampleRadiance(scene, uvec2(x, y), sampleIndex, rays));
+          }
+        }
+      }
+      const int done = tilesDone.fetch_add(1) + 1;
+      if (options.progress) {
+        std::unique_lock lock(progressMutex, std::try_to_lock);
+        if (lock.owns_lock()) options.progress(double(done) / double(tileCount));
+      }
+    }
+    totalRays += rays;
+  };
+  std::vector<std::thread> threads;
+  for (int i = 1; i < stats.threads; ++i) threads.emplace_back(worker);
+  worker();
+  for (std::thread& t : threads) t.join();
+  if (options.progress) options.progress(1.0);
+
+  stats.rays = totalRays;
+  stats.invalidSamples = film.totalInvalid();
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+}  // namespace pt

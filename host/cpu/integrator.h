@@ -1,0 +1,40 @@
+// The CPU reference path tracer: plain C++, written for clarity, multithreaded over tiles.
+// It reads the same flat arrays and draws the same random numbers as the shader, so a
+// difference image between the two backends points at a bug.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "bvh/traverse.h"
+#include "image/image.h"
+#include "render/prepare.h"
+
+namespace pt {
+
+struct CpuRenderOptions {
+  int threads = 0;             // 0: all hardware threads
+  uint32_t firstSample = 0;    // sample indices [firstSample, firstSample + spp) are taken
+  int spp = 1;
+  // Called now and then from one thread with the fraction of work done, in [0, 1].
+  std::function<void(double)> progress;
+};
+
+struct RenderStats {
+  double seconds = 0.0;
+  uint64_t rays = 0;            // every ray traced: camera, bounce and shadow rays
+  uint64_t invalidSamples = 0;  // samples whose radiance was NaN or Inf (not accumulated)
+  int threads = 0;
+};
+
+// Camera ray through film point (x, y) in [0, width) x [0, height), row 0 at the top.
+Ray cameraRay(const Camera& camera, vec2 filmPoint);
+
+// Radiance arriving at the camera along one path sample of pixel (x, y). Exposed so tests
+// can evaluate single paths; `rays` is incremented by the rays traced.
+vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays);
+
+// Renders into film (which must have the camera's resolution), adding spp samples per pixel.
+RenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film);
+
+}  // namespace pt

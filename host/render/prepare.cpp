@@ -1,0 +1,109 @@
+// Scene preparation; see prepare.h.
+#include "render/prepare.h"
+
+#include <cmath>
+
+#include "common/check.h"
+
+namespace pt {
+
+std::string EffectSet::toString() const {
+  std::string s;
+  auto add = [&s](bool on, const char* name) {
+    if (!on) return;
+    if (!s.empty()) s += '+';
+    s += name;
+  };
+  add(diffuse, "diffuse");
+  add(mirror, "mirror");
+  add(lightSampling, "nee");
+  add(bsdfEmission && lightSampling, "mis");
+  add(russianRoulette, "rr");
+  return s.empty() ? "none" : s;
+}
+
+std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
+                                   const std::vector<Material>& materials) {
+  // Power of each emissive triangle: one-sided, so flux = pi * area * radiance; the pmf only
+  // needs proportions, and luminance weights the channels.
+  std::vector<Emitter> emitters;
+  std::vector<double> power;
+  for (uint32_t i = 0; i < triangles.size(); ++i) {
+    Triangle& tri = triangles[i];
+    tri.emitter = kNoEmitter;
+    const vec3 e = materials[tri.material].emission;
+    const double luminance = 0.2126 * e.x + 0.7152 * e.y + 0.0722 * e.z;
+    const double area = 0.5 * double(length(cross(tri.v1 - tri.v0, tri.v2 - tri.v0)));
+    if (!(luminance > 0.0) || !(area > 0.0)) continue;
+    tri.emitter = uint32_t(emitters.size());
+    emitters.push_back(Emitter{i, 0.0f, 1.0f, uint32_t(emitters.size())});
+    power.push_back(luminance * area);
+  }
+  if (emitters.empty()) return emitters;
+
+  // Vose's alias method: scale probabilities by n, then pair each under-full slot with an
+  // over-full one that tops it up. Slots left at the end are full (threshold 1).
+  const size_t n = emitters.size();
+  double total = 0.0;
+  for (double p : power) total += p;
+  std::vector<double> scaled(n);
+  std::vector<uint32_t> small, large;
+  for (size_t i = 0; i < n; ++i) {
+    emitters[i].pmf = float(power[i] / total);
+    scaled[i] = power[i] / total * double(n);
+    (scaled[i] < 1.0 ? small : large).push_back(uint32_t(i));
+  }
+  while (!small.empty() && !large.empty()) {
+    const uint32_t s = small.back();
+    small.pop_back();
+    const uint32_t l = large.back();
+    emitters[s].aliasThreshold = float(scaled[s]);
+    emitters[s].alias = l;
+    scaled[l] -= 1.0 - scaled[s];
+    if (scaled[l] < 1.0) {
+      large.pop_back();
+      small.push_back(l);
+    }
+  }
+  for (uint32_t i : small) emitters[i].aliasThreshold = 1.0f;  // rounding leftovers
+  for (uint32_t i : large) emitters[i].aliasThreshold = 1.0f;
+  return emitters;
+}
+
+SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
+  SceneData data;
+  const int width = settings.width > 0 ? settings.width : scene.camera.width;
+  const int height = settings.height > 0 ? settings.height : scene.camera.height;
+  const IntegratorSettings& integ = scene.integrator;
+  data.spp = settings.spp > 0 ? settings.spp : integ.spp;
+  data.materials = scene.materials;
+
+  data.bvh = buildBvh(scene.triangles, BvhBuildOptions{settings.maxLeafSize});
+  // Emitters index triangles in leaf order, so they are built after the reorder.
+  data.emitters = buildEmitters(data.bvh.triangles, data.materials);
+
+  RenderParams& p = data.params;
+  p.camera = makeCamera(scene.camera, width, height);
+  p.maxDepth = uint32_t(settings.maxDepth >= 0 ? settings.maxDepth : integ.maxDepth);
+  p.rrStartDepth = uint32_t(integ.rrStartDepth);
+  p.emitterCount = uint32_t(data.emitters.size());
+  p.seed = settings.seed >= 0 ? uint32_t(settings.seed) : integ.seed;
+  p.strategy = integ.strategy;
+  p.russianRoulette = integ.russianRoulette ? 1u : 0u;
+
+  // Effects: which material kinds occur on triangles, and whether light sampling can matter.
+  EffectSet& fx = data.effects;
+  for (const Triangle& tri : data.bvh.triangles) {
+    const Material& m = data.materials[tri.material];
+    const bool reflects = m.reflectance != vec3(0.0f);
+    if (m.type == kMaterialMirror && reflects) fx.mirror = true;
+    if (m.type == kMaterialDiffuse && reflects) fx.diffuse = true;
+  }
+  const bool scatters = p.maxDepth > 0;
+  fx.lightSampling = fx.diffuse && scatters && !data.emitters.empty() && p.strategy != kStrategyBsdf;
+  fx.bsdfEmission = !data.emitters.empty() && p.strategy != kStrategyNee;
+  fx.russianRoulette = p.russianRoulette != 0 && scatters && (fx.diffuse || fx.mirror);
+  return data;
+}
+
+}  // namespace pt

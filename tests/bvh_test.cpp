@@ -1,0 +1,310 @@
+// BVH construction invariants and traversal against brute force.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include "bvh/bvh.h"
+#include "bvh/traverse.h"
+#include "scene/scene.h"
+#include "test_util.h"
+
+namespace pt {
+namespace {
+
+std::vector<Triangle> loadBunny() {
+  test::TempDir dir;
+  std::ofstream(dir / "bunny.json") << R"({
+    "materials": [{"name": "white", "reflectance": [0.5, 0.5, 0.5]}],
+    "shapes": [{"type": "obj", "file": "/usr/share/glmark2/models/bunny.obj",
+                "material": "white"}]})";
+  return loadScene(dir / "bunny.json").triangles;
+}
+
+// Checks every structural invariant of a built BVH.
+void expectValidBvh(const Bvh& bvh, size_t triangleCount, int maxLeafSize) {
+  ASSERT_EQ(bvh.triangles.size(), triangleCount);
+  ASSERT_LE(bvh.maxDepth, int(kBvhStackSize));
+  std::vector<int> leafOf(triangleCount, 0);  // how many leaves hold each triangle slot
+  std::vector<int> seenPrimitive(triangleCount, 0);
+  size_t leaves = 0;
+  // Walk the tree from the root, checking children against parents.
+  struct Item { uint32_t node; int depth; };
+  std::vector<Item> todo{{0, 0}};
+  std::vector<int> visited(bvh.nodes.size(), 0);
+  while (!todo.empty()) {
+    const Item item = todo.back();
+    todo.pop_back();
+    ASSERT_LT(item.node, bvh.nodes.size());
+    visited[item.node]++;
+    const BvhNode& node = bvh.nodes[item.node];
+    ASSERT_TRUE(all(lessThanEqual(node.boundsMin, node.boundsMax)));
+    if (node.count > 0) {
+      ++leaves;
+      EXPECT_LE(node.count, uint32_t(maxLeafSize));
+      ASSERT_LE(size_t(node.offset) + node.count, triangleCount);
+      for (uint32_t i = node.offset; i < node.offset + node.count; ++i) {
+        leafOf[i]++;
+        const Triangle& t = bvh.triangles[i];
+        for (vec3 v : {t.v0, t.v1, t.v2}) {
+          EXPECT_TRUE(all(lessThanEqual(node.boundsMin, v)) && all(lessThanEqual(v, node.boundsMax)));
+        }
+      }
+      continue;
+    }
+    const uint32_t left = item.node + 1, right = node.offset;
+    ASSERT_GT(right, left) << "right child must come after the left subtree";
+    for (uint32_t child : {left, right}) {
+      const BvhNode& c = bvh.nodes[child];
+      EXPECT_TRUE(all(lessThanEqual(node.boundsMin, c.boundsMin)));
+      EXPECT_TRUE(all(lessThanEqual(c.boundsMax, node.boundsMax)));
+      todo.push_back({child, item.depth + 1});
+    }
+  }
+  EXPECT_EQ(bvh.nodes.size(), 2 * leaves - 1);
+  for (size_t i = 0; i < bvh.nodes.size(); ++i) EXPECT_EQ(visited[i], 1) << "node " << i;
+  for (size_t i = 0; i < triangleCount; ++i) {
+    EXPECT_EQ(leafOf[i], 1) << "triangle slot " << i;
+    ASSERT_LT(bvh.triangles[i].primitive, triangleCount);
+    seenPrimitive[bvh.triangles[i].primitive]++;
+  }
+  for (size_t i = 0; i < triangleCount; ++i) EXPECT_EQ(seenPrimitive[i], 1) << "primitive " << i;
+}
+
+// Morton codes of the reordered triangles, normalised as the builder does, are sorted.
+void expectMortonOrder(const Bvh& bvh) {
+  vec3 lo(INFINITY), hi(-INFINITY);
+  std::vector<vec3> c;
+  for (const Triangle& t : bvh.triangles) {
+    c.push_back((t.v0 + t.v1 + t.v2) * (1.0f / 3.0f));
+    lo = min(lo, c.back());
+    hi = max(hi, c.back());
+  }
+  const vec3 e = hi - lo;
+  const vec3 s(e.x > 0 ? 1 / e.x : 0, e.y > 0 ? 1 / e.y : 0, e.z > 0 ? 1 / e.z : 0);
+  for (size_t i = 1; i < c.size(); ++i) {
+    ASSERT_LE(mortonCode63((c[i - 1] - lo) * s), mortonCode63((c[i] - lo) * s)) << i;
+  }
+}
+
+// Closest hit by testing every triangle.
+struct BruteHit {
+  bool found = false;
+  float t = INFINITY;
+  uint primitive = 0;
+};
+
+BruteHit bruteForce(const std::vector<Triangle>& tris, const Ray& ray) {
+  const RayPrecomputed r(ray);
+  BruteHit best;
+  for (const Triangle& tri : tris) {
+    Hit h;
+    if (intersectTriangle(r, tri, best.t, h)) best = {true, h.t, tri.primitive};
+  }
+  return best;
+}
+
+TEST(BvhMorton, InterleavesBitsXLowest) {
+  const float cell = 1.0f / float(1 << 21);
+  EXPECT_EQ(mortonCode63(vec3(0.0f)), 0u);
+  EXPECT_EQ(mortonCode63(vec3(cell * 1.5f, 0, 0)), 0b001u);
+  EXPECT_EQ(mortonCode63(vec3(0, cell * 1.5f, 0)), 0b010u);
+  EXPECT_EQ(mortonCode63(vec3(0, 0, cell * 1.5f)), 0b100u);
+  EXPECT_EQ(mortonCode63(vec3(cell * 2.5f, 0, 0)), 0b001000u);
+  // The top corner uses all 63 bits, and 1.0 maps to the last cell, not past it.
+  EXPECT_EQ(mortonCode63(vec3(1.0f)), (uint64_t(1) << 63) - 1);
+}
+
+TEST(BvhBuild, InvariantsHoldForSeveralLeafSizes) {
+  const std::vector<Triangle> sphere = test::makeSphere(vec3(1, 2, 3), 5.0f, 40, 60);
+  for (int leafSize : {1, 2, 4, 8}) {
+    SCOPED_TRACE("leaf size " + std::to_string(leafSize));
+    const Bvh bvh = buildBvh(sphere, BvhBuildOptions{leafSize});
+    expectValidBvh(bvh, sphere.size(), leafSize);
+    expectMortonOrder(bvh);
+  }
+}
+
+TEST(BvhBuild, SingleTriangleIsOneLeaf) {
+  const Bvh bvh = buildBvh({Triangle{vec3(0), 0, vec3(1, 0, 0), kNoEmitter, vec3(0, 1, 0), 0}});
+  ASSERT_EQ(bvh.nodes.size(), 1u);
+  EXPECT_EQ(bvh.nodes[0].count, 1u);
+  EXPECT_EQ(bvh.nodes[0].boundsMax, vec3(1, 1, 0));
+}
+
+TEST(BvhBuild, EqualMortonCodesStillSplit) {
+  // 100 copies of one triangle: every code is equal, yet leaves must stay small.
+  std::vector<Triangle> tris(100, Triangle{vec3(0), 0, vec3(1, 0, 0), kNoEmitter, vec3(0, 1, 0), 0});
+  for (uint i = 0; i < tris.size(); ++i) tris[i].primitive = i;
+  const Bvh bvh = buildBvh(tris, BvhBuildOptions{2});
+  expectValidBvh(bvh, tris.size(), 2);
+  EXPECT_LE(bvh.maxDepth, 7);  // balanced: ceil(log2(50)) levels
+}
+
+TEST(BvhBuild, DepthStaysWithinTraversalStack) {
+  // 63 clusters whose Morton codes each have a single bit set, one cluster per bit: every
+  // highest-differing-bit split peels off one cluster, a chain 62 levels deep, and each
+  // cluster of 64 coincident triangles needs 6 more levels with leaves of 1. Without the
+  // balanced fallback the tree would be 68 deep; the traversal stack holds kBvhStackSize.
+  constexpr float kCell = 1.0f / float(1 << 21);
+  std::vector<Triangle> tris;
+  auto addCluster = [&](vec3 c) {
+    // Coincident copies; small enough for the centroid to stay in its Morton cell, large
+    // enough to stay a real triangle in float where the coordinates reach 0.5.
+    const float s = 0.5f * kCell;
+    for (int i = 0; i < 64; ++i) {
+      tris.push_back(Triangle{c, 0, c + vec3(s, 0, 0), kNoEmitter, c + vec3(0, s, 0),
+                              uint(tris.size())});
+    }
+  };
+  for (int bit = 0; bit < 63; ++bit) {
+    vec3 c(0.25f * kCell);
+    c[bit % 3] = (std::ldexp(1.0f, bit / 3) + 0.5f) * kCell;
+    addCluster(c);
+  }
+  addCluster(vec3(1.0f));  // fixes the centroid bounds to about [0, 1]
+  const Bvh bvh = buildBvh(tris, BvhBuildOptions{1});
+  expectValidBvh(bvh, tris.size(), 1);
+  EXPECT_GT(bvh.maxDepth, 50);  // the Morton chain really is deep here
+  // Traversal with the fixed stack still finds what brute force finds, for every cluster.
+  for (size_t i = 0; i < tris.size(); i += 64) {
+    const Triangle& t = tris[i];
+    const Ray ray{(t.v0 + t.v1 + t.v2) / 3.0f - vec3(0, 0, 1), vec3(0, 0, 1)};
+    const auto hit = closestHit(bvh, ray);
+    ASSERT_TRUE(hit.has_value()) << "cluster " << i / 64;
+    EXPECT_EQ(hit->t, bruteForce(tris, ray).t);
+  }
+}
+
+TEST(BvhBuild, BunnyInvariants) {
+  const std::vector<Triangle> bunny = loadBunny();
+  ASSERT_EQ(bunny.size(), 69666u);
+  const Bvh bvh = buildBvh(bunny, BvhBuildOptions{4});
+  expectValidBvh(bvh, bunny.size(), 4);
+  expectMortonOrder(bvh);
+}
+
+TEST(BvhTraversal, MatchesBruteForceOnBunny) {
+  const std::vector<Triangle> bunny = loadBunny();
+  const Bvh bvh = buildBvh(bunny, BvhBuildOptions{4});
+  // Ray set: origins around the mesh; half aimed at a random point of a random triangle (so
+  // most hit), half in uniformly random directions (many miss).
+  constexpr int kRays = 100000;
+  std::mt19937 rng(1234);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  std::vector<Ray> rays(kRays);
+  std::vector<float> shadowFraction(kRays);
+  for (int i = 0; i < kRays; ++i) {
+    const vec3 o(uni(rng) * 4 - 2, uni(rng) * 4 - 2, uni(rng) * 4 - 2);
+    vec3 d;
+    if (i % 2 == 0) {
+      const Triangle& t = bunny[size_t(uni(rng) * float(bunny.size())) % bunny.size()];
+      const vec2 b = sampleTriangleBarycentrics(vec2(uni(rng), uni(rng)));
+      d = normalize((1 - b.x - b.y) * t.v0 + b.x * t.v1 + b.y * t.v2 - o);
+    } else {
+      d = normalize(vec3(uni(rng) - 0.5f, uni(rng) - 0.5f, uni(rng) - 0.5f));
+    }
+    rays[i] = Ray{o, d};
+    shadowFraction[i] = uni(rng) * 2.0f;  // any-hit range as a fraction of the closest t
+  }
+  // Brute force on all cores: every triangle is considered for every ray (7e9 pairs); a
+  // conservative bounding-sphere test skips the exact test where it cannot hit.
+  std::vector<vec4> spheres;  // centre, squared radius
+  for (const Triangle& t : bunny) {
+    const vec3 c = (t.v0 + t.v1 + t.v2) / 3.0f;
+    const float r2 = std::max({dot(t.v0 - c, t.v0 - c), dot(t.v1 - c, t.v1 - c),
+                               dot(t.v2 - c, t.v2 - c)});
+    spheres.emplace_back(c, r2 * 1.001f + 1e-12f);
+  }
+  auto bruteForceCulled = [&](const Ray& ray) {
+    const RayPrecomputed r(ray);
+    BruteHit best;
+    for (size_t k = 0; k < bunny.size(); ++k) {
+      const vec3 v = vec3(spheres[k]) - ray.origin;
+      const float vv = dot(v, v), tc = dot(v, ray.direction);
+      // Squared distance of the centre from the ray's line, with slack for rounding.
+      if (vv - tc * tc > spheres[k].w + 1e-5f * vv) continue;
+      Hit h;
+      if (intersectTriangle(r, bunny[k], best.t, h)) best = {true, h.t, bunny[k].primitive};
+    }
+    return best;
+  };
+  std::vector<BruteHit> expected(kRays);
+  {
+    const unsigned n = std::max(1u, std::thread::hardware_concurrency());
+    std::vector<std::thread> pool;
+    for (unsigned w = 0; w < n; ++w)
+      pool.emplace_back([&, w] {
+        for (int i = int(w); i < kRays; i += int(n)) expected[i] = bruteForceCulled(rays[i]);
+      });
+    for (auto& th : pool) th.join();
+  }
+  int hits = 0, mismatches = 0, anyHitMismatches = 0;
+  for (int i = 0; i < kRays; ++i) {
+    const auto hit = closestHit(bvh, rays[i]);
+    const BruteHit& e = expected[i];
+    hits += e.found;
+    // Same distance bit for bit (the triangle may differ only where two share that
+    // distance, at an edge, so the distance is what is compared).
+    const bool same = hit.has_value() == e.found && (!e.found || hit->t == e.t);
+    if (!same && ++mismatches <= 5) ADD_FAILURE() << "ray " << i << " closest hit differs";
+    // Any-hit within a range that may or may not contain the closest hit.
+    const float tMax = e.found ? e.t * shadowFraction[i] : 1e3f;
+    const bool blocked = anyHit(bvh, rays[i], tMax);
+    const bool expectBlocked = e.found && e.t < tMax;
+    if (blocked != expectBlocked && ++anyHitMismatches <= 5)
+      ADD_FAILURE() << "ray " << i << " any-hit differs";
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(anyHitMismatches, 0);
+  EXPECT_GT(hits, kRays / 2);  // the test exercises hits, not just misses
+}
+
+TEST(BvhTraversal, AxisParallelRaysInFacePlanes) {
+  // A closed octahedron in the unit cube; rays along the axes that run exactly in the planes of the
+  // box faces (direction components exactly 0) must still find the far faces.
+  const std::vector<Triangle> cube = test::makeSphere(vec3(0.5f), 0.5f, 2, 4);  // an octahedron
+  const Bvh bvh = buildBvh(cube);
+  const BvhNode& root = bvh.nodes[0];
+  // Origin on the root box's min-x face plane, travelling along +y inside that plane.
+  const Ray inPlane{vec3(root.boundsMin.x, root.boundsMin.y - 1.0f, 0.5f), vec3(0, 1, 0)};
+  float tNear = 0;
+  EXPECT_TRUE(intersectBox(RayPrecomputed(inPlane), root.boundsMin, root.boundsMax, INFINITY, tNear));
+  EXPECT_FLOAT_EQ(tNear, 1.0f);
+  // A parallel ray outside the slab misses the box. (Within about 1e-30 of the plane the
+  // test may report a hit: box tests may err towards hits, never towards misses.)
+  const Ray outside{vec3(root.boundsMin.x - 1e-6f, root.boundsMin.y - 1, 0.5f), vec3(0, 1, 0)};
+  EXPECT_FALSE(intersectBox(RayPrecomputed(outside), root.boundsMin, root.boundsMax, INFINITY, tNear));
+  // Axis-parallel rays through the centre hit the closed mesh, and agree with brute force.
+  for (vec3 d : {vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1),
+                 vec3(0, 0, -1)}) {
+    const Ray ray{vec3(0.5f), d};
+    const auto hit = closestHit(bvh, ray);
+    ASSERT_TRUE(hit.has_value());
+    EXPECT_EQ(hit->t, bruteForce(cube, ray).t);
+  }
+}
+
+TEST(BvhTraversal, WatertightAtSharedEdgesAndVertices) {
+  // Rays from inside a closed sphere aimed exactly at its vertices and edge midpoints, where
+  // a non-watertight test lets rays slip between triangles.
+  const std::vector<Triangle> sphere = test::makeSphere(vec3(0.3f, -0.2f, 0.1f), 1.0f, 30, 50);
+  const Bvh bvh = buildBvh(sphere);
+  const vec3 origins[] = {vec3(0.3f, -0.2f, 0.1f), vec3(0.5f, 0.1f, -0.2f)};
+  int rays = 0, leaks = 0;
+  for (const vec3& o : origins) {
+    for (const Triangle& t : sphere) {
+      for (vec3 target : {t.v0, t.v1, t.v2, 0.5f * (t.v0 + t.v1), 0.5f * (t.v1 + t.v2)}) {
+        ++rays;
+        if (!closestHit(bvh, Ray{o, target - o}).has_value()) ++leaks;
+      }
+    }
+  }
+  EXPECT_GT(rays, 20000);
+  EXPECT_EQ(leaks, 0);
+}
+
+}  // namespace
+}  // namespace pt
