@@ -59,11 +59,31 @@ PT_INLINE vec3 localToWorld(vec3 local, vec3 n) {
   return local.x * t + local.y * bt + local.z * n;
 }
 
+// (cos(2 pi u), sin(2 pi u)) for u in [0, 1], from plain arithmetic instead of the GPU's
+// cos and sin, whose precision Vulkan leaves loose (about 1e-3 absolute is allowed): with
+// them, CPU and GPU paths would drift apart. Reduces to the quadrant nearest u, where the
+// angle x lies in [-pi/4, pi/4], and sums Taylor series to x^9 / x^10 (error < 3e-9).
+PT_INLINE vec2 cosSinTwoPi(float u) {
+  float quadrant = floor(4.0f * u + 0.5f);
+  float x = (2.0f * kPi) * (u - 0.25f * quadrant);
+  float x2 = x * x;
+  float s = x * (1.0f + x2 * (-1.0f / 6.0f + x2 * (1.0f / 120.0f + x2 * (-1.0f / 5040.0f +
+                                                                        x2 * (1.0f / 362880.0f)))));
+  float c = 1.0f + x2 * (-0.5f + x2 * (1.0f / 24.0f + x2 * (-1.0f / 720.0f + x2 * (1.0f / 40320.0f +
+                                                                        x2 * (-1.0f / 3628800.0f)))));
+  // Rotate by quadrant * 90 degrees.
+  int q = int(quadrant) & 3;
+  if (q == 1) return vec2(-s, c);
+  if (q == 2) return vec2(-c, -s);
+  if (q == 3) return vec2(s, -c);
+  return vec2(c, s);
+}
+
 // Cosine-weighted direction about +z (Malley's method); pdf = cos(theta) / pi.
 PT_INLINE vec3 sampleCosineHemisphere(vec2 u) {
   float r = sqrt(u.x);
-  float phi = 2.0f * kPi * u.y;
-  return vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0f, 1.0f - u.x)));
+  vec2 cs = cosSinTwoPi(u.y);
+  return vec3(r * cs.x, r * cs.y, sqrt(max(0.0f, 1.0f - u.x)));
 }
 
 // Uniformly distributed point on triangle (v0, v1, v2), as barycentric weights of v1, v2.
@@ -81,22 +101,25 @@ PT_INLINE float powerHeuristic(float a, float b) {
 
 // ---- Ray origins -----------------------------------------------------------------------
 
-// Moves a ray origin p off the surface along n (the side the new ray leaves from) by an
-// amount that scales with |p|: a fixed number of float ulps, or a small absolute step near
-// the origin where ulps vanish. Wächter and Binder, "A Fast and Robust Method for Avoiding
-// Self-Intersection", Ray Tracing Gems (2019), chapter 6.
-PT_CONST float kOffsetOrigin = 1.0f / 32.0f;
-PT_CONST float kOffsetFloatScale = 1.0f / 65536.0f;
-PT_CONST float kOffsetIntScale = 256.0f;
+// Moves a ray origin p off its surface along n (unit, on the side the new ray leaves from)
+// by a fixed fraction of `magnitude`, the largest absolute coordinate of p and of the
+// triangle's vertices. Why that scale: the watertight test's rounding, and so the distance
+// at which a ray can re-hit its own triangle, grows with the coordinates of the vertices
+// relative to the origin, all three axes mixed by the shear. Wächter and Binder (Ray Tracing
+// Gems, 2019, ch. 6) offset each axis by ulps of that axis alone; on a plane through the
+// origin (the Cornell box's green wall is x = 0) that leaves an offset of 1e-5 where the
+// test rounds at 1e-4 (coordinates ~500), and shadow rays hit their own wall. 2^-16 of the
+// magnitude is 64 to 128 float ulps of the largest coordinate: far above that rounding,
+// scale-invariant, and (0.009 in the Cornell box) below its 0.01 light-to-ceiling gap.
+PT_CONST float kOffsetScale = 1.0f / 65536.0f;
 
-PT_INLINE float offsetComponent(float p, float n) {
-  int ulps = int(kOffsetIntScale * n);
-  float moved = intBitsToFloat(floatBitsToInt(p) + (p < 0.0f ? -ulps : ulps));
-  return abs(p) < kOffsetOrigin ? p + kOffsetFloatScale * n : moved;
+PT_INLINE float triangleMagnitude(vec3 v0, vec3 v1, vec3 v2) {
+  vec3 m = max(abs(v0), max(abs(v1), abs(v2)));
+  return max(m.x, max(m.y, m.z));
 }
 
-PT_INLINE vec3 offsetRayOrigin(vec3 p, vec3 n) {
-  return vec3(offsetComponent(p.x, n.x), offsetComponent(p.y, n.y), offsetComponent(p.z, n.z));
+PT_INLINE vec3 offsetRayOrigin(vec3 p, vec3 n, float magnitude) {
+  return p + (magnitude * kOffsetScale) * n;
 }
 
 #ifdef __cplusplus

@@ -101,6 +101,55 @@ struct RenderParams {
   uint reserved1;     //  4 bytes: zero
 };                    // 96 bytes
 
+// ---- Compute pipeline interface (Vulkan backend) ----------------------------------------
+
+// Descriptor bindings of set 0, all storage buffers.
+#define PT_BINDING_PARAMS 0     // RenderParams
+#define PT_BINDING_NODES 1      // BvhNode[]
+#define PT_BINDING_TRIANGLES 2  // Triangle[]
+#define PT_BINDING_MATERIALS 3  // Material[]
+#define PT_BINDING_EMITTERS 4   // Emitter[] (one dummy entry when the scene has none)
+#define PT_BINDING_ACCUM 5      // AccumPixel[width * height]
+#define PT_BINDING_COUNTERS 6   // DeviceCounters
+#define PT_BINDING_COUNT 7
+
+// Specialization constant ids: the effect set. An effect switched off is compiled out.
+#define PT_SPEC_DIFFUSE 0        // bool: Lambertian surfaces occur
+#define PT_SPEC_MIRROR 1         // bool: ideal mirrors occur
+#define PT_SPEC_NEE 2            // bool: sample emitters at diffuse vertices
+#define PT_SPEC_BSDF_EMISSION 3  // bool: count emission reached by BSDF-sampled rays
+#define PT_SPEC_MIS 4            // bool: weigh the two with the power heuristic
+#define PT_SPEC_RR 5             // bool: Russian roulette
+
+PT_CONST uint kWorkgroupSize = 8u;  // workgroups of 8 x 8 pixels
+
+// Push constants of one dispatch (one pass): which sample index every pixel takes.
+struct PassConstants {
+  uint sampleIndex;  // 4 bytes
+  uint debugPixel;   // 4 bytes: y * width + x of the pixel whose path is printed, or ~0u
+  uint reserved0;    // 4 bytes
+  uint reserved1;    // 4 bytes
+};                   // 16 bytes
+
+// Per-pixel accumulation on the device, in float; the host folds it into its double
+// precision film every few passes and clears it, so float sums never grow long.
+struct AccumPixel {
+  vec3 sum;      // 12 bytes: sum of valid samples' radiance
+  uint invalid;  //  4 bytes: samples that came out NaN or Inf (not added to sum)
+};               // 16 bytes
+
+// Lavapipe (Mesa 22.3) silently ends every loop of an invocation after 65,535 iterations in
+// total. The shader counts its own iterations and gives up a path at this budget, reporting
+// it in DeviceCounters::truncated, so a cut-short sample can never pass unnoticed.
+PT_CONST uint kLoopBudget = 60000u;
+
+struct DeviceCounters {
+  uint raysLow;    // 4 bytes: rays traced, low 32 bits
+  uint raysHigh;   // 4 bytes: rays traced, high 32 bits (carried by the shader)
+  uint truncated;  // 4 bytes: samples given up at kLoopBudget iterations
+  uint maxLoopIterations;  // 4 bytes: most iterations any invocation used
+};                 // 16 bytes
+
 // ---- Random-number dimensions ----------------------------------------------------------
 // Random numbers are a pure function of (pixel, sample index, dimension, seed); see
 // sampling.h. One dimension yields up to two numbers. Each path uses dimension kDimPixel for

@@ -1,6 +1,7 @@
 // The `pt` command line: render a scene, compare two images. Input errors print one line
 // and exit with kExitInputError; see `pt --help` and README.md.
 #include <cctype>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -15,13 +16,18 @@
 #include "image/image.h"
 #include "render/prepare.h"
 #include "scene/scene.h"
+#include "vulkan/backend.h"
 
 namespace pt {
 namespace {
 
 struct RenderArgs {
   std::string scene;
-  std::string backend = "cpu";
+  std::string backend = "vulkan";
+  std::string device;
+  bool validation = false;
+  bool noSpecialize = false;
+  std::string debugPixel;  // "X,Y"
   int spp = 0, width = 0, height = 0, maxDepth = -1, threads = 0, leafSize = 4;
   long long seed = -1;
   std::vector<std::string> outputs;
@@ -63,32 +69,89 @@ int runRender(const RenderArgs& args) {
     }
   }
 
-  if (args.backend != "cpu") {
-    throw InputError("--backend: '" + args.backend + "' is not available in this build (cpu)");
-  }
   const Camera& cam = data.params.camera;
+  int debugX = -1, debugY = -1;
+  if (!args.debugPixel.empty()) {
+    char extra = 0;
+    if (std::sscanf(args.debugPixel.c_str(), "%d,%d%c", &debugX, &debugY, &extra) != 2 ||
+        debugX < 0 || debugY < 0 || debugX >= int(cam.width) || debugY >= int(cam.height)) {
+      throw InputError("--debug-pixel: expected X,Y inside the " + std::to_string(cam.width) +
+                       "x" + std::to_string(cam.height) + " image, got '" + args.debugPixel + "'");
+    }
+    // The CPU reference's paths first; the shader's follow from the validation layer.
+    uint64_t rays = 0;
+    for (int s = 0; s < data.spp; ++s) {
+      sampleRadiance(data, uvec2(debugX, debugY), uint32_t(s), rays, /*debugPrint=*/true);
+    }
+  }
   Film film(int(cam.width), int(cam.height));
-  CpuRenderOptions options;
-  options.threads = args.threads;
-  options.spp = data.spp;
   Progress progress("rendering");
-  options.progress = [&progress](double f) { progress.update(f); };
-  const RenderStats stats = renderCpu(data, options, film);
+  RenderStats stats;
+  std::string backendInfo;
+  std::string effects = data.effects.toString();
+  uint64_t truncated = 0;
+  uint32_t validationErrors = 0;
+  if (args.backend == "cpu") {
+    CpuRenderOptions options;
+    options.threads = args.threads;
+    options.spp = data.spp;
+    options.progress = [&progress](double f) { progress.update(f); };
+    stats = renderCpu(data, options, film);
+    backendInfo = "backend=cpu threads=" + std::to_string(stats.threads);
+  } else {
+    VulkanRenderOptions options;
+    options.context.device = args.device;
+    // PT_VALIDATION=1 turns the validation layers on without changing command lines (tests).
+    const char* env = std::getenv("PT_VALIDATION");
+    options.context.validation = args.validation || (env && std::string(env) == "1");
+    options.spp = data.spp;
+    options.specialize = !args.noSpecialize;
+    options.context.debugPrintf = debugX >= 0;
+    options.debugPixelX = debugX;
+    options.debugPixelY = debugY;
+    options.progress = [&progress](double f) { progress.update(f); };
+    const VulkanRenderStats v = renderVulkan(data, options, film);
+    stats = v;
+    // Throughput from the device's timestamps; wall time also counts set-up and upload.
+    stats.seconds = v.deviceSeconds;
+    truncated = v.truncatedSamples;
+    validationErrors = v.validationErrors;
+    backendInfo = "backend=vulkan device=\"" + v.device + "\" wall_seconds=" +
+                  std::to_string(v.seconds) + " max_loop_iterations=" +
+                  std::to_string(v.maxLoopIterations);
+    if (args.noSpecialize) effects = "all(unspecialized)";
+  }
   progress.finish();
 
   const Image image = film.resolve();
   for (const auto& path : outputs) writeImage(image, path);
 
   std::printf(
-      "backend=cpu threads=%d resolution=%ux%u spp=%d seconds=%.3f Mrays/s=%.3f effects=%s "
-      "bvh_nodes=%zu bvh_build_s=%.4f invalid_samples=%llu\n",
-      stats.threads, cam.width, cam.height, data.spp, stats.seconds,
-      double(stats.rays) / stats.seconds * 1e-6, data.effects.toString().c_str(),
-      data.bvh.nodes.size(), data.bvh.buildSeconds, (unsigned long long)stats.invalidSamples);
+      "%s resolution=%ux%u spp=%d seconds=%.3f Mrays/s=%.3f effects=%s bvh_nodes=%zu "
+      "bvh_build_s=%.4f invalid_samples=%llu\n",
+      backendInfo.c_str(), cam.width, cam.height, data.spp, stats.seconds,
+      double(stats.rays) / stats.seconds * 1e-6, effects.c_str(), data.bvh.nodes.size(),
+      data.bvh.buildSeconds, (unsigned long long)stats.invalidSamples);
+  int status = kExitOk;
   if (stats.invalidSamples > 0) {
-    std::fprintf(stderr, "error: %llu samples were NaN or Inf and were left out of the image\n",
-                 (unsigned long long)stats.invalidSamples);
-    return kExitFailure;
+    std::fprintf(stderr, "error: %llu samples were NaN or Inf%s; they were left out of the image\n",
+                 (unsigned long long)stats.invalidSamples,
+                 truncated ? " or cut short by the shader's loop budget" : "");
+    status = kExitFailure;
+  }
+  if (validationErrors > 0) {
+    std::fprintf(stderr, "error: %u Vulkan validation errors\n", validationErrors);
+    status = kExitFailure;
+  }
+  return status;
+}
+
+int runDevices() {
+  const std::vector<DeviceInfo> devices = VulkanContext::listDevices();
+  if (devices.empty()) throw NoDeviceError("no Vulkan device found");
+  for (const DeviceInfo& d : devices) {
+    std::printf("%u: %s (%s; %s)%s%s\n", d.index, d.name.c_str(), d.type.c_str(),
+                d.driver.c_str(), d.suitable ? "" : " unsuitable: ", d.whyNot.c_str());
   }
   return kExitOk;
 }
@@ -117,13 +180,19 @@ int runDiff(const DiffArgs& args) {
 
 int main(int argc, char** argv) {
   using namespace pt;
-  CLI::App app{"pt: a physically based path tracer (CPU reference)"};
+  CLI::App app{"pt: a physically based path tracer (Vulkan compute, CPU reference)"};
   app.require_subcommand(1);
 
   RenderArgs r;
   CLI::App* render = app.add_subcommand("render", "Render a scene to one or more images");
   render->add_option("scene", r.scene, "Scene file (JSON)")->required();
-  render->add_option("--backend", r.backend, "cpu")->capture_default_str();
+  render->add_option("--backend", r.backend, "vulkan (GPU, or lavapipe without one) or cpu")
+      ->check(CLI::IsMember({"vulkan", "cpu"}))
+      ->capture_default_str();
+  render->add_option("--device", r.device, "Vulkan device: index or part of the name (see `devices`)");
+  render->add_flag("--validation", r.validation, "Enable the Vulkan validation layers");
+  render->add_flag("--no-specialize", r.noSpecialize,
+                   "Compile every effect into the shader (to measure what specialization saves)");
   render->add_option("--spp", r.spp, "Samples per pixel (default: the scene's)")
       ->check(CLI::PositiveNumber);
   render->add_option("--seed", r.seed, "Random seed (default: the scene's)")
@@ -139,6 +208,8 @@ int main(int argc, char** argv) {
   render->add_option("--leaf-size", r.leafSize, "Maximum triangles per BVH leaf")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
+  render->add_option("--debug-pixel", r.debugPixel,
+                     "Print pixel X,Y's paths from the CPU reference and from the shader");
   render->add_option("--out", r.outputs, "Output image (.png, .exr, .pfm); repeatable");
 
   DiffArgs d;
@@ -156,6 +227,8 @@ int main(int argc, char** argv) {
                    "The images agree when at most this fraction of pixels differ")
       ->capture_default_str();
 
+  CLI::App* devices = app.add_subcommand("devices", "List Vulkan devices");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -168,9 +241,16 @@ int main(int argc, char** argv) {
   try {
     if (*render) return runRender(r);
     if (*diff) return runDiff(d);
+    if (*devices) return runDevices();
   } catch (const InputError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitInputError;
+  } catch (const NoDeviceError& e) {
+    std::fprintf(stderr, "pt: no usable Vulkan device: %s\n", e.what());
+    return kExitNoDevice;
+  } catch (const vk::SystemError& e) {
+    std::fprintf(stderr, "pt: Vulkan error: %s\n", e.what());
+    return kExitInternal;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pt: error: %s\n", e.what());
     return kExitInternal;

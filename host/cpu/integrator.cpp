@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -29,7 +30,8 @@ Ray cameraRay(const Camera& cam, vec2 filmPoint) {
   return Ray{cam.position, normalize(d)};
 }
 
-vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays) {
+vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
+                    bool debugPrint) {
   const RenderParams& params = scene.params;
   const Bvh& bvh = scene.bvh;
   const uint seed = params.seed;
@@ -60,6 +62,15 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     const vec3 ng = normalize(edgeCross);
     const vec3 wo = -ray.direction;
     const float cosOut = dot(ng, wo);
+    // Coordinates' scale at this vertex, for the ray offsets.
+    const float magnitude = triangleMagnitude(tri.v0, tri.v1, tri.v2);
+    if (debugPrint) {
+      std::fprintf(stderr,
+                   "cpu depth %u: hit triangle %u (primitive %u) t=%g p=(%g, %g, %g) "
+                   "beta=(%g, %g, %g)\n",
+                   depth, hit->triangle, tri.primitive, hit->t, p.x, p.y, p.z, beta.x, beta.y,
+                   beta.z);
+    }
 
     // Add emitted light found by this ray: one-sided, on the geometric normal's side.
     if (tri.emitter != kNoEmitter && cosOut > 0.0f) {
@@ -118,14 +129,21 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
         const float cosSurface = dot(n, wl);
         if (cosLight > 0.0f && cosSurface > 0.0f) {
           // Shadow ray between the two offset points; t in [0, 1) spans the segment.
-          const vec3 from = offsetRayOrigin(p, n);
-          const vec3 to = offsetRayOrigin(lightPoint, lightNormal);
+          const vec3 from = offsetRayOrigin(p, n, magnitude);
+          const vec3 to = offsetRayOrigin(lightPoint, lightNormal,
+                                          triangleMagnitude(light.v0, light.v1, light.v2));
           ++rays;
           if (!anyHit(bvh, Ray{from, to - from}, 1.0f)) {
             const float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
             const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
             const vec3 Le = scene.materials[light.material].emission;
             L += beta * f * Le * (cosSurface * weight / lightPdf);
+            if (debugPrint) {
+              std::fprintf(stderr,
+                           "cpu depth %u: light sample on triangle %u (primitive %u) pdf=%g "
+                           "weight=%g\n",
+                           depth, emitter.triangle, light.primitive, lightPdf, weight);
+            }
           }
         }
       }
@@ -147,7 +165,10 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     }
 
     // Leave the surface on the side of the new direction.
-    ray = Ray{offsetRayOrigin(p, n), wi};
+    ray = Ray{offsetRayOrigin(p, n, magnitude), wi};
+  }
+  if (debugPrint) {
+    std::fprintf(stderr, "cpu sample %u: L=(%g, %g, %g)\n", sampleIndex, L.x, L.y, L.z);
   }
   return L;
 }

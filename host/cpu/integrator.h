@@ -31,8 +31,10 @@ struct RenderStats {
 Ray cameraRay(const Camera& camera, vec2 filmPoint);
 
 // Radiance arriving at the camera along one path sample of pixel (x, y). Exposed so tests
-// can evaluate single paths; `rays` is incremented by the rays traced.
-vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays);
+// can evaluate single paths; `rays` is incremented by the rays traced. With debugPrint, the
+// path's vertices and light samples go to stderr in the shader's --debug-pixel format.
+vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
+                    bool debugPrint = false);
 
 // Renders into film (which must have the camera's resolution), adding spp samples per pixel.
 RenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film);

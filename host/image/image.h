@@ -2,11 +2,16 @@
 // Knows nothing of scenes or renderers.
 #pragma once
 
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
+
+#include "common/check.h"
 
 namespace pt {
 
@@ -34,18 +39,63 @@ void writeImage(const Image& image, const std::filesystem::path& path);
 Image readImage(const std::filesystem::path& path);
 
 struct DiffStats {
-  double rmse = 0.0;          // sqrt(mean over pixels and channels of (a - b)^2)
-  double relMse = 0.0;        // mean of (a - b)^2 / (b^2 + 1e-2), b the reference
-  double maxAbsError = 0.0;   // max over pixels and channels of |a - b|
+  double rmse = 0.0;               // sqrt(mean over pixels and channels of (a - b)^2)
+  double relMse = 0.0;             // mean of (a - b)^2 / (b^2 + 1e-2), b the reference
+  double maxAbsError = 0.0;        // max over pixels and channels of |a - b|
   size_t pixelsOverThreshold = 0;  // pixels with any channel |a - b| > threshold * max(1, |b|)
   size_t pixelCount = 0;
+  // Pixels where a channel of a or b is NaN or infinite. They are also counted in
+  // pixelsOverThreshold and left out of rmse, relMse and maxAbsError (whose means are then
+  // over the finite pixels only; 0 when there are none).
+  size_t nonFinitePixels = 0;
 };
 
-// Compares a against the reference b (same size, else InputError).
+// Compares a against the reference b (same size, else InputError "image sizes differ: WxH vs
+// WxH"). A negative or NaN threshold is an InputError.
 DiffStats diffImages(const Image& a, const Image& b, double threshold);
 
 // A false-colour heatmap of the per-pixel max channel |a - b|, scaled so that `scale` maps to
-// the top of the colour ramp.
+// the top of the colour ramp (black, blue, magenta, yellow, white as the error grows); pixels
+// where a or b is non-finite are pure green. The result holds linear values, so written as
+// PNG it shows the ramp colours exactly. Sizes must match and scale must be positive, else
+// InputError.
 Image diffHeatmap(const Image& a, const Image& b, double scale);
+
+// The exact piecewise sRGB transfer curve (IEC 61966-2-1) on [0, 1], evaluated in double.
+float linearToSrgb(float linear);
+float srgbToLinear(float encoded);
+// One linear channel as an 8-bit sRGB code, as PNG output stores it: clamped to [0, 1], NaN
+// as 0, rounded to nearest.
+uint8_t linearToSrgb8(float linear);
+
+// Per-pixel sums of linear radiance in double precision plus sample counts, so that long
+// renders (1e6+ samples per pixel) do not drift. Invalid (NaN/Inf) samples are not added;
+// they are counted per pixel so they can be reported, never silently dropped.
+struct Film {
+  int width = 0, height = 0;
+  std::vector<glm::dvec3> sum;         // row-major, row 0 top
+  std::vector<uint64_t> sampleCount;   // valid samples added per pixel
+  std::vector<uint64_t> invalidCount;  // NaN/Inf samples seen per pixel
+
+  Film() = default;
+  Film(int w, int h);
+
+  // Inline because it runs once per sample. Threads may call it concurrently for disjoint
+  // pixels: it touches only pixel (x, y) and takes no lock.
+  void add(int x, int y, glm::vec3 radiance) {
+    PT_CHECK(x >= 0 && x < width && y >= 0 && y < height, "film pixel out of range");
+    const size_t i = size_t(y) * size_t(width) + size_t(x);
+    if (std::isfinite(radiance.x) && std::isfinite(radiance.y) && std::isfinite(radiance.z)) {
+      sum[i] += glm::dvec3(radiance);
+      ++sampleCount[i];
+    } else {
+      ++invalidCount[i];
+    }
+  }
+
+  void merge(const Film& other);  // sizes must match (PT_CHECK)
+  uint64_t totalInvalid() const;
+  Image resolve() const;  // sum / count per pixel (0 where count == 0)
+};
 
 }  // namespace pt

@@ -17,7 +17,7 @@ std::string EffectSet::toString() const {
   add(diffuse, "diffuse");
   add(mirror, "mirror");
   add(lightSampling, "nee");
-  add(bsdfEmission && lightSampling, "mis");
+  add(mis, "mis");
   add(russianRoulette, "rr");
   return s.empty() ? "none" : s;
 }
@@ -102,6 +102,7 @@ SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
   const bool scatters = p.maxDepth > 0;
   fx.lightSampling = fx.diffuse && scatters && !data.emitters.empty() && p.strategy != kStrategyBsdf;
   fx.bsdfEmission = !data.emitters.empty() && p.strategy != kStrategyNee;
+  fx.mis = fx.lightSampling && fx.bsdfEmission && p.strategy == kStrategyMis;
   fx.russianRoulette = p.russianRoulette != 0 && scatters && (fx.diffuse || fx.mirror);
   return data;
 }

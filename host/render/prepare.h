@@ -27,6 +27,7 @@ struct EffectSet {
   bool mirror = false;           // some surface is an ideal mirror
   bool lightSampling = false;    // next-event estimation (needs emitters, a diffuse surface)
   bool bsdfEmission = false;     // emission found by BSDF-sampled rays is counted (MIS/BSDF)
+  bool mis = false;              // both of the above, weighed by the power heuristic
   bool russianRoulette = false;
   std::string toString() const;  // e.g. "diffuse+mirror+nee+mis+rr"
 };

@@ -1,0 +1,511 @@
+// Image files: EXR via tinyexr, PFM by hand, PNG via stb, plus the sRGB curve. Every format
+// is encoded to and decoded from memory, so file access and its errors live in one place.
+
+#include "image/image.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <climits>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string_view>
+#include <system_error>
+
+#include <unistd.h>
+
+#include <tinyexr.h>
+
+// stb is compiled into this file only, with internal linkage: ptcore also links Debian's
+// libstb, and static definitions keep the two copies from interposing on each other. Only the
+// PNG decoder is built, and neither side touches files: we do all file I/O ourselves.
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_PNG
+#define STBI_NO_STDIO
+#include <stb/stb_image.h>
+#define STB_IMAGE_WRITE_STATIC
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#define STBI_WRITE_NO_STDIO
+#include <stb/stb_image_write.h>
+
+namespace pt {
+namespace {
+
+namespace fs = std::filesystem;
+using Bytes = std::vector<unsigned char>;
+
+// Throws the one-line InputError every image failure uses: "<path>: <what>". Library messages
+// can contain newlines, which would break the one-line promise, so they become spaces.
+[[noreturn]] void fail(const fs::path& path, std::string what) {
+  std::replace(what.begin(), what.end(), '\n', ' ');
+  while (!what.empty() && what.back() == ' ') what.pop_back();
+  throw InputError(path.string() + ": " + what);
+}
+
+enum class Format { kExr, kPfm, kPng };
+
+Format formatOf(const fs::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".exr") return Format::kExr;
+  if (ext == ".pfm") return Format::kPfm;
+  if (ext == ".png") return Format::kPng;
+  if (ext.empty()) fail(path, "no image file extension (expected .exr, .pfm or .png)");
+  fail(path, "unknown image file extension '" + path.extension().string() +
+                 "' (expected .exr, .pfm or .png)");
+}
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+
+Bytes readFile(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found) fail(path, "not found");
+  if (ec) fail(path, "cannot access: " + ec.message());
+  if (fs::is_directory(status)) fail(path, "is a directory, not an image file");
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  if (!file) fail(path, std::string("cannot open: ") + std::strerror(errno));
+  Bytes bytes;
+  unsigned char chunk[1 << 16];
+  size_t n;
+  while ((n = std::fread(chunk, 1, sizeof(chunk), file.get())) > 0) {
+    bytes.insert(bytes.end(), chunk, chunk + n);
+  }
+  if (std::ferror(file.get())) fail(path, std::string("cannot read: ") + std::strerror(errno));
+  return bytes;
+}
+
+// Writes to "<name>.tmp-<pid>-<n>" beside the target, flushes it to disk and renames it over
+// the target. rename() within one directory is atomic, so readers (and a crash) see either
+// the old file or the complete new one, never a partial one. The counter keeps two threads of
+// one process writing the same target from sharing a temporary file.
+void writeFileAtomically(const fs::path& path, const Bytes& bytes) {
+  static std::atomic<unsigned> counter{0};
+  fs::path tmp = path;
+  tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+
+  // "wx" never opens something that already exists, so a stray file or directory of that name
+  // is left alone and the failure is reported instead.
+  std::FILE* file = std::fopen(tmp.c_str(), "wx");
+  if (!file) fail(path, std::string("cannot write: ") + std::strerror(errno));
+  int error = 0;
+  if (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) {
+    error = errno;
+  }
+  if (std::fflush(file) != 0 && !error) error = errno;
+  if (::fsync(::fileno(file)) != 0 && !error) error = errno;
+  if (std::fclose(file) != 0 && !error) error = errno;
+  std::error_code ec;
+  if (error) {
+    fs::remove(tmp, ec);
+    fail(path, std::string("cannot write: ") + std::strerror(error));
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    fail(path, "cannot move the finished file into place: " + ec.message());
+  }
+}
+
+// ---- sRGB -----------------------------------------------------------------------------------
+
+double encodeSrgb(double linear) {
+  return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+}
+
+double decodeSrgb(double encoded) {
+  return encoded <= 0.04045 ? encoded / 12.92 : std::pow((encoded + 0.055) / 1.055, 2.4);
+}
+
+// ---- PFM ------------------------------------------------------------------------------------
+
+// Header "PF\n<w> <h>\n-1.0\n" (negative scale: little-endian), then rows bottom to top.
+Bytes encodePfm(const Image& image) {
+  const std::string header =
+      "PF\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n-1.0\n";
+  Bytes bytes(header.begin(), header.end());
+  bytes.reserve(header.size() + image.pixels.size() * 12);
+  for (int y = image.height - 1; y >= 0; --y) {
+    for (int x = 0; x < image.width; ++x) {
+      const glm::vec3& p = image.at(x, y);
+      for (int c = 0; c < 3; ++c) {
+        // Byte by byte, so the file is little-endian whatever the host is.
+        const uint32_t bits = std::bit_cast<uint32_t>(p[c]);
+        for (int b = 0; b < 4; ++b) bytes.push_back(static_cast<unsigned char>(bits >> (8 * b)));
+      }
+    }
+  }
+  return bytes;
+}
+
+Image decodePfm(const Bytes& data, const fs::path& path) {
+  if (data.size() < 2 || data[0] != 'P' || (data[1] != 'F' && data[1] != 'f')) {
+    fail(path, "bad header: expected 'PF' or 'Pf'");
+  }
+  const int channels = data[1] == 'F' ? 3 : 1;
+  size_t pos = 2;
+  auto isSpace = [](unsigned char c) { return std::isspace(c) != 0; };
+  // Header fields are separated by whitespace; returns the next field.
+  auto field = [&](const char* what) {
+    if (pos >= data.size() || !isSpace(data[pos])) {
+      fail(path, std::string("bad header: expected whitespace before the ") + what);
+    }
+    while (pos < data.size() && isSpace(data[pos])) ++pos;
+    const size_t start = pos;
+    while (pos < data.size() && !isSpace(data[pos]) && pos - start < 64) ++pos;
+    if (pos == start) fail(path, std::string("bad header: missing ") + what);
+    return std::string_view(reinterpret_cast<const char*>(data.data()) + start, pos - start);
+  };
+  auto dimension = [&](const char* what) {
+    const std::string_view text = field(what);
+    int value = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (ec != std::errc() || end != text.data() + text.size() || value <= 0) {
+      fail(path, std::string("bad header: ") + what + " '" + std::string(text) +
+                     "' is not a positive integer");
+    }
+    return value;
+  };
+  const int width = dimension("width");
+  const int height = dimension("height");
+  const std::string_view scaleText = field("scale");
+  float scale = 0.0f;
+  const auto [end, ec] =
+      std::from_chars(scaleText.data(), scaleText.data() + scaleText.size(), scale);
+  if (ec != std::errc() || end != scaleText.data() + scaleText.size() || !std::isfinite(scale) ||
+      scale == 0.0f) {
+    fail(path, "bad header: scale '" + std::string(scaleText) + "' is not a non-zero number");
+  }
+  // Exactly one whitespace character ends the header; pixel data may start with any byte.
+  if (pos >= data.size() || !isSpace(data[pos])) {
+    fail(path, "bad header: expected a newline after the scale");
+  }
+  ++pos;
+
+  const uint64_t expected = uint64_t(width) * uint64_t(height) * uint64_t(channels) * 4;
+  const uint64_t found = data.size() - pos;
+  if (found < expected) {
+    fail(path, "truncated pixel data: expected " + std::to_string(expected) + " bytes for " +
+                   std::to_string(width) + "x" + std::to_string(height) + ", found " +
+                   std::to_string(found));
+  }
+  if (found > expected) {
+    fail(path, std::to_string(found - expected) + " unexpected bytes after the pixel data of " +
+                   std::to_string(width) + "x" + std::to_string(height));
+  }
+
+  // The sign of the scale gives the byte order; its magnitude multiplies the values (as pbrt
+  // does). Most files say 1, where the multiplication is skipped so values stay bit-exact.
+  const bool littleEndian = scale < 0.0f;
+  const float factor = std::fabs(scale);
+  Image image(width, height);
+  const unsigned char* p = data.data() + pos;
+  auto next = [&] {
+    const uint32_t bits =
+        littleEndian
+            ? uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24
+            : uint32_t(p[3]) | uint32_t(p[2]) << 8 | uint32_t(p[1]) << 16 | uint32_t(p[0]) << 24;
+    p += 4;
+    const float value = std::bit_cast<float>(bits);
+    return factor == 1.0f ? value : value * factor;
+  };
+  for (int row = 0; row < height; ++row) {
+    const int y = height - 1 - row;  // the file stores the bottom row first
+    for (int x = 0; x < width; ++x) {
+      glm::vec3& pixel = image.at(x, y);
+      if (channels == 3) {
+        pixel.r = next();
+        pixel.g = next();
+        pixel.b = next();
+      } else {
+        pixel = glm::vec3(next());
+      }
+    }
+  }
+  return image;
+}
+
+// ---- EXR ------------------------------------------------------------------------------------
+
+std::string takeExrError(const char* err) {
+  std::string message = err ? err : "unknown tinyexr error";
+  if (err) FreeEXRErrorMessage(err);
+  return message;
+}
+
+Bytes encodeExr(const Image& image, const fs::path& path) {
+  // OpenEXR keeps channels sorted by name, so B, G, R is the order in the file; readers match
+  // channels by name, so they still see R as red. tinyexr wants planar data in that order.
+  const size_t n = image.pixels.size();
+  std::vector<float> planes[3] = {std::vector<float>(n), std::vector<float>(n),
+                                  std::vector<float>(n)};
+  for (size_t i = 0; i < n; ++i) {
+    planes[0][i] = image.pixels[i].b;
+    planes[1][i] = image.pixels[i].g;
+    planes[2][i] = image.pixels[i].r;
+  }
+  unsigned char* planePointers[3] = {reinterpret_cast<unsigned char*>(planes[0].data()),
+                                     reinterpret_cast<unsigned char*>(planes[1].data()),
+                                     reinterpret_cast<unsigned char*>(planes[2].data())};
+
+  EXRChannelInfo channels[3] = {};
+  std::strcpy(channels[0].name, "B");
+  std::strcpy(channels[1].name, "G");
+  std::strcpy(channels[2].name, "R");
+  // Stored as 32-bit float, not half: renders are references and must round-trip exactly.
+  int pixelTypes[3] = {TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT};
+  int storedTypes[3] = {TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT};
+
+  // The header and image point at our own arrays, so they are not passed to FreeEXR*.
+  EXRHeader header;
+  InitEXRHeader(&header);
+  header.num_channels = 3;
+  header.channels = channels;
+  header.pixel_types = pixelTypes;
+  header.requested_pixel_types = storedTypes;
+  header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;  // lossless
+  EXRImage exr;
+  InitEXRImage(&exr);
+  exr.num_channels = 3;
+  exr.images = planePointers;
+  exr.width = image.width;
+  exr.height = image.height;
+
+  unsigned char* memory = nullptr;
+  const char* err = nullptr;
+  const size_t size = SaveEXRImageToMemory(&exr, &header, &memory, &err);
+  if (size == 0 || !memory) {
+    std::free(memory);
+    fail(path, "cannot encode EXR: " + takeExrError(err));
+  }
+  Bytes bytes(memory, memory + size);
+  std::free(memory);
+  return bytes;
+}
+
+// Owns what tinyexr allocates while reading, freed on every exit path.
+struct ExrReadState {
+  EXRHeader header;
+  EXRImage image;
+  bool headerParsed = false;
+  bool imageLoaded = false;
+  ExrReadState() {
+    InitEXRHeader(&header);
+    InitEXRImage(&image);
+  }
+  ~ExrReadState() {
+    if (imageLoaded) FreeEXRImage(&image);
+    if (headerParsed) FreeEXRHeader(&header);
+  }
+  ExrReadState(const ExrReadState&) = delete;
+  ExrReadState& operator=(const ExrReadState&) = delete;
+};
+
+Image decodeExr(const Bytes& data, const fs::path& path) {
+  EXRVersion version;
+  if (ParseEXRVersionFromMemory(&version, data.data(), data.size()) != TINYEXR_SUCCESS) {
+    fail(path, "not an OpenEXR file (bad magic number or version)");
+  }
+  if (version.multipart || version.non_image) {
+    fail(path, "multi-part and deep EXR files are not supported");
+  }
+  ExrReadState exr;
+  const char* err = nullptr;
+  const int parsed =
+      ParseEXRHeaderFromMemory(&exr.header, &version, data.data(), data.size(), &err);
+  exr.headerParsed = true;  // tinyexr may have allocated parts of it even on failure
+  if (parsed != TINYEXR_SUCCESS) fail(path, "bad EXR header: " + takeExrError(err));
+
+  // Pick the channels by name: R, G, B; else a luminance Y; else a lone channel of any name.
+  const EXRHeader& header = exr.header;
+  int r = -1, g = -1, b = -1, luminance = -1;
+  std::string names;
+  for (int c = 0; c < header.num_channels; ++c) {
+    const std::string_view name = header.channels[c].name;
+    if (name == "R") r = c;
+    if (name == "G") g = c;
+    if (name == "B") b = c;
+    if (name == "Y") luminance = c;
+    names += (c ? ", " : "") + std::string(name);
+  }
+  int source[3];
+  if (r >= 0 && g >= 0 && b >= 0) {
+    source[0] = r, source[1] = g, source[2] = b;
+  } else if (luminance >= 0 || header.num_channels == 1) {
+    const int c = luminance >= 0 ? luminance : 0;
+    source[0] = source[1] = source[2] = c;
+  } else {
+    fail(path, "no R, G, B or Y channels (found: " + names + ")");
+  }
+  for (int c : source) {
+    if (header.channels[c].x_sampling != 1 || header.channels[c].y_sampling != 1) {
+      fail(path,
+           "subsampled channel '" + std::string(header.channels[c].name) + "' is not supported");
+    }
+  }
+  // Half channels are widened to float while loading; float and uint are read as stored.
+  for (int c = 0; c < header.num_channels; ++c) {
+    if (header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) {
+      exr.header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
+    }
+  }
+  // On a decoding error tinyexr frees the image itself, but only as many channel buffers as
+  // image.num_channels says, which it sets only on success: preset it so nothing leaks. The
+  // freed image is not marked loaded, so it is not freed a second time.
+  exr.image.num_channels = header.num_channels;
+  if (LoadEXRImageFromMemory(&exr.image, &exr.header, data.data(), data.size(), &err) !=
+      TINYEXR_SUCCESS) {
+    fail(path, "cannot decode EXR: " + takeExrError(err));
+  }
+  exr.imageLoaded = true;
+
+  const EXRImage& loaded = exr.image;
+  if (loaded.width <= 0 || loaded.height <= 0) fail(path, "EXR image is empty");
+  Image image(loaded.width, loaded.height);
+  // Loading replaced pixel_types with the requested types, so they say what the buffers hold.
+  auto value = [&](unsigned char* const* planes, int c, size_t index) {
+    if (header.pixel_types[c] == TINYEXR_PIXELTYPE_UINT) {
+      return float(reinterpret_cast<const uint32_t*>(planes[c])[index]);
+    }
+    return reinterpret_cast<const float*>(planes[c])[index];
+  };
+  auto copyPixel = [&](unsigned char* const* planes, size_t index, int x, int y) {
+    glm::vec3& pixel = image.at(x, y);
+    for (int k = 0; k < 3; ++k) pixel[k] = value(planes, source[k], index);
+  };
+  if (header.tiled) {
+    if (!loaded.tiles) fail(path, "tiled EXR without tiles");
+    // Level 0 only. Tile offsets count tiles; every tile buffer is a full tile wide.
+    for (int t = 0; t < loaded.num_tiles; ++t) {
+      const EXRTile& tile = loaded.tiles[t];
+      for (int j = 0; j < tile.height; ++j) {
+        for (int i = 0; i < tile.width; ++i) {
+          const int x = tile.offset_x * header.tile_size_x + i;
+          const int y = tile.offset_y * header.tile_size_y + j;
+          if (x >= image.width || y >= image.height) continue;
+          copyPixel(tile.images, size_t(j) * size_t(header.tile_size_x) + size_t(i), x, y);
+        }
+      }
+    }
+  } else {
+    if (!loaded.images) fail(path, "EXR has no scanline data");
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        copyPixel(loaded.images, size_t(y) * size_t(image.width) + size_t(x), x, y);
+      }
+    }
+  }
+  return image;
+}
+
+// ---- PNG ------------------------------------------------------------------------------------
+
+Bytes encodePng(const Image& image, const fs::path& path) {
+  Bytes rgb(image.pixels.size() * 3);
+  for (size_t i = 0; i < image.pixels.size(); ++i) {
+    for (int c = 0; c < 3; ++c) rgb[3 * i + size_t(c)] = linearToSrgb8(image.pixels[i][c]);
+  }
+  Bytes png;
+  auto append = [](void* context, void* data, int size) {
+    auto* out = static_cast<Bytes*>(context);
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    out->insert(out->end(), bytes, bytes + size);
+  };
+  if (uint64_t(image.width) * 3 > uint64_t(INT_MAX) ||
+      !stbi_write_png_to_func(append, &png, image.width, image.height, 3, rgb.data(),
+                              image.width * 3)) {
+    fail(path, "cannot encode PNG");
+  }
+  return png;
+}
+
+Image decodePng(const Bytes& data, const fs::path& path) {
+  if (data.size() > size_t(INT_MAX)) fail(path, "PNG file too large");
+  const int size = int(data.size());
+  int width = 0, height = 0, channelsInFile = 0;
+  // Colour, grey and alpha variants all come back as RGB (alpha dropped). 16-bit files keep
+  // their precision. Gamma and ICC chunks are ignored: PNG here means sRGB.
+  if (stbi_is_16_bit_from_memory(data.data(), size)) {
+    stbi_us* pixels =
+        stbi_load_16_from_memory(data.data(), size, &width, &height, &channelsInFile, 3);
+    if (!pixels) fail(path, std::string("cannot decode PNG: ") + stbi_failure_reason());
+    Image image(width, height);
+    for (size_t i = 0; i < image.pixels.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        image.pixels[i][c] = srgbToLinear(float(pixels[3 * i + size_t(c)]) / 65535.0f);
+      }
+    }
+    stbi_image_free(pixels);
+    return image;
+  }
+  stbi_uc* pixels = stbi_load_from_memory(data.data(), size, &width, &height, &channelsInFile, 3);
+  if (!pixels) fail(path, std::string("cannot decode PNG: ") + stbi_failure_reason());
+  float table[256];
+  for (int v = 0; v < 256; ++v) table[v] = float(decodeSrgb(v / 255.0));
+  Image image(width, height);
+  for (size_t i = 0; i < image.pixels.size(); ++i) {
+    for (int c = 0; c < 3; ++c) image.pixels[i][c] = table[pixels[3 * i + size_t(c)]];
+  }
+  stbi_image_free(pixels);
+  return image;
+}
+
+}  // namespace
+
+float linearToSrgb(float linear) {
+  return float(encodeSrgb(linear));
+}
+
+float srgbToLinear(float encoded) {
+  return float(decodeSrgb(encoded));
+}
+
+uint8_t linearToSrgb8(float linear) {
+  if (!(linear > 0.0f)) return 0;  // also NaN
+  if (linear >= 1.0f) return 255;
+  return uint8_t(encodeSrgb(linear) * 255.0 + 0.5);
+}
+
+void writeImage(const Image& image, const std::filesystem::path& path) {
+  const Format format = formatOf(path);
+  PT_CHECK(image.width >= 0 && image.height >= 0 &&
+               image.pixels.size() == size_t(image.width) * size_t(image.height),
+           "image pixel count does not match its size");
+  if (image.width == 0 || image.height == 0) fail(path, "cannot write an empty image");
+  switch (format) {
+    case Format::kExr:
+      writeFileAtomically(path, encodeExr(image, path));
+      break;
+    case Format::kPfm:
+      writeFileAtomically(path, encodePfm(image));
+      break;
+    case Format::kPng:
+      writeFileAtomically(path, encodePng(image, path));
+      break;
+  }
+}
+
+Image readImage(const std::filesystem::path& path) {
+  const Format format = formatOf(path);
+  const Bytes bytes = readFile(path);
+  switch (format) {
+    case Format::kExr:
+      return decodeExr(bytes, path);
+    case Format::kPfm:
+      return decodePfm(bytes, path);
+    case Format::kPng:
+      return decodePng(bytes, path);
+  }
+  PT_CHECK(false, "unhandled image format");
+}
+
+}  // namespace pt

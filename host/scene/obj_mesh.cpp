@@ -1,0 +1,319 @@
+// OBJ loading: a light pre-scan of the text gives line-accurate errors for what
+// tinyobjloader would silently accept or mangle (index 0, out-of-range indices, unparsable
+// or non-finite coordinates, polygons of more than 255 vertices); tinyobjloader then does
+// the actual load and the faces are fan-triangulated here.
+#include "obj_mesh.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <sstream>
+#include <string_view>
+
+#include <tiny_obj_loader.h>
+
+#include "json_reader.h"
+
+namespace pt::scene_detail {
+
+namespace {
+
+// tinyobjloader stores the vertex count of a face in an unsigned char.
+constexpr std::size_t kMaxFaceVertices = 255;
+
+// Calls fn(lineNumber, line) for every line, splitting exactly as tinyobjloader does
+// ("\n", "\r\n" or a lone "\r"), so that our line numbers match the file as it reads it.
+template <typename Fn>
+void forEachLine(std::string_view text, Fn&& fn) {
+  std::size_t lineNumber = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    std::size_t end = pos;
+    while (end < text.size() && text[end] != '\n' && text[end] != '\r') ++end;
+    std::string_view line = text.substr(pos, end - pos);
+    // tinyobjloader reads each line as a C string: a NUL byte ends it.
+    line = line.substr(0, line.find('\0'));
+    ++lineNumber;
+    fn(lineNumber, line);
+    if (end < text.size() && text[end] == '\r' && end + 1 < text.size() && text[end + 1] == '\n') {
+      ++end;
+    }
+    pos = end + 1;
+  }
+}
+
+bool isBlank(char c) {
+  return c == ' ' || c == '\t';
+}
+
+// The statement keyword of a line ("v", "vt", "f", ...) or empty for blank/comment lines.
+// Like tinyobjloader, a keyword counts only when followed by a space or a tab.
+std::string_view keyword(std::string_view line, std::string_view* rest) {
+  std::size_t start = 0;
+  while (start < line.size() && isBlank(line[start])) ++start;
+  line.remove_prefix(start);
+  if (line.empty() || line[0] == '#') return {};
+  std::size_t end = 0;
+  while (end < line.size() && !isBlank(line[end])) ++end;
+  if (end == line.size()) return {};  // a bare keyword: tinyobjloader ignores the line
+  *rest = line.substr(end);
+  return line.substr(0, end);
+}
+
+std::vector<std::string_view> splitBlanks(std::string_view s) {
+  std::vector<std::string_view> tokens;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    while (i < s.size() && isBlank(s[i])) ++i;
+    const std::size_t start = i;
+    while (i < s.size() && !isBlank(s[i])) ++i;
+    if (i > start) tokens.push_back(s.substr(start, i - start));
+  }
+  return tokens;
+}
+
+// from_chars takes no '+' sign: drop one, but refuse "+-3" and "++3", which tinyobjloader
+// would read as 0.
+bool skipPlus(std::string_view* token) {
+  if (token->empty() || (*token)[0] != '+') return true;
+  token->remove_prefix(1);
+  return !token->empty() && (*token)[0] != '+' && (*token)[0] != '-';
+}
+
+// Parses a whole token as an integer ("+3" and "-3" allowed).
+bool parseIndex(std::string_view token, std::int64_t* value) {
+  if (!skipPlus(&token)) return false;
+  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), *value);
+  return ec == std::errc() && ptr == token.data() + token.size();
+}
+
+// Parses a whole token as a real number. from_chars also takes "inf" and "nan", which the
+// caller reports as non-finite.
+bool parseReal(std::string_view token, double* value) {
+  if (!skipPlus(&token)) return false;
+  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), *value,
+                                         std::chars_format::general);
+  if (ec == std::errc::result_out_of_range) {
+    // Overflow or underflow: from_chars leaves the value alone, so decide by the exponent
+    // sign whether this is "too large" (infinite) or "too small" (zero).
+    const std::size_t e = token.find_first_of("eE");
+    const bool negativeExponent =
+        e != std::string_view::npos && e + 1 < token.size() && token[e + 1] == '-';
+    *value = negativeExponent ? 0.0 : std::numeric_limits<double>::infinity();
+    return ptr == token.data() + token.size();
+  }
+  return ec == std::errc() && ptr == token.data() + token.size();
+}
+
+struct Counts {
+  std::int64_t vertices = 0;
+  std::int64_t texcoords = 0;
+  std::int64_t normals = 0;
+  std::int64_t faces = 0;
+};
+
+class ObjScanner {
+ public:
+  ObjScanner(const std::string& file, const std::string& context, const Counts& totals)
+      : file_(file), context_(context), totals_(totals) {}
+
+  // Validates one line; counts what has been defined so far.
+  void scan(std::size_t lineNumber, std::string_view line) {
+    line_ = lineNumber;
+    std::string_view rest;
+    const std::string_view key = keyword(line, &rest);
+    if (key == "v") {
+      vertex(rest);
+      vertexLines_.push_back(lineNumber);
+      ++sofar_.vertices;
+    } else if (key == "vt") {
+      ++sofar_.texcoords;
+    } else if (key == "vn") {
+      ++sofar_.normals;
+    } else if (key == "f" || key == "l" || key == "p") {
+      element(key, rest);
+    }
+  }
+
+  const std::vector<std::size_t>& vertexLines() const { return vertexLines_; }
+  std::int64_t faces() const { return sofar_.faces; }
+
+  [[noreturn]] void fail(std::size_t line, const std::string& problem) const {
+    throwInputError(file_, "line " + std::to_string(line), problem + context_);
+  }
+
+ private:
+  void vertex(std::string_view rest) const {
+    const std::vector<std::string_view> tokens = splitBlanks(rest);
+    if (tokens.size() < 3) {
+      fail(line_, "vertex has " + std::to_string(tokens.size()) + " coordinates (need 3)");
+    }
+    for (int i = 0; i < 3; ++i) {
+      double v = 0.0;
+      if (!parseReal(tokens[i], &v)) {
+        fail(line_, "vertex coordinate " + singleQuoted(tokens[i]) + " is not a number");
+      }
+      if (!std::isfinite(static_cast<float>(v))) {
+        fail(line_, "non-finite vertex coordinate " + singleQuoted(tokens[i]) +
+                        (std::isfinite(v) ? " (too large for a 32-bit float)" : ""));
+      }
+    }
+  }
+
+  // A face, line or point statement: a list of v, v/vt, v//vn or v/vt/vn references.
+  void element(std::string_view key, std::string_view rest) {
+    const std::vector<std::string_view> refs = splitBlanks(rest);
+    for (std::string_view ref : refs) {
+      std::string_view parts[3];
+      std::size_t count = 0;
+      std::size_t start = 0;
+      for (std::size_t i = 0; i <= ref.size(); ++i) {
+        if (i == ref.size() || ref[i] == '/') {
+          if (count == 3) fail(line_, "malformed vertex reference " + singleQuoted(ref));
+          parts[count++] = ref.substr(start, i - start);
+          start = i + 1;
+        }
+      }
+      // v, v/vt, v//vn, v/vt/vn: the vertex is required; an empty texture slot only
+      // as "v//vn".
+      if (parts[0].empty() || (count == 2 && parts[1].empty()) ||
+          (count == 3 && parts[2].empty())) {
+        fail(line_, "malformed vertex reference " + singleQuoted(ref));
+      }
+      checkIndex(parts[0], "vertex", sofar_.vertices, totals_.vertices);
+      if (count >= 2 && !parts[1].empty()) {
+        checkIndex(parts[1], "texture coordinate", sofar_.texcoords, totals_.texcoords);
+      }
+      if (count == 3) checkIndex(parts[2], "normal", sofar_.normals, totals_.normals);
+    }
+    if (key == "f") {
+      if (refs.size() < 3) {
+        fail(line_, "face has " + std::to_string(refs.size()) + " vertices (need at least 3)");
+      }
+      if (refs.size() > kMaxFaceVertices) {
+        fail(line_, "face has " + std::to_string(refs.size()) + " vertices (at most " +
+                        std::to_string(kMaxFaceVertices) + " supported)");
+      }
+      ++sofar_.faces;
+    }
+  }
+
+  // Positive indices count from 1 over the whole file; negative ones count back from the
+  // last element defined before this line.
+  void checkIndex(std::string_view token, const std::string& what, std::int64_t sofar,
+                  std::int64_t total) const {
+    std::int64_t index = 0;
+    if (!parseIndex(token, &index)) {
+      fail(line_, what + " index " + singleQuoted(token) + " is not an integer");
+    }
+    const std::string plural = what == "vertex" ? "vertices" : what + "s";
+    if (index == 0) fail(line_, what + " index 0 is invalid (OBJ indices start at 1)");
+    if (index > total) {
+      fail(line_, what + " index " + std::to_string(index) + " out of range (file has " +
+                      std::to_string(total) + " " + plural + ")");
+    }
+    if (index < 0 && -index > sofar) {
+      fail(line_, what + " index " + std::to_string(index) + " out of range (" +
+                      std::to_string(sofar) + " " + plural + " defined before this line)");
+    }
+  }
+
+  const std::string& file_;
+  const std::string& context_;
+  const Counts& totals_;
+  Counts sofar_;
+  std::size_t line_ = 0;
+  std::vector<std::size_t> vertexLines_;  // line of each vertex, for post-load checks
+};
+
+}  // namespace
+
+std::vector<std::array<glm::dvec3, 3>> loadObjTriangles(const std::string& text,
+                                                        const std::string& file,
+                                                        const std::string& context) {
+  // Pass 1: totals, needed to check positive (absolute) indices that refer forward.
+  Counts totals;
+  forEachLine(text, [&](std::size_t, std::string_view line) {
+    std::string_view rest;
+    const std::string_view key = keyword(line, &rest);
+    if (key == "v") ++totals.vertices;
+    if (key == "vt") ++totals.texcoords;
+    if (key == "vn") ++totals.normals;
+  });
+
+  // Pass 2: validate every statement tinyobjloader will interpret.
+  ObjScanner scanner(file, context, totals);
+  forEachLine(text, [&](std::size_t n, std::string_view line) { scanner.scan(n, line); });
+  if (scanner.faces() == 0) {
+    throwInputError(file, "", "no faces (an OBJ mesh needs at least one 'f' line)" + context);
+  }
+
+  // The actual load. No material reader: materials come from the scene file.
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+  std::string warn;
+  std::string err;
+  std::istringstream stream(text);
+  const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, nullptr,
+                                   /*triangulate=*/false, /*default_vcols_fallback=*/false);
+  if (!ok) {
+    throwInputError(file, "", "tinyobjloader: " + err.substr(0, err.find('\n')) + context);
+  }
+
+  // The pre-scan and tinyobjloader must agree; if they ever do not, say so rather than
+  // index out of range.
+  const std::size_t vertexCount = attrib.vertices.size() / 3;
+  if (vertexCount != scanner.vertexLines().size()) {
+    throwInputError(file, "",
+                    "tinyobjloader read " + std::to_string(vertexCount) + " vertices, expected " +
+                        std::to_string(scanner.vertexLines().size()) + context);
+  }
+  std::vector<glm::dvec3> vertices(vertexCount);
+  for (std::size_t i = 0; i < vertexCount; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const float value = attrib.vertices[3 * i + static_cast<std::size_t>(c)];
+      // tinyobjloader's own number parser may round differently near the float limit.
+      if (!std::isfinite(value)) {
+        throwInputError(file, "line " + std::to_string(scanner.vertexLines()[i]),
+                        "non-finite vertex coordinate" + context);
+      }
+      vertices[i][c] = value;
+    }
+  }
+
+  std::vector<std::array<glm::dvec3, 3>> triangles;
+  std::int64_t faceCount = 0;
+  for (const tinyobj::shape_t& shape : shapes) {
+    const tinyobj::mesh_t& mesh = shape.mesh;
+    std::size_t offset = 0;
+    for (const unsigned char faceSize : mesh.num_face_vertices) {
+      const std::size_t n = faceSize;
+      if (offset + n > mesh.indices.size()) break;  // reported by the count check below
+      std::vector<std::size_t> face(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        const int index = mesh.indices[offset + k].vertex_index;
+        if (index < 0 || static_cast<std::size_t>(index) >= vertexCount) {
+          throwInputError(file, "",
+                          "tinyobjloader produced vertex index " + std::to_string(index) +
+                              " out of range" + context);
+        }
+        face[k] = static_cast<std::size_t>(index);
+      }
+      for (std::size_t k = 1; k + 1 < n; ++k) {
+        triangles.push_back({vertices[face[0]], vertices[face[k]], vertices[face[k + 1]]});
+      }
+      offset += n;
+      ++faceCount;
+    }
+  }
+  if (faceCount != scanner.faces()) {
+    throwInputError(file, "",
+                    "tinyobjloader read " + std::to_string(faceCount) + " faces, expected " +
+                        std::to_string(scanner.faces()) + context);
+  }
+  return triangles;
+}
+
+}  // namespace pt::scene_detail

@@ -1,0 +1,452 @@
+// Scene loading: reads the JSON scene description (docs/scene-format.md) into a Scene with
+// a flat triangle list, validating everything and naming the field of any error.
+#include "scene.h"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "../common/check.h"
+#include "json_reader.h"
+#include "obj_mesh.h"
+
+namespace pt {
+
+namespace {
+
+using scene_detail::JsonNode;
+using scene_detail::singleQuoted;
+using Tri = std::array<glm::dvec3, 3>;
+
+constexpr std::int64_t kMaxResolution = 16384;  // keeps width * height well inside int
+constexpr std::int64_t kIntMax = std::numeric_limits<int>::max();
+
+// Accepted values of an enumerated string field, in documentation order.
+template <typename T>
+struct Choice {
+  std::string_view name;
+  T value;
+};
+
+template <typename T, std::size_t N>
+T readChoice(const JsonNode& node, const std::array<Choice<T>, N>& choices, const char* what) {
+  const std::string s = node.string();
+  std::vector<std::string_view> names;
+  for (const Choice<T>& c : choices) {
+    if (c.name == s) return c.value;
+    names.push_back(c.name);
+  }
+  std::string expected;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) expected += i + 1 == names.size() ? " or " : ", ";
+    expected += "'" + std::string(names[i]) + "'";
+  }
+  const std::string hint = scene_detail::didYouMean(s, names);
+  node.fail("unknown " + std::string(what) + " " + singleQuoted(s) +
+            (hint.empty() ? " (expected " + expected + ")" : hint));
+}
+
+// ---- camera and integrator --------------------------------------------------------------
+
+CameraDesc readCamera(const JsonNode& node) {
+  node.checkKeys({"position", "target", "up", "vfov", "width", "height"});
+  CameraDesc desc;
+  glm::dvec3 position(desc.position), target(desc.target), up(desc.up);
+  if (auto n = node.find("position")) position = n->vec3();
+  if (auto n = node.find("target")) target = n->vec3();
+  if (auto n = node.find("up")) up = n->vec3();
+  if (auto n = node.find("vfov")) {
+    const double vfov = n->number();
+    // Checked after rounding to float too: 179.999999999 rounds to 180 and 1e-50 to 0.
+    const float rounded = static_cast<float>(vfov);
+    if (!(vfov > 0.0 && vfov < 180.0 && rounded > 0.0f && rounded < 180.0f)) {
+      n->fail("expected a field of view in degrees strictly between 0 and 180, got " +
+              n->describe());
+    }
+    desc.vfovDegrees = rounded;
+  }
+  if (auto n = node.find("width")) desc.width = static_cast<int>(n->integer(1, kMaxResolution));
+  if (auto n = node.find("height")) desc.height = static_cast<int>(n->integer(1, kMaxResolution));
+
+  // The basis must be well defined. Checked in double on the float values makeCamera sees.
+  desc.position = glm::vec3(position);
+  desc.target = glm::vec3(target);
+  desc.up = glm::vec3(up);
+  const std::string prefix = node.path() + ".";
+  const glm::dvec3 forward = glm::dvec3(desc.target) - glm::dvec3(desc.position);
+  if (glm::length(forward) == 0.0) {
+    scene_detail::throwInputError(node.file(), prefix + "target",
+                                  "equals camera.position, so there is no view direction");
+  }
+  const glm::dvec3 upD(desc.up);
+  if (glm::length(upD) == 0.0) {
+    scene_detail::throwInputError(node.file(), prefix + "up", "must not be the zero vector");
+  }
+  const double sine = glm::length(glm::cross(glm::normalize(forward), glm::normalize(upD)));
+  if (!(sine > 1e-6)) {
+    scene_detail::throwInputError(node.file(), prefix + "up",
+                                  "is parallel to the view direction (target - position)");
+  }
+  return desc;
+}
+
+IntegratorSettings readIntegrator(const JsonNode& node) {
+  node.checkKeys({"spp", "maxDepth", "seed", "russianRoulette", "rrStartDepth", "strategy"});
+  IntegratorSettings s;
+  if (auto n = node.find("spp")) s.spp = static_cast<int>(n->integer(1, kIntMax));
+  if (auto n = node.find("maxDepth")) s.maxDepth = static_cast<int>(n->integer(0, kIntMax));
+  if (auto n = node.find("seed")) s.seed = static_cast<uint>(n->integer(0, 0xFFFFFFFFll));
+  if (auto n = node.find("russianRoulette")) s.russianRoulette = n->boolean();
+  if (auto n = node.find("rrStartDepth")) {
+    s.rrStartDepth = static_cast<int>(n->integer(1, kIntMax));
+  }
+  if (auto n = node.find("strategy")) {
+    static constexpr std::array<Choice<uint>, 3> kStrategies{
+        {{"mis", kStrategyMis}, {"nee", kStrategyNee}, {"bsdf", kStrategyBsdf}}};
+    s.strategy = readChoice(*n, kStrategies, "strategy");
+  }
+  return s;
+}
+
+// ---- materials --------------------------------------------------------------------------
+
+void readMaterials(const JsonNode& node, Scene& scene) {
+  if (node.size() == 0) node.fail("expected at least one material");
+  std::unordered_map<std::string, std::size_t> firstIndex;
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const JsonNode m = node[i];
+    m.checkKeys({"name", "type", "reflectance", "emission"});
+    const JsonNode nameNode = m.require("name");
+    const std::string name = nameNode.string();
+    if (name.empty()) nameNode.fail("must not be empty");
+    if (auto [it, inserted] = firstIndex.emplace(name, i); !inserted) {
+      nameNode.fail("duplicate material name " + singleQuoted(name) + " (also used by materials[" +
+                    std::to_string(it->second) + "])");
+    }
+
+    Material material{};
+    material.type = kMaterialDiffuse;
+    if (auto n = m.find("type")) {
+      static constexpr std::array<Choice<uint>, 2> kTypes{
+          {{"diffuse", kMaterialDiffuse}, {"mirror", kMaterialMirror}}};
+      material.type = readChoice(*n, kTypes, "material type");
+    }
+    material.reflectance = material.type == kMaterialMirror ? glm::vec3(1.0f) : glm::vec3(0.8f);
+    if (auto n = m.find("reflectance")) {
+      const glm::dvec3 r = n->vec3();
+      for (std::size_t c = 0; c < 3; ++c) {
+        if (!(r[c] >= 0.0 && r[c] <= 1.0)) {
+          (*n)[c].fail("expected a number in [0, 1], got " + (*n)[c].describe());
+        }
+      }
+      material.reflectance = glm::vec3(r);
+    }
+    material.emission = glm::vec3(0.0f);
+    if (auto n = m.find("emission")) {
+      const glm::dvec3 e = n->vec3();
+      for (std::size_t c = 0; c < 3; ++c) {
+        if (!(e[c] >= 0.0)) {
+          (*n)[c].fail("expected a non-negative number, got " + (*n)[c].describe());
+        }
+      }
+      material.emission = glm::vec3(e);
+    }
+    material.reserved = 0;
+    scene.materials.push_back(material);
+    scene.materialNames.push_back(name);
+  }
+}
+
+// ---- transforms -------------------------------------------------------------------------
+
+// p -> rotate(scale * p) + translate, evaluated in double so that vertices are rounded to
+// float once.
+struct Transform {
+  glm::dvec3 scale{1.0};
+  glm::dvec3 axis{0.0, 1.0, 0.0};  // unit
+  double cosAngle = 1.0;
+  double sinAngle = 0.0;
+  glm::dvec3 translate{0.0};
+
+  glm::dvec3 apply(glm::dvec3 p) const {
+    p *= scale;
+    // Rodrigues' rotation formula (right-handed about axis).
+    p = p * cosAngle + glm::cross(axis, p) * sinAngle +
+        axis * (glm::dot(axis, p) * (1.0 - cosAngle));
+    return p + translate;
+  }
+};
+
+// cos and sin of an angle in degrees, exact for multiples of 90 degrees so that axis-aligned
+// geometry stays exactly axis-aligned (cos(radians(90)) is 6e-17, not 0).
+std::pair<double, double> cosSinDegrees(double degrees) {
+  const double reduced = std::fmod(degrees, 360.0);  // exact
+  if (std::fmod(reduced, 90.0) == 0.0) {
+    switch (static_cast<int>(reduced < 0 ? reduced + 360.0 : reduced)) {
+      case 0:
+        return {1.0, 0.0};
+      case 90:
+        return {0.0, 1.0};
+      case 180:
+        return {-1.0, 0.0};
+      case 270:
+        return {0.0, -1.0};
+      default:
+        break;
+    }
+  }
+  const double radians = reduced * (3.14159265358979323846 / 180.0);
+  return {std::cos(radians), std::sin(radians)};
+}
+
+Transform readTransform(const JsonNode& node) {
+  node.checkKeys({"scale", "rotate", "translate"});
+  Transform t;
+  if (auto n = node.find("scale")) {
+    if (n->json().is_array()) {
+      t.scale = n->vec3();
+      for (std::size_t c = 0; c < 3; ++c) {
+        if (t.scale[c] == 0.0) (*n)[c].fail("scale factors must be non-zero");
+      }
+    } else {
+      if (!n->json().is_number()) {
+        n->fail("expected a number or an array of 3 numbers, got " + n->describe());
+      }
+      t.scale = glm::dvec3(n->floatNumber());
+      if (t.scale.x == 0.0) n->fail("scale factor must be non-zero");
+    }
+  }
+  if (auto n = node.find("rotate")) {
+    n->checkKeys({"axis", "degrees"});
+    const JsonNode axisNode = n->require("axis");
+    const glm::dvec3 axis = axisNode.vec3();
+    if (glm::length(axis) == 0.0) axisNode.fail("rotation axis must not be the zero vector");
+    t.axis = glm::normalize(axis);
+    std::tie(t.cosAngle, t.sinAngle) = cosSinDegrees(n->require("degrees").number());
+  }
+  if (auto n = node.find("translate")) t.translate = n->vec3();
+  return t;
+}
+
+// ---- shapes -----------------------------------------------------------------------------
+
+// Reads a "vertices" array of points; `exactly` > 0 demands that many.
+std::vector<glm::dvec3> readPoints(const JsonNode& node, std::size_t exactly) {
+  const std::size_t n = node.size();
+  if (exactly > 0 && n != exactly) {
+    node.fail("expected an array of " + std::to_string(exactly) + " points, got " +
+              node.describe());
+  }
+  if (n == 0) node.fail("expected at least one point");
+  std::vector<glm::dvec3> points;
+  points.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) points.push_back(node[i].vec3());
+  return points;
+}
+
+std::vector<Tri> readTriangleShape(const JsonNode& shape) {
+  const std::vector<glm::dvec3> vertices = readPoints(shape.require("vertices"), 0);
+  const JsonNode indices = shape.require("indices");
+  if (indices.size() == 0) indices.fail("expected at least one triangle");
+  std::vector<Tri> triangles;
+  triangles.reserve(indices.size());
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    const JsonNode triple = indices[i];
+    if (!triple.json().is_array() || triple.size() != 3) {
+      triple.fail("expected an array of 3 vertex indices, got " + triple.describe());
+    }
+    Tri tri;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const JsonNode index = triple[k];
+      const std::int64_t v = index.integer(0, std::numeric_limits<std::int64_t>::max());
+      if (static_cast<std::uint64_t>(v) >= vertices.size()) {
+        index.fail("vertex index " + std::to_string(v) + " out of range (the shape has " +
+                   std::to_string(vertices.size()) + " vertices; indices start at 0)");
+      }
+      tri[k] = vertices[static_cast<std::size_t>(v)];
+    }
+    triangles.push_back(tri);
+  }
+  return triangles;
+}
+
+std::vector<Tri> readObjShape(const JsonNode& shape, const std::filesystem::path& scenePath) {
+  const JsonNode fileNode = shape.require("file");
+  const std::string name = fileNode.string();
+  if (name.empty()) fileNode.fail("expected a file name, got an empty string");
+  const std::filesystem::path given(name);
+  const std::filesystem::path resolved =
+      given.is_absolute() ? given : scenePath.parent_path() / given;
+  std::string text;
+  std::string why;
+  if (!scene_detail::readTextFile(resolved, &text, &why)) {
+    const std::string looked =
+        resolved == given ? std::string{} : "looked for " + singleQuoted(resolved.string()) + ": ";
+    fileNode.fail("cannot open " + singleQuoted(name) + " (" + looked + why + ")");
+  }
+  const std::string context = " (referenced by " + shape.file() + ": " + fileNode.path() + ")";
+  return scene_detail::loadObjTriangles(text, resolved.string(), context);
+}
+
+// Appends the triangles of one shape to the scene, transformed and rounded to float,
+// dropping those of zero area.
+void emitTriangles(const JsonNode& shape, const std::vector<Tri>& triangles,
+                   const std::optional<Transform>& transform, uint material, Scene& scene) {
+  std::size_t dropped = 0;
+  for (const Tri& tri : triangles) {
+    Triangle out{};
+    glm::vec3* corners[3] = {&out.v0, &out.v1, &out.v2};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const glm::dvec3 p = transform ? transform->apply(tri[k]) : tri[k];
+      *corners[k] = glm::vec3(p);
+      if (!std::isfinite(corners[k]->x) || !std::isfinite(corners[k]->y) ||
+          !std::isfinite(corners[k]->z)) {
+        shape.fail("transform moves vertices beyond the range of 32-bit floats");
+      }
+    }
+    // Zero area: the edges at v0 are parallel to within double rounding, i.e. the sine of
+    // the angle between them is at most 1e-12 (scale-invariant; computed in double on the
+    // float vertices the renderer will see, so thin but real slivers are kept). Covers
+    // coincident vertices too.
+    const glm::dvec3 e1 = glm::dvec3(out.v1) - glm::dvec3(out.v0);
+    const glm::dvec3 e2 = glm::dvec3(out.v2) - glm::dvec3(out.v0);
+    if (!(glm::length(glm::cross(e1, e2)) > 1e-12 * glm::length(e1) * glm::length(e2))) {
+      ++dropped;
+      continue;
+    }
+    if (scene.triangles.size() >= static_cast<std::size_t>(kNoEmitter)) {
+      shape.fail("too many triangles in the scene (at most 4294967295)");
+    }
+    out.material = material;
+    out.emitter = kNoEmitter;
+    out.primitive = static_cast<uint>(scene.triangles.size());
+    scene.triangles.push_back(out);
+  }
+  if (dropped > 0) {
+    scene.warnings.push_back(shape.file() + ": " + shape.path() + ": dropped " +
+                             std::to_string(dropped) + " zero-area triangle" +
+                             (dropped == 1 ? "" : "s") + " (of " +
+                             std::to_string(triangles.size()) + ")");
+  }
+}
+
+void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Scene& scene) {
+  if (node.size() == 0) node.fail("expected at least one shape");
+  std::unordered_map<std::string, uint> materialIndex;
+  std::vector<std::string_view> materialNames;
+  for (std::size_t i = 0; i < scene.materialNames.size(); ++i) {
+    materialIndex.emplace(scene.materialNames[i], static_cast<uint>(i));
+    materialNames.push_back(scene.materialNames[i]);
+  }
+
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const JsonNode shape = node[i];
+    shape.expectObject();
+    enum class Kind { kQuad, kTriangles, kObj };
+    static constexpr std::array<Choice<Kind>, 3> kKinds{
+        {{"quad", Kind::kQuad}, {"triangles", Kind::kTriangles}, {"obj", Kind::kObj}}};
+    const Kind kind = readChoice(shape.require("type"), kKinds, "shape type");
+    switch (kind) {
+      case Kind::kQuad:
+        shape.checkKeys({"type", "name", "material", "vertices", "transform"});
+        break;
+      case Kind::kTriangles:
+        shape.checkKeys({"type", "name", "material", "vertices", "indices", "transform"});
+        break;
+      case Kind::kObj:
+        shape.checkKeys({"type", "name", "material", "file", "transform"});
+        break;
+    }
+    if (auto n = shape.find("name")) n->string();  // documentation only, but must be a string
+
+    const JsonNode materialNode = shape.require("material");
+    const std::string materialName = materialNode.string();
+    const auto found = materialIndex.find(materialName);
+    if (found == materialIndex.end()) {
+      materialNode.fail("unknown material " + singleQuoted(materialName) +
+                        scene_detail::didYouMean(materialName, materialNames));
+    }
+
+    std::optional<Transform> transform;
+    if (auto n = shape.find("transform")) transform = readTransform(*n);
+
+    std::vector<Tri> triangles;
+    switch (kind) {
+      case Kind::kQuad: {
+        const std::vector<glm::dvec3> v = readPoints(shape.require("vertices"), 4);
+        // Fixed split along the v0-v2 diagonal; both halves keep the quad's winding.
+        triangles = {Tri{v[0], v[1], v[2]}, Tri{v[0], v[2], v[3]}};
+        break;
+      }
+      case Kind::kTriangles:
+        triangles = readTriangleShape(shape);
+        break;
+      case Kind::kObj:
+        triangles = readObjShape(shape, scenePath);
+        break;
+    }
+    total += triangles.size();
+    emitTriangles(shape, triangles, transform, found->second, scene);
+  }
+  if (scene.triangles.empty()) {
+    node.fail("no triangles left: all " + std::to_string(total) + " have zero area");
+  }
+}
+
+}  // namespace
+
+Scene loadScene(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::string text;
+  std::string why;
+  if (!scene_detail::readTextFile(path, &text, &why)) {
+    scene_detail::throwInputError(file, "", "cannot open scene file (" + why + ")");
+  }
+  const nlohmann::json document = scene_detail::parseJson(text, file);
+  const JsonNode root(document, "", file);
+  root.checkKeys({"description", "camera", "integrator", "materials", "shapes"});
+
+  Scene scene;
+  scene.sourcePath = path;
+  if (auto n = root.find("description")) n->string();
+  if (auto n = root.find("camera")) scene.camera = readCamera(*n);
+  if (auto n = root.find("integrator")) scene.integrator = readIntegrator(*n);
+  readMaterials(root.require("materials"), scene);
+  readShapes(root.require("shapes"), path, scene);
+  return scene;
+}
+
+Camera makeCamera(const CameraDesc& desc, int width, int height) {
+  PT_CHECK(width > 0 && height > 0, "film size must be positive");
+  // Double precision so that far-away or nearly-degenerate setups round only once.
+  const glm::dvec3 position(desc.position);
+  const glm::dvec3 forward = glm::normalize(glm::dvec3(desc.target) - position);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(desc.up)));
+  const glm::dvec3 up = glm::cross(right, forward);
+  const double tanHalfFovY = std::tan(glm::radians(static_cast<double>(desc.vfovDegrees)) / 2.0);
+
+  Camera camera{};
+  camera.position = desc.position;
+  camera.forward = glm::vec3(forward);
+  camera.right = glm::vec3(right);
+  camera.up = glm::vec3(up);
+  camera.tanHalfFovY = static_cast<float>(tanHalfFovY);
+  camera.aspect = static_cast<float>(static_cast<double>(width) / static_cast<double>(height));
+  camera.width = static_cast<uint>(width);
+  camera.height = static_cast<uint>(height);
+  PT_CHECK(std::isfinite(camera.right.x + camera.right.y + camera.right.z + camera.forward.x +
+                         camera.forward.y + camera.forward.z + camera.tanHalfFovY),
+           "camera basis is degenerate (up parallel to the view direction?)");
+  return camera;
+}
+
+}  // namespace pt

@@ -1,0 +1,209 @@
+// The GPU path tracer: one invocation traces one path sample of one pixel and adds it to the
+// accumulation buffer. The same integrator as host/cpu/integrator.cpp (NEE + BSDF sampling
+// with MIS, Russian roulette, Lambertian and mirror), written separately in GLSL; the
+// layouts (shared_types.h) and random numbers (sampling.h) are shared.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#ifdef PT_DEBUG_PRINTF
+#extension GL_EXT_debug_printf : enable
+#endif
+
+#include "shared_types.h"
+#include "sampling.h"
+
+layout(local_size_x = kWorkgroupSize, local_size_y = kWorkgroupSize) in;
+
+// The effect set: what the scene does not use is compiled out (see host/render/prepare.h).
+layout(constant_id = PT_SPEC_DIFFUSE) const bool kDiffuse = true;
+layout(constant_id = PT_SPEC_MIRROR) const bool kMirror = true;
+layout(constant_id = PT_SPEC_NEE) const bool kNee = true;
+layout(constant_id = PT_SPEC_BSDF_EMISSION) const bool kBsdfEmission = true;
+layout(constant_id = PT_SPEC_MIS) const bool kMis = true;
+layout(constant_id = PT_SPEC_RR) const bool kRussianRoulette = true;
+
+layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer { RenderParams params; };
+layout(std430, set = 0, binding = PT_BINDING_NODES) readonly buffer NodeBuffer { BvhNode nodes[]; };
+layout(std430, set = 0, binding = PT_BINDING_TRIANGLES) readonly buffer TriangleBuffer { Triangle triangles[]; };
+layout(std430, set = 0, binding = PT_BINDING_MATERIALS) readonly buffer MaterialBuffer { Material materials[]; };
+layout(std430, set = 0, binding = PT_BINDING_EMITTERS) readonly buffer EmitterBuffer { Emitter emitters[]; };
+layout(std430, set = 0, binding = PT_BINDING_ACCUM) buffer AccumBuffer { AccumPixel accum[]; };
+layout(std430, set = 0, binding = PT_BINDING_COUNTERS) buffer CounterBuffer { DeviceCounters counters; };
+
+layout(push_constant) uniform Pass { PassConstants pass; };
+
+// Loop iterations used by this invocation, against lavapipe's silent cap (kLoopBudget).
+uint gLoopIterations = 0u;
+uint gRays = 0u;
+bool gDebug = false;  // this invocation prints its path (--debug-pixel)
+
+#include "bvh.glsl"
+
+float maxComponent(vec3 v) { return max(v.x, max(v.y, v.z)); }
+
+// Primary ray through film point (x, y), row 0 at the top.
+vec3 cameraDirection(Camera cam, vec2 filmPoint) {
+  float u = 2.0 * filmPoint.x / float(cam.width) - 1.0;
+  float v = 1.0 - 2.0 * filmPoint.y / float(cam.height);
+  return normalize(cam.forward + (u * cam.tanHalfFovY * cam.aspect) * cam.right +
+                   (v * cam.tanHalfFovY) * cam.up);
+}
+
+vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
+  uint seed = params.seed;
+  // Effects switched off by a specialization constant fold away here; the run-time half of
+  // each test keeps the unspecialized shader (every constant true) correct for any scene.
+  bool neeOn = kNee && params.emitterCount > 0u && params.strategy != kStrategyBsdf;
+  bool misOn = kMis && params.strategy == kStrategyMis;
+  bool bsdfEmissionOn = kBsdfEmission && params.strategy != kStrategyNee;
+  bool rouletteOn = kRussianRoulette && params.russianRoulette != 0u;
+  // Primary ray through a uniformly jittered point of the pixel (box filter of width 1).
+  vec3 origin = params.camera.position;
+  vec3 direction = cameraDirection(params.camera, vec2(pixel) + random2(pixel, sampleIndex, kDimPixel, seed));
+  vec3 L = vec3(0.0);     // radiance gathered so far
+  vec3 beta = vec3(1.0);  // path throughput
+  // The camera ray counts as specular: emission it finds is taken at full weight.
+  bool specularBounce = true;
+  float bsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that produced the ray
+
+  for (uint depth = 0u; gLoopIterations < kLoopBudget;) {
+    gLoopIterations++;
+    // Find the closest surface along the ray; the background is black.
+    gRays++;
+    HitData hit;
+    if (!traceRay(origin, direction, 1.0 / 0.0, /*anyHit=*/false, hit)) break;
+    Triangle tri = triangles[hit.triangle];
+    Material material = materials[tri.material];
+    // Hit point from barycentrics (more accurate than origin + t * direction).
+    vec3 p = hit.barycentrics.x * tri.v0 + hit.barycentrics.y * tri.v1 + hit.barycentrics.z * tri.v2;
+    vec3 edgeCross = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
+    vec3 ng = normalize(edgeCross);
+    vec3 wo = -direction;
+    float cosOut = dot(ng, wo);
+    // Coordinates' scale at this vertex, for the ray offsets.
+    float magnitude = triangleMagnitude(tri.v0, tri.v1, tri.v2);
+#ifdef PT_DEBUG_PRINTF
+    if (gDebug) {
+      debugPrintfEXT("gpu depth %u: hit triangle %u (primitive %u) t=%g p=(%g, %g, %g) beta=(%g, %g, %g)", depth,
+                     hit.triangle, tri.primitive, hit.t, p.x, p.y, p.z, beta.x, beta.y, beta.z);
+    }
+#endif
+
+    // Add emitted light found by this ray: one-sided, on the geometric normal's side.
+    if (tri.emitter != kNoEmitter && cosOut > 0.0) {
+      vec3 Le = material.emission;
+      if (specularBounce) {
+        L += beta * Le;
+      } else if (bsdfEmissionOn) {
+        // Weigh against the chance that light sampling had produced this point.
+        float weight = 1.0;
+        if (misOn) {
+          float area = 0.5 * length(edgeCross);
+          float lightPdf = emitters[tri.emitter].pmf * hit.t * hit.t / (cosOut * area);
+          weight = powerHeuristic(bsdfPdf, lightPdf);
+        }
+        L += beta * weight * Le;
+      }
+    }
+
+    // Stop after maxDepth scattering events.
+    if (depth == params.maxDepth) break;
+    uint dim = kDimFirstBounce + kDimsPerBounce * depth;
+    ++depth;
+
+    // Both materials are two-sided: shade with the normal facing the incoming ray.
+    vec3 n = cosOut >= 0.0 ? ng : -ng;
+    vec3 wi;
+    if (kMirror && (!kDiffuse || material.type == kMaterialMirror)) {
+      // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
+      wi = direction - 2.0 * dot(direction, n) * n;
+      beta *= material.reflectance;
+      specularBounce = true;
+    } else {
+      vec3 f = material.reflectance * kInvPi;
+      // Sample direct illumination from an emitter (next-event estimation).
+      if (neeOn && material.reflectance != vec3(0.0)) {
+        // Pick an emitter from the alias table, then a uniform point on its triangle.
+        vec2 uChoose = random2(pixel, sampleIndex, dim + kDimLightChoose, seed);
+        uint slot = min(uint(uChoose.x * float(params.emitterCount)), params.emitterCount - 1u);
+        Emitter chosen = emitters[slot];
+        Emitter emitter = emitters[uChoose.y < chosen.aliasThreshold ? slot : chosen.alias];
+        Triangle light = triangles[emitter.triangle];
+        vec2 b = sampleTriangleBarycentrics(random2(pixel, sampleIndex, dim + kDimLightPoint, seed));
+        vec3 lightPoint = (1.0 - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
+        vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
+        float lightArea = 0.5 * length(lightCross);
+        vec3 lightNormal = normalize(lightCross);
+
+        vec3 toLight = lightPoint - p;
+        float dist2 = dot(toLight, toLight);
+        vec3 wl = toLight / sqrt(dist2);
+        float cosLight = -dot(lightNormal, wl);  // > 0: we see the emitting side
+        float cosSurface = dot(n, wl);
+        if (cosLight > 0.0 && cosSurface > 0.0) {
+          // Shadow ray between the two offset points; t in [0, 1) spans the segment.
+          vec3 from = offsetRayOrigin(p, n, magnitude);
+          vec3 to = offsetRayOrigin(lightPoint, lightNormal, triangleMagnitude(light.v0, light.v1, light.v2));
+          gRays++;
+          HitData blocker;
+          bool occluded = traceRay(from, to - from, 1.0, /*anyHit=*/true, blocker);
+          if (!occluded) {
+            float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
+            float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0;
+            vec3 Le = materials[light.material].emission;
+            L += beta * f * Le * (cosSurface * weight / lightPdf);
+#ifdef PT_DEBUG_PRINTF
+            if (gDebug) {
+              debugPrintfEXT("gpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g", depth,
+                             emitter.triangle, light.primitive, lightPdf, weight);
+            }
+#endif
+          }
+        }
+      }
+      // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
+      wi = localToWorld(sampleCosineHemisphere(random2(pixel, sampleIndex, dim + kDimBsdf, seed)), n);
+      bsdfPdf = dot(wi, n) * kInvPi;
+      if (!(bsdfPdf > 0.0)) break;  // direction in the tangent plane: zero contribution
+      beta *= material.reflectance;
+      specularBounce = false;
+    }
+    if (maxComponent(beta) <= 0.0) break;
+
+    // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
+    if (rouletteOn && depth >= params.rrStartDepth) {
+      float q = max(0.0, 1.0 - maxComponent(beta));
+      if (random1(pixel, sampleIndex, dim + kDimRoulette, seed) < q) break;
+      beta /= 1.0 - q;
+    }
+
+    // Leave the surface on the side of the new direction.
+    origin = offsetRayOrigin(p, n, magnitude);
+    direction = wi;
+  }
+  return L;
+}
+
+void main() {
+  uvec2 pixel = gl_GlobalInvocationID.xy;
+  if (pixel.x >= params.camera.width || pixel.y >= params.camera.height) return;
+  uint index = pixel.y * params.camera.width + pixel.x;
+  gDebug = index == pass.debugPixel;
+
+  vec3 L = sampleRadiance(pixel, pass.sampleIndex);
+
+#ifdef PT_DEBUG_PRINTF
+  if (gDebug) debugPrintfEXT("gpu sample %u: L=(%g, %g, %g)", pass.sampleIndex, L.x, L.y, L.z);
+#endif
+  // A path given up at the loop budget is reported, never added as if complete.
+  if (gLoopIterations >= kLoopBudget) {
+    atomicAdd(counters.truncated, 1u);
+    accum[index].invalid += 1u;
+  } else if (any(isnan(L)) || any(isinf(L))) {
+    accum[index].invalid += 1u;  // counted, never silently dropped
+  } else {
+    accum[index].sum += L;
+  }
+  atomicMax(counters.maxLoopIterations, gLoopIterations);
+  uint before = atomicAdd(counters.raysLow, gRays);
+  if (before + gRays < before) atomicAdd(counters.raysHigh, 1u);  // carry into the high word
+}
