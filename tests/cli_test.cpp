@@ -39,7 +39,7 @@ int lineCount(const std::string& s) { return int(std::count(s.begin(), s.end(), 
 
 TEST(Cli, RenderWritesEveryOutputAndOneStatsLine) {
   test::TempDir dir;
-  const Result r = runPt("render " + kConfigs + "/cornell-box.json --spp 2 --width 32 --height 32 " +
+  const Result r = runPt("render " + kConfigs + "/cornell-box.json --backend cpu --spp 2 --width 32 --height 32 " +
                              "--threads 2 --out " + (dir / "a.png").string() + " --out " +
                              (dir / "a.exr").string() + " --out " + (dir / "a.pfm").string(),
                          dir);
@@ -52,7 +52,7 @@ TEST(Cli, RenderWritesEveryOutputAndOneStatsLine) {
   }
   // The same render compared with itself agrees; against a different seed it does not.
   EXPECT_EQ(runPt("diff " + (dir / "a.exr").string() + " " + (dir / "a.pfm").string(), dir).status, 0);
-  ASSERT_EQ(runPt("render " + kConfigs + "/cornell-box.json --spp 2 --width 32 --height 32 " +
+  ASSERT_EQ(runPt("render " + kConfigs + "/cornell-box.json --backend cpu --spp 2 --width 32 --height 32 " +
                       "--seed 9 --out " + (dir / "b.exr").string(),
                   dir)
                 .status,

@@ -147,7 +147,8 @@ class ObjScanner {
   void vertex(std::string_view rest) const {
     const std::vector<std::string_view> tokens = splitBlanks(rest);
     if (tokens.size() < 3) {
-      fail(line_, "vertex has " + std::to_string(tokens.size()) + " coordinates (need 3)");
+      fail(line_, "vertex has " + std::to_string(tokens.size()) +
+                      (tokens.size() == 1 ? " coordinate" : " coordinates") + " (need 3)");
     }
     for (int i = 0; i < 3; ++i) {
       double v = 0.0;

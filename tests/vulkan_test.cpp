@@ -1,0 +1,157 @@
+// The Vulkan backend on whatever device the machine has (lavapipe in CI), always with the
+// validation layers on: it must agree with the CPU reference sample for sample.
+#include <gtest/gtest.h>
+
+#include "cpu/integrator.h"
+#include "render/prepare.h"
+#include "scene/scene.h"
+#include "vulkan/backend.h"
+
+namespace pt {
+namespace {
+
+const std::filesystem::path kConfigs = std::filesystem::path(PT_SOURCE_DIR) / "configs";
+
+VulkanRenderOptions validatedOptions(int spp) {
+  VulkanRenderOptions options;
+  options.context.validation = true;  // a validation error fails the test below
+  options.spp = spp;
+  options.passesPerFlush = 3;  // exercise several folds into the film
+  return options;
+}
+
+struct Comparison {
+  DiffStats diff;
+  VulkanRenderStats gpu;
+  vec3 gpuMean{0.0f}, cpuMean{0.0f};
+};
+
+Comparison renderBoth(const SceneData& data, int spp, bool specialize = true) {
+  const Camera& cam = data.params.camera;
+  Film cpu(int(cam.width), int(cam.height)), gpu(int(cam.width), int(cam.height));
+  const RenderStats cpuStats = renderCpu(data, CpuRenderOptions{.threads = 2, .spp = spp}, cpu);
+  EXPECT_EQ(cpuStats.invalidSamples, 0u);
+  VulkanRenderOptions options = validatedOptions(spp);
+  options.specialize = specialize;
+  Comparison c;
+  c.gpu = renderVulkan(data, options, gpu);
+  const Image a = gpu.resolve(), b = cpu.resolve();
+  c.diff = diffImages(a, b, 1e-3);
+  for (size_t i = 0; i < a.pixels.size(); ++i) {
+    c.gpuMean += a.pixels[i] / float(a.pixels.size());
+    c.cpuMean += b.pixels[i] / float(b.pixels.size());
+  }
+  return c;
+}
+
+// The acceptance rule: within 1e-3 relative on at least 99.5 % of pixels, no validation
+// errors, nothing invalid or cut short, and image means equal to 1e-3 (diverged paths are
+// rare and unbiased, so they cannot move the mean).
+void expectAgreement(const Comparison& c) {
+  EXPECT_EQ(c.gpu.validationErrors, 0u);
+  EXPECT_EQ(c.gpu.invalidSamples, 0u);
+  EXPECT_EQ(c.gpu.truncatedSamples, 0u);
+  EXPECT_EQ(c.diff.nonFinitePixels, 0u);
+  EXPECT_LE(double(c.diff.pixelsOverThreshold), 0.005 * double(c.diff.pixelCount))
+      << "rmse " << c.diff.rmse << " max " << c.diff.maxAbsError;
+  for (int ch = 0; ch < 3; ++ch) {
+    EXPECT_GT(c.cpuMean[ch], 0.0f);
+    EXPECT_NEAR(c.gpuMean[ch], c.cpuMean[ch], 1e-3f * c.cpuMean[ch]) << "channel " << ch;
+  }
+  EXPECT_GT(c.gpu.rays, 0u);
+}
+
+SceneData prepare(const std::string& config, int size) {
+  return prepareScene(loadScene(kConfigs / config), RenderSettings{.width = size, .height = size});
+}
+
+TEST(Vulkan, CornellBoxMatchesCpuReference) {
+  expectAgreement(renderBoth(prepare("cornell-box.json", 64), 8));
+}
+
+TEST(Vulkan, MirrorVariantMatchesCpuReference) {
+  const SceneData data = prepare("cornell-mirror.json", 64);
+  EXPECT_TRUE(data.effects.mirror);
+  expectAgreement(renderBoth(data, 8));
+}
+
+TEST(Vulkan, BunnyMeshMatchesCpuReference) {
+  // 69,666 triangles: deep BVH traversals on every bounce.
+  expectAgreement(renderBoth(prepare("bunny-box.json", 40), 4));
+}
+
+TEST(Vulkan, UnspecializedShaderGivesTheSameImage) {
+  // Every effect compiled in and decided at run time must not change the result.
+  const SceneData data = prepare("cornell-mirror.json", 32);
+  Film a(32, 32), b(32, 32);
+  VulkanRenderOptions options = validatedOptions(4);
+  const VulkanRenderStats s1 = renderVulkan(data, options, a);
+  options.specialize = false;
+  const VulkanRenderStats s2 = renderVulkan(data, options, b);
+  EXPECT_EQ(s1.validationErrors + s2.validationErrors, 0u);
+  const DiffStats d = diffImages(a.resolve(), b.resolve(), 1e-5);
+  EXPECT_EQ(d.pixelsOverThreshold, 0u) << "max " << d.maxAbsError;
+}
+
+// A closed cube of perfect mirrors (reflectance 1, so Russian roulette never ends a path)
+// with a small emitter inside, itself a mirror: nothing absorbs, every path bounces until the depth limit, so the shader's
+// loop count grows with maxDepth.
+SceneData mirrorBox(int maxDepth) {
+  Scene scene;
+  scene.materials = {Material{vec3(1.0f), kMaterialMirror, vec3(0.0f), 0},
+                     Material{vec3(1.0f), kMaterialMirror, vec3(1.0f), 0}};
+  auto quad = [&](vec3 c, vec3 u, vec3 v, uint m) {
+    scene.triangles.push_back(Triangle{c - u - v, m, c + u - v, kNoEmitter, c + u + v, 0});
+    scene.triangles.push_back(Triangle{c - u - v, m, c + u + v, kNoEmitter, c - u + v, 0});
+  };
+  const vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  quad(-x, y, z, 0), quad(x, z, y, 0), quad(-y, z, x, 0), quad(y, x, z, 0), quad(-z, x, y, 0),
+      quad(z, y, x, 0);
+  quad(vec3(0.1f, 0.0f, 0.5f), 0.05f * y, 0.05f * x, 1);  // emits towards -z, reflects
+  for (uint i = 0; i < scene.triangles.size(); ++i) scene.triangles[i].primitive = i;
+  scene.camera = CameraDesc{vec3(0.3f, 0.2f, -0.5f), vec3(0.2f, 0.1f, 1), y, 60.0f, 8, 8};
+  scene.integrator.maxDepth = maxDepth;
+  return prepareScene(scene, RenderSettings{});
+}
+
+TEST(VulkanLoopBudget, DeepPathsAreCompleteAndMatchCpu) {
+  const SceneData data = mirrorBox(64);
+  const Comparison c = renderBoth(data, 2);
+  EXPECT_EQ(c.gpu.truncatedSamples, 0u);
+  EXPECT_GT(c.gpu.maxLoopIterations, 64u * 3u);  // the paths really are 64 bounces deep
+  EXPECT_LT(c.gpu.maxLoopIterations, kLoopBudget);
+  EXPECT_EQ(c.gpu.validationErrors, 0u);
+  EXPECT_LE(double(c.diff.pixelsOverThreshold), 0.005 * double(c.diff.pixelCount));
+}
+
+TEST(VulkanLoopBudget, PathsBeyondTheBudgetAreReportedNotSilentlyCut) {
+  // 100,000 bounces need far more than lavapipe's 65,535 loop iterations: every sample must
+  // come back flagged as cut short and counted invalid, none added to the image.
+  const SceneData data = mirrorBox(100000);
+  Film film(8, 8);
+  const VulkanRenderStats stats = renderVulkan(data, validatedOptions(1), film);
+  EXPECT_EQ(stats.truncatedSamples, 64u);
+  EXPECT_EQ(stats.invalidSamples, 64u);
+  EXPECT_GE(stats.maxLoopIterations, kLoopBudget);
+  for (uint64_t n : film.sampleCount) EXPECT_EQ(n, 0u);
+}
+
+TEST(VulkanLimits, BuffersBeyondMaxStorageBufferRangeFailClearly) {
+  // A 4096 x 4096 film needs a 256 MiB accumulation buffer; lavapipe allows 128 MiB per
+  // storage buffer. A device with a larger limit renders it instead (skip there).
+  SceneData data = prepare("cornell-box.json", 4096);
+  VulkanContext ctx(ContextOptions{});
+  if (ctx.limits.maxStorageBufferRange >= 4096ull * 4096ull * sizeof(AccumPixel)) {
+    GTEST_SKIP() << "device allows " << ctx.limits.maxStorageBufferRange << " bytes";
+  }
+  Film film(4096, 4096);
+  try {
+    renderVulkan(data, validatedOptions(1), film);
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("maxStorageBufferRange"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pt
