@@ -2,7 +2,7 @@
 // Wald 2013), the slab test with Ize's (2013) widened far distance, and iterative traversal
 // with a fixed stack, near child first, closest-hit and any-hit. The same algorithms as
 // host/bvh/traverse.cpp, written for the GPU. Expects the buffers `nodes` and `triangles`
-// and the loop counter `gLoopIterations` to be declared by the including shader.
+// and the globals `gLoopIterations` and `gTruncated` to be declared by the including shader.
 
 // Smallest |direction| component used for 1/direction: keeps every slab product finite.
 const float kMinDirection = 1e-30;
@@ -91,8 +91,9 @@ bool intersectBox(RayData r, vec3 lo, vec3 hi, float tMax, out float tNear) {
   return enter <= exit;
 }
 
-// Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax. Returns false when nothing
-// is hit, and also when the loop budget ran out (the caller checks gLoopIterations).
+// Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax. Every loop records how it
+// ended: one that ends other than by its own break or return was cut short by lavapipe's
+// silent loop-iteration cap, and sets gTruncated.
 bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData best) {
   RayData r = prepareRay(origin, direction);
   best.t = tMax;
@@ -104,12 +105,15 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
   uint stackSize = 0u;
   uint nodeIndex = 0u;
   bool found = false;
-  while (gLoopIterations < kLoopBudget) {
+  bool complete = false;
+  for (;;) {
     gLoopIterations++;
     BvhNode node = nodes[nodeIndex];
     if (node.count > 0u) {
       // Leaf: test its triangles, shrinking the search range as hits are found.
-      for (uint i = node.offset; i < node.offset + node.count; ++i) {
+      uint i = node.offset;
+      uint end = node.offset + node.count;
+      for (; i < end; ++i) {
         gLoopIterations++;
         HitData hit;
         if (intersectTriangle(r, triangles[i], best.t, hit)) {
@@ -119,6 +123,7 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
           if (anyHit) return true;
         }
       }
+      if (i < end) gTruncated = true;
     } else {
       // Interior: visit the nearer child that the ray enters, push the other.
       uint left = nodeIndex + 1u;
@@ -137,8 +142,12 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
         continue;
       }
     }
-    if (stackSize == 0u) break;
+    if (stackSize == 0u) {
+      complete = true;
+      break;
+    }
     nodeIndex = stack[--stackSize];
   }
+  if (!complete) gTruncated = true;
   return found;
 }

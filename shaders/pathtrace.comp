@@ -31,8 +31,11 @@ layout(std430, set = 0, binding = PT_BINDING_COUNTERS) buffer CounterBuffer { De
 
 layout(push_constant) uniform Pass { PassConstants pass; };
 
-// Loop iterations used by this invocation, against lavapipe's silent cap (kLoopBudget).
-uint gLoopIterations = 0u;
+// Lavapipe (Mesa 22.3) silently ends every loop once an invocation has run 65,535 loop
+// iterations (counted per SIMD group, so a lane's own count can be lower). Each loop here
+// notes how it ended; one that ended otherwise was cut short: gTruncated.
+bool gTruncated = false;
+uint gLoopIterations = 0u;  // this invocation's count, for the statistics
 uint gRays = 0u;
 bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 
@@ -65,12 +68,16 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
   bool specularBounce = true;
   float bsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that produced the ray
 
-  for (uint depth = 0u; gLoopIterations < kLoopBudget;) {
+  bool pathEnded = false;
+  for (uint depth = 0u;;) {
     gLoopIterations++;
     // Find the closest surface along the ray; the background is black.
     gRays++;
     HitData hit;
-    if (!traceRay(origin, direction, 1.0 / 0.0, /*anyHit=*/false, hit)) break;
+    if (!traceRay(origin, direction, 1.0 / 0.0, /*anyHit=*/false, hit)) {
+      pathEnded = true;
+      break;
+    }
     Triangle tri = triangles[hit.triangle];
     Material material = materials[tri.material];
     // Hit point from barycentrics (more accurate than origin + t * direction).
@@ -106,7 +113,10 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
     }
 
     // Stop after maxDepth scattering events.
-    if (depth == params.maxDepth) break;
+    if (depth == params.maxDepth) {
+      pathEnded = true;
+      break;
+    }
     uint dim = kDimFirstBounce + kDimsPerBounce * depth;
     ++depth;
 
@@ -163,16 +173,25 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
       // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
       wi = localToWorld(sampleCosineHemisphere(random2(pixel, sampleIndex, dim + kDimBsdf, seed)), n);
       bsdfPdf = dot(wi, n) * kInvPi;
-      if (!(bsdfPdf > 0.0)) break;  // direction in the tangent plane: zero contribution
+      if (!(bsdfPdf > 0.0)) {  // direction in the tangent plane: zero contribution
+        pathEnded = true;
+        break;
+      }
       beta *= material.reflectance;
       specularBounce = false;
     }
-    if (maxComponent(beta) <= 0.0) break;
+    if (maxComponent(beta) <= 0.0) {
+      pathEnded = true;
+      break;
+    }
 
     // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
     if (rouletteOn && depth >= params.rrStartDepth) {
       float q = max(0.0, 1.0 - maxComponent(beta));
-      if (random1(pixel, sampleIndex, dim + kDimRoulette, seed) < q) break;
+      if (random1(pixel, sampleIndex, dim + kDimRoulette, seed) < q) {
+        pathEnded = true;
+        break;
+      }
       beta /= 1.0 - q;
     }
 
@@ -180,6 +199,7 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
     origin = offsetRayOrigin(p, n, magnitude);
     direction = wi;
   }
+  if (!pathEnded) gTruncated = true;
   return L;
 }
 
@@ -195,7 +215,7 @@ void main() {
   if (gDebug) debugPrintfEXT("gpu sample %u: L=(%g, %g, %g)", pass.sampleIndex, L.x, L.y, L.z);
 #endif
   // A path given up at the loop budget is reported, never added as if complete.
-  if (gLoopIterations >= kLoopBudget) {
+  if (gTruncated) {
     atomicAdd(counters.truncated, 1u);
     accum[index].invalid += 1u;
   } else if (any(isnan(L)) || any(isinf(L))) {

@@ -138,16 +138,11 @@ struct AccumPixel {
   uint invalid;  //  4 bytes: samples that came out NaN or Inf (not added to sum)
 };               // 16 bytes
 
-// Lavapipe (Mesa 22.3) silently ends every loop of an invocation after 65,535 iterations in
-// total. The shader counts its own iterations and gives up a path at this budget, reporting
-// it in DeviceCounters::truncated, so a cut-short sample can never pass unnoticed.
-PT_CONST uint kLoopBudget = 60000u;
-
 struct DeviceCounters {
   uint raysLow;    // 4 bytes: rays traced, low 32 bits
   uint raysHigh;   // 4 bytes: rays traced, high 32 bits (carried by the shader)
-  uint truncated;  // 4 bytes: samples given up at kLoopBudget iterations
-  uint maxLoopIterations;  // 4 bytes: most iterations any invocation used
+  uint truncated;  // 4 bytes: samples whose loops lavapipe's iteration cap cut short
+  uint maxLoopIterations;  // 4 bytes: most loop iterations one invocation counted
 };                 // 16 bytes
 
 // ---- Random-number dimensions ----------------------------------------------------------

@@ -110,3 +110,43 @@ TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
 
 }  // namespace
 }  // namespace pt
+
+namespace pt {
+namespace {
+
+TEST(CliVulkan, RendersOnTheDefaultBackendWithValidation) {
+  test::TempDir dir;
+  const Result r = runPt("render " + kConfigs + "/cornell-mirror.json --spp 2 --width 16 --height 16 " +
+                             "--validation --out " + (dir / "v.exr").string(),
+                         dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* key : {"backend=vulkan", "device=", "effects=diffuse+mirror+nee+mis+rr",
+                          "invalid_samples=0", "Mrays/s="}) {
+    EXPECT_NE(r.out.find(key), std::string::npos) << key << " in " << r.out;
+  }
+  EXPECT_EQ(r.err.find("validation"), std::string::npos) << r.err;
+  const Result d = runPt("devices", dir);
+  EXPECT_EQ(d.status, 0);
+  EXPECT_GE(lineCount(d.out), 1);
+}
+
+TEST(CliVulkan, NoDriverGivesItsOwnExitStatus) {
+  test::TempDir dir;
+  // Point the loader at a driver manifest that does not exist: no Vulkan driver at all.
+  const std::string env = "VK_ICD_FILENAMES=" + (dir / "none.json").string() +
+                          " VK_DRIVER_FILES=" + (dir / "none.json").string() + " ";
+  const auto out = dir / "o.txt", err = dir / "e.txt";
+  const std::string cmd = env + kPt + " render " + kConfigs + "/cornell-box.json --spp 1 --out " +
+                          (dir / "x.png").string() + " >" + out.string() + " 2>" + err.string();
+  const int raw = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(raw));
+  EXPECT_EQ(WEXITSTATUS(raw), 3);
+  std::ifstream f(err);
+  const std::string text(std::istreambuf_iterator<char>(f), {});
+  EXPECT_EQ(lineCount(text), 1) << text;
+  EXPECT_NE(text.find("Vulkan"), std::string::npos) << text;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+}
+
+}  // namespace
+}  // namespace pt
