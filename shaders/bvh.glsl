@@ -7,7 +7,8 @@
 // Smallest |direction| component used for 1/direction: keeps every slab product finite.
 const float kMinDirection = 1e-30;
 // 1 + 2 gamma(3): Ize 2013's widening of the far distance against rounding.
-const float kFarScale = 1.0 + 2.0 * (3.0 * 5.9604644775390625e-8 / (1.0 - 3.0 * 5.9604644775390625e-8));
+const float kFarScale =
+    1.0 + 2.0 * (3.0 * 5.9604644775390625e-8 / (1.0 - 3.0 * 5.9604644775390625e-8));
 
 struct RayData {
   vec3 origin;
@@ -29,7 +30,8 @@ float safeInverse(float d) {
 RayData prepareRay(vec3 origin, vec3 direction) {
   RayData r;
   r.origin = origin;
-  r.invDirection = vec3(safeInverse(direction.x), safeInverse(direction.y), safeInverse(direction.z));
+  r.invDirection =
+      vec3(safeInverse(direction.x), safeInverse(direction.y), safeInverse(direction.z));
   vec3 a = abs(direction);
   r.kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
   r.kx = (r.kz + 1) % 3;
@@ -130,7 +132,8 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
       uint right = node.offset;
       float tLeft, tRight;
       bool hitLeft = intersectBox(r, nodes[left].boundsMin, nodes[left].boundsMax, best.t, tLeft);
-      bool hitRight = intersectBox(r, nodes[right].boundsMin, nodes[right].boundsMax, best.t, tRight);
+      bool hitRight =
+          intersectBox(r, nodes[right].boundsMin, nodes[right].boundsMax, best.t, tRight);
       if (hitLeft && hitRight) {
         bool leftFirst = tLeft <= tRight;
         stack[stackSize++] = leftFirst ? right : left;

@@ -21,15 +21,31 @@ layout(constant_id = PT_SPEC_BSDF_EMISSION) const bool kBsdfEmission = true;
 layout(constant_id = PT_SPEC_MIS) const bool kMis = true;
 layout(constant_id = PT_SPEC_RR) const bool kRussianRoulette = true;
 
-layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer { RenderParams params; };
-layout(std430, set = 0, binding = PT_BINDING_NODES) readonly buffer NodeBuffer { BvhNode nodes[]; };
-layout(std430, set = 0, binding = PT_BINDING_TRIANGLES) readonly buffer TriangleBuffer { Triangle triangles[]; };
-layout(std430, set = 0, binding = PT_BINDING_MATERIALS) readonly buffer MaterialBuffer { Material materials[]; };
-layout(std430, set = 0, binding = PT_BINDING_EMITTERS) readonly buffer EmitterBuffer { Emitter emitters[]; };
-layout(std430, set = 0, binding = PT_BINDING_ACCUM) buffer AccumBuffer { AccumPixel accum[]; };
-layout(std430, set = 0, binding = PT_BINDING_COUNTERS) buffer CounterBuffer { DeviceCounters counters; };
+layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer {
+  RenderParams params;
+};
+layout(std430, set = 0, binding = PT_BINDING_NODES) readonly buffer NodeBuffer {
+  BvhNode nodes[];
+};
+layout(std430, set = 0, binding = PT_BINDING_TRIANGLES) readonly buffer TriangleBuffer {
+  Triangle triangles[];
+};
+layout(std430, set = 0, binding = PT_BINDING_MATERIALS) readonly buffer MaterialBuffer {
+  Material materials[];
+};
+layout(std430, set = 0, binding = PT_BINDING_EMITTERS) readonly buffer EmitterBuffer {
+  Emitter emitters[];
+};
+layout(std430, set = 0, binding = PT_BINDING_ACCUM) buffer AccumBuffer {
+  AccumPixel accum[];
+};
+layout(std430, set = 0, binding = PT_BINDING_COUNTERS) buffer CounterBuffer {
+  DeviceCounters counters;
+};
 
-layout(push_constant) uniform Pass { PassConstants pass; };
+layout(push_constant) uniform Pass {
+  PassConstants pass;
+};
 
 // Lavapipe (Mesa 22.3) silently ends every loop once an invocation has run 65,535 loop
 // iterations (counted per SIMD group, so a lane's own count can be lower). Each loop here
@@ -41,7 +57,9 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 
 #include "bvh.glsl"
 
-float maxComponent(vec3 v) { return max(v.x, max(v.y, v.z)); }
+float maxComponent(vec3 v) {
+  return max(v.x, max(v.y, v.z));
+}
 
 // Primary ray through film point (x, y), row 0 at the top.
 vec3 cameraDirection(Camera cam, vec2 filmPoint) {
@@ -61,7 +79,8 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
   bool rouletteOn = kRussianRoulette && params.russianRoulette != 0u;
   // Primary ray through a uniformly jittered point of the pixel (box filter of width 1).
   vec3 origin = params.camera.position;
-  vec3 direction = cameraDirection(params.camera, vec2(pixel) + random2(pixel, sampleIndex, kDimPixel, seed));
+  vec3 direction =
+      cameraDirection(params.camera, vec2(pixel) + random2(pixel, sampleIndex, kDimPixel, seed));
   vec3 L = vec3(0.0);     // radiance gathered so far
   vec3 beta = vec3(1.0);  // path throughput
   // The camera ray counts as specular: emission it finds is taken at full weight.
@@ -81,7 +100,8 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
     Triangle tri = triangles[hit.triangle];
     Material material = materials[tri.material];
     // Hit point from barycentrics (more accurate than origin + t * direction).
-    vec3 p = hit.barycentrics.x * tri.v0 + hit.barycentrics.y * tri.v1 + hit.barycentrics.z * tri.v2;
+    vec3 p =
+        hit.barycentrics.x * tri.v0 + hit.barycentrics.y * tri.v1 + hit.barycentrics.z * tri.v2;
     vec3 edgeCross = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
     vec3 ng = normalize(edgeCross);
     vec3 wo = -direction;
@@ -90,8 +110,9 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
     float magnitude = triangleMagnitude(tri.v0, tri.v1, tri.v2);
 #ifdef PT_DEBUG_PRINTF
     if (gDebug) {
-      debugPrintfEXT("gpu depth %u: hit triangle %u (primitive %u) t=%g p=(%g, %g, %g) beta=(%g, %g, %g)", depth,
-                     hit.triangle, tri.primitive, hit.t, p.x, p.y, p.z, beta.x, beta.y, beta.z);
+      debugPrintfEXT(
+          "gpu depth %u: hit triangle %u (primitive %u) t=%g p=(%g, %g, %g) beta=(%g, %g, %g)",
+          depth, hit.triangle, tri.primitive, hit.t, p.x, p.y, p.z, beta.x, beta.y, beta.z);
     }
 #endif
 
@@ -138,7 +159,8 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
         Emitter chosen = emitters[slot];
         Emitter emitter = emitters[uChoose.y < chosen.aliasThreshold ? slot : chosen.alias];
         Triangle light = triangles[emitter.triangle];
-        vec2 b = sampleTriangleBarycentrics(random2(pixel, sampleIndex, dim + kDimLightPoint, seed));
+        vec2 b =
+            sampleTriangleBarycentrics(random2(pixel, sampleIndex, dim + kDimLightPoint, seed));
         vec3 lightPoint = (1.0 - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
         vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
         float lightArea = 0.5 * length(lightCross);
@@ -152,7 +174,8 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
         if (cosLight > 0.0 && cosSurface > 0.0) {
           // Shadow ray between the two offset points; t in [0, 1) spans the segment.
           vec3 from = offsetRayOrigin(p, n, magnitude);
-          vec3 to = offsetRayOrigin(lightPoint, lightNormal, triangleMagnitude(light.v0, light.v1, light.v2));
+          vec3 to = offsetRayOrigin(lightPoint, lightNormal,
+                                    triangleMagnitude(light.v0, light.v1, light.v2));
           gRays++;
           HitData blocker;
           bool occluded = traceRay(from, to - from, 1.0, /*anyHit=*/true, blocker);
@@ -163,15 +186,17 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
             L += beta * f * Le * (cosSurface * weight / lightPdf);
 #ifdef PT_DEBUG_PRINTF
             if (gDebug) {
-              debugPrintfEXT("gpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g", depth,
-                             emitter.triangle, light.primitive, lightPdf, weight);
+              debugPrintfEXT(
+                  "gpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g",
+                  depth, emitter.triangle, light.primitive, lightPdf, weight);
             }
 #endif
           }
         }
       }
       // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
-      wi = localToWorld(sampleCosineHemisphere(random2(pixel, sampleIndex, dim + kDimBsdf, seed)), n);
+      wi = localToWorld(sampleCosineHemisphere(random2(pixel, sampleIndex, dim + kDimBsdf, seed)),
+                        n);
       bsdfPdf = dot(wi, n) * kInvPi;
       if (!(bsdfPdf > 0.0)) {  // direction in the tangent plane: zero contribution
         pathEnded = true;

@@ -67,10 +67,12 @@ PT_INLINE vec2 cosSinTwoPi(float u) {
   float quadrant = floor(4.0f * u + 0.5f);
   float x = (2.0f * kPi) * (u - 0.25f * quadrant);
   float x2 = x * x;
-  float s = x * (1.0f + x2 * (-1.0f / 6.0f + x2 * (1.0f / 120.0f + x2 * (-1.0f / 5040.0f +
-                                                                        x2 * (1.0f / 362880.0f)))));
-  float c = 1.0f + x2 * (-0.5f + x2 * (1.0f / 24.0f + x2 * (-1.0f / 720.0f + x2 * (1.0f / 40320.0f +
-                                                                        x2 * (-1.0f / 3628800.0f)))));
+  float s =
+      x * (1.0f + x2 * (-1.0f / 6.0f +
+                        x2 * (1.0f / 120.0f + x2 * (-1.0f / 5040.0f + x2 * (1.0f / 362880.0f)))));
+  float c = 1.0f + x2 * (-0.5f + x2 * (1.0f / 24.0f +
+                                       x2 * (-1.0f / 720.0f +
+                                             x2 * (1.0f / 40320.0f + x2 * (-1.0f / 3628800.0f)))));
   // Rotate by quadrant * 90 degrees.
   int q = int(quadrant) & 3;
   if (q == 1) return vec2(-s, c);

@@ -55,7 +55,7 @@ struct Material {
   vec3 reflectance;  // 12 bytes: diffuse albedo or mirror reflectance, linear RGB
   uint type;         //  4 bytes: kMaterialDiffuse or kMaterialMirror
   vec3 emission;     // 12 bytes: radiance emitted on the front side (geometric normal side)
-  uint reserved;      //  4 bytes: zero (keeps the 16-byte row)
+  uint reserved;     //  4 bytes: zero (keeps the 16-byte row)
 };                   // 32 bytes
 
 // One entry of the emitter alias table (Walker 1977, Vose 1991): emitter i is picked with
@@ -90,16 +90,16 @@ PT_CONST uint kStrategyNee = 1u;   // light sampling only (emission hit by BSDF 
 PT_CONST uint kStrategyBsdf = 2u;  // BSDF sampling only (no shadow rays)
 
 struct RenderParams {
-  Camera camera;      // 64 bytes
-  uint maxDepth;      //  4 bytes: maximum number of scattering events on a path
-  uint rrStartDepth;  //  4 bytes: Russian roulette from this many scattering events on
-  uint emitterCount;  //  4 bytes
-  uint seed;          //  4 bytes
-  uint strategy;      //  4 bytes: kStrategyMis, kStrategyNee or kStrategyBsdf
+  Camera camera;         // 64 bytes
+  uint maxDepth;         //  4 bytes: maximum number of scattering events on a path
+  uint rrStartDepth;     //  4 bytes: Russian roulette from this many scattering events on
+  uint emitterCount;     //  4 bytes
+  uint seed;             //  4 bytes
+  uint strategy;         //  4 bytes: kStrategyMis, kStrategyNee or kStrategyBsdf
   uint russianRoulette;  // 4 bytes: 0 or 1
-  uint reserved0;     //  4 bytes: zero (std430 rounds the struct to 16 bytes)
-  uint reserved1;     //  4 bytes: zero
-};                    // 96 bytes
+  uint reserved0;        //  4 bytes: zero (std430 rounds the struct to 16 bytes)
+  uint reserved1;        //  4 bytes: zero
+};                       // 96 bytes
 
 // ---- Compute pipeline interface (Vulkan backend) ----------------------------------------
 
@@ -139,11 +139,11 @@ struct AccumPixel {
 };               // 16 bytes
 
 struct DeviceCounters {
-  uint raysLow;    // 4 bytes: rays traced, low 32 bits
-  uint raysHigh;   // 4 bytes: rays traced, high 32 bits (carried by the shader)
-  uint truncated;  // 4 bytes: samples whose loops lavapipe's iteration cap cut short
+  uint raysLow;            // 4 bytes: rays traced, low 32 bits
+  uint raysHigh;           // 4 bytes: rays traced, high 32 bits (carried by the shader)
+  uint truncated;          // 4 bytes: samples whose loops lavapipe's iteration cap cut short
   uint maxLoopIterations;  // 4 bytes: most loop iterations one invocation counted
-};                 // 16 bytes
+};                         // 16 bytes
 
 // ---- Random-number dimensions ----------------------------------------------------------
 // Random numbers are a pure function of (pixel, sample index, dimension, seed); see

@@ -31,7 +31,10 @@ void expectValidBvh(const Bvh& bvh, size_t triangleCount, int maxLeafSize) {
   std::vector<int> seenPrimitive(triangleCount, 0);
   size_t leaves = 0;
   // Walk the tree from the root, checking children against parents.
-  struct Item { uint32_t node; int depth; };
+  struct Item {
+    uint32_t node;
+    int depth;
+  };
   std::vector<Item> todo{{0, 0}};
   std::vector<int> visited(bvh.nodes.size(), 0);
   while (!todo.empty()) {
@@ -49,7 +52,8 @@ void expectValidBvh(const Bvh& bvh, size_t triangleCount, int maxLeafSize) {
         leafOf[i]++;
         const Triangle& t = bvh.triangles[i];
         for (vec3 v : {t.v0, t.v1, t.v2}) {
-          EXPECT_TRUE(all(lessThanEqual(node.boundsMin, v)) && all(lessThanEqual(v, node.boundsMax)));
+          EXPECT_TRUE(all(lessThanEqual(node.boundsMin, v)) &&
+                      all(lessThanEqual(v, node.boundsMax)));
         }
       }
       continue;
@@ -136,7 +140,8 @@ TEST(BvhBuild, SingleTriangleIsOneLeaf) {
 
 TEST(BvhBuild, EqualMortonCodesStillSplit) {
   // 100 copies of one triangle: every code is equal, yet leaves must stay small.
-  std::vector<Triangle> tris(100, Triangle{vec3(0), 0, vec3(1, 0, 0), kNoEmitter, vec3(0, 1, 0), 0});
+  std::vector<Triangle> tris(100,
+                             Triangle{vec3(0), 0, vec3(1, 0, 0), kNoEmitter, vec3(0, 1, 0), 0});
   for (uint i = 0; i < tris.size(); ++i) tris[i].primitive = i;
   const Bvh bvh = buildBvh(tris, BvhBuildOptions{2});
   expectValidBvh(bvh, tris.size(), 2);
@@ -155,8 +160,8 @@ TEST(BvhBuild, DepthStaysWithinTraversalStack) {
     // enough to stay a real triangle in float where the coordinates reach 0.5.
     const float s = 0.5f * kCell;
     for (int i = 0; i < 64; ++i) {
-      tris.push_back(Triangle{c, 0, c + vec3(s, 0, 0), kNoEmitter, c + vec3(0, s, 0),
-                              uint(tris.size())});
+      tris.push_back(
+          Triangle{c, 0, c + vec3(s, 0, 0), kNoEmitter, c + vec3(0, s, 0), uint(tris.size())});
     }
   };
   for (int bit = 0; bit < 63; ++bit) {
@@ -214,8 +219,8 @@ TEST(BvhTraversal, MatchesBruteForceOnBunny) {
   std::vector<vec4> spheres;  // centre, squared radius
   for (const Triangle& t : bunny) {
     const vec3 c = (t.v0 + t.v1 + t.v2) / 3.0f;
-    const float r2 = std::max({dot(t.v0 - c, t.v0 - c), dot(t.v1 - c, t.v1 - c),
-                               dot(t.v2 - c, t.v2 - c)});
+    const float r2 =
+        std::max({dot(t.v0 - c, t.v0 - c), dot(t.v1 - c, t.v1 - c), dot(t.v2 - c, t.v2 - c)});
     spheres.emplace_back(c, r2 * 1.001f + 1e-12f);
   }
   auto bruteForceCulled = [&](const Ray& ray) {
@@ -271,12 +276,14 @@ TEST(BvhTraversal, AxisParallelRaysInFacePlanes) {
   // Origin on the root box's min-x face plane, travelling along +y inside that plane.
   const Ray inPlane{vec3(root.boundsMin.x, root.boundsMin.y - 1.0f, 0.5f), vec3(0, 1, 0)};
   float tNear = 0;
-  EXPECT_TRUE(intersectBox(RayPrecomputed(inPlane), root.boundsMin, root.boundsMax, INFINITY, tNear));
+  EXPECT_TRUE(
+      intersectBox(RayPrecomputed(inPlane), root.boundsMin, root.boundsMax, INFINITY, tNear));
   EXPECT_FLOAT_EQ(tNear, 1.0f);
   // A parallel ray outside the slab misses the box. (Within about 1e-30 of the plane the
   // test may report a hit: box tests may err towards hits, never towards misses.)
   const Ray outside{vec3(root.boundsMin.x - 1e-6f, root.boundsMin.y - 1, 0.5f), vec3(0, 1, 0)};
-  EXPECT_FALSE(intersectBox(RayPrecomputed(outside), root.boundsMin, root.boundsMax, INFINITY, tNear));
+  EXPECT_FALSE(
+      intersectBox(RayPrecomputed(outside), root.boundsMin, root.boundsMax, INFINITY, tNear));
   // Axis-parallel rays through the centre hit the closed mesh, and agree with brute force.
   for (vec3 d : {vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1),
                  vec3(0, 0, -1)}) {

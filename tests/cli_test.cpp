@@ -35,24 +35,30 @@ Result runPt(const std::string& args, const test::TempDir& dir) {
   return r;
 }
 
-int lineCount(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+int lineCount(const std::string& s) {
+  return int(std::count(s.begin(), s.end(), '\n'));
+}
 
 TEST(Cli, RenderWritesEveryOutputAndOneStatsLine) {
   test::TempDir dir;
-  const Result r = runPt("render " + kConfigs + "/cornell-box.json --backend cpu --spp 2 --width 32 --height 32 " +
+  const Result r = runPt("render " + kConfigs +
+                             "/cornell-box.json --backend cpu --spp 2 --width 32 --height 32 " +
                              "--threads 2 --out " + (dir / "a.png").string() + " --out " +
                              (dir / "a.exr").string() + " --out " + (dir / "a.pfm").string(),
                          dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* f : {"a.png", "a.exr", "a.pfm"}) EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  for (const char* f : {"a.png", "a.exr", "a.pfm"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
   EXPECT_EQ(lineCount(r.out), 1) << r.out;
   for (const char* key : {"backend=cpu", "threads=2", "resolution=32x32", "spp=2", "seconds=",
                           "Mrays/s=", "invalid_samples=0", "effects=diffuse+nee+mis+rr"}) {
     EXPECT_NE(r.out.find(key), std::string::npos) << key << " in " << r.out;
   }
   // The same render compared with itself agrees; against a different seed it does not.
-  EXPECT_EQ(runPt("diff " + (dir / "a.exr").string() + " " + (dir / "a.pfm").string(), dir).status, 0);
-  ASSERT_EQ(runPt("render " + kConfigs + "/cornell-box.json --backend cpu --spp 2 --width 32 --height 32 " +
+  EXPECT_EQ(runPt("diff " + (dir / "a.exr").string() + " " + (dir / "a.pfm").string(), dir).status,
+            0);
+  ASSERT_EQ(runPt("render " + kConfigs +
+                      "/cornell-box.json --backend cpu --spp 2 --width 32 --height 32 " +
                       "--seed 9 --out " + (dir / "b.exr").string(),
                   dir)
                 .status,
@@ -86,9 +92,11 @@ TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
       {"zero spp", "render " + box + " --spp 0" + out, "--spp"},
       {"negative width", "render " + box + " --width -4" + out, "--width"},
       {"unknown backend", "render " + box + " --backend nope" + out, "--backend"},
-      {"unknown extension", "render " + box + " --spp 1 --width 8 --height 8 --out " +
-                                (dir / "out.bmp").string(), "out.bmp"},
-      {"missing image", "diff " + (dir / "x.exr").string() + " " + (dir / "y.exr").string(), "x.exr"},
+      {"unknown extension",
+       "render " + box + " --spp 1 --width 8 --height 8 --out " + (dir / "out.bmp").string(),
+       "out.bmp"},
+      {"missing image", "diff " + (dir / "x.exr").string() + " " + (dir / "y.exr").string(),
+       "x.exr"},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.name);
@@ -116,9 +124,10 @@ namespace {
 
 TEST(CliVulkan, RendersOnTheDefaultBackendWithValidation) {
   test::TempDir dir;
-  const Result r = runPt("render " + kConfigs + "/cornell-mirror.json --spp 2 --width 16 --height 16 " +
-                             "--validation --out " + (dir / "v.exr").string(),
-                         dir);
+  const Result r =
+      runPt("render " + kConfigs + "/cornell-mirror.json --spp 2 --width 16 --height 16 " +
+                "--validation --out " + (dir / "v.exr").string(),
+            dir);
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* key : {"backend=vulkan", "device=", "effects=diffuse+mirror+nee+mis+rr",
                           "invalid_samples=0", "Mrays/s="}) {

@@ -33,14 +33,15 @@ Scene makeFurnace(float s, std::vector<Material> materials, uint faceMaterial = 
       const vec3 inward = -side * axes[a];
       const vec3 u = s * axes[(a + 1) % 3];
       const vec3 v = s * cross(inward, axes[(a + 1) % 3]);  // cross(u, v) = s^2 inward
-      const bool isOther = std::find(otherFaces.begin(), otherFaces.end(), face) != otherFaces.end();
+      const bool isOther =
+          std::find(otherFaces.begin(), otherFaces.end(), face) != otherFaces.end();
       addQuad(scene, side * s * axes[a], u, v, isOther ? other : faceMaterial);
       ++face;
     }
   }
   for (uint i = 0; i < scene.triangles.size(); ++i) scene.triangles[i].primitive = i;
-  scene.camera = CameraDesc{vec3(0.1f * s, -0.2f * s, 0.05f * s), vec3(1, 0.3f, 0.7f), vec3(0, 1, 0),
-                            90.0f, 16, 16};
+  scene.camera = CameraDesc{
+      vec3(0.1f * s, -0.2f * s, 0.05f * s), vec3(1, 0.3f, 0.7f), vec3(0, 1, 0), 90.0f, 16, 16};
   scene.integrator.maxDepth = 100000;  // the closed form sums every bounce
   return scene;
 }
@@ -59,7 +60,8 @@ Estimate estimateImageMean(const SceneData& data, int spp) {
   for (uint y = 0; y < cam.height; ++y) {
     for (uint x = 0; x < cam.width; ++x) {
       glm::dvec3 sum(0.0);
-      for (int s = 0; s < spp; ++s) sum += glm::dvec3(sampleRadiance(data, uvec2(x, y), uint(s), rays));
+      for (int s = 0; s < spp; ++s)
+        sum += glm::dvec3(sampleRadiance(data, uvec2(x, y), uint(s), rays));
       pixelMeans.push_back(sum / double(spp));
     }
   }
@@ -97,10 +99,9 @@ TEST(CpuFurnace, MirrorsAndDiffuseMatchClosedForm) {
   // Two faces are mirrors of the same reflectance and emission: L = Le / (1 - a) still.
   const float a = 0.6f;
   const vec3 Le(1.0f);
-  Scene scene = makeFurnace(1.0f,
-                            {Material{vec3(a), kMaterialDiffuse, Le, 0},
-                             Material{vec3(a), kMaterialMirror, Le, 0}},
-                            0, {0, 3}, 1);
+  Scene scene = makeFurnace(
+      1.0f, {Material{vec3(a), kMaterialDiffuse, Le, 0}, Material{vec3(a), kMaterialMirror, Le, 0}},
+      0, {0, 3}, 1);
   const SceneData data = prepareScene(scene, RenderSettings{});
   EXPECT_TRUE(data.effects.mirror && data.effects.diffuse);
   expectWithin3Sigma(estimateImageMean(data, 64), Le / (1.0f - a));

@@ -94,8 +94,8 @@ TEST(Vulkan, UnspecializedShaderGivesTheSameImage) {
 }
 
 // A closed cube of perfect mirrors (reflectance 1, so Russian roulette never ends a path)
-// with a small emitter inside, itself a mirror: nothing absorbs, every path bounces until the depth limit, so the shader's
-// loop count grows with maxDepth.
+// with a small emitter inside, itself a mirror: nothing absorbs, every path bounces until the depth
+// limit, so the shader's loop count grows with maxDepth.
 SceneData mirrorBox(int maxDepth) {
   Scene scene;
   scene.materials = {Material{vec3(1.0f), kMaterialMirror, vec3(0.0f), 0},

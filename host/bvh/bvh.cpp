@@ -124,8 +124,9 @@ class Builder {
     // highest bit any pair in the range differs in; split where that bit turns from 0 to 1.
     const int bit = 63 - std::countl_zero(a ^ b);
     const uint64_t mask = uint64_t(1) << bit;
-    auto it = std::partition_point(codes_.begin() + ptrdiff_t(first), codes_.begin() + ptrdiff_t(last),
-                                   [mask](uint64_t c) { return (c & mask) == 0; });
+    auto it =
+        std::partition_point(codes_.begin() + ptrdiff_t(first), codes_.begin() + ptrdiff_t(last),
+                             [mask](uint64_t c) { return (c & mask) == 0; });
     return size_t(it - codes_.begin());
   }
 

@@ -124,10 +124,10 @@ bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best, TraversalSt
       const uint32_t left = nodeIndex + 1;
       const uint32_t right = node.offset;
       float tLeft = 0.0f, tRight = 0.0f;
-      const bool hitLeft = intersectBox(r, bvh.nodes[left].boundsMin, bvh.nodes[left].boundsMax,
-                                        closest, tLeft);
-      const bool hitRight = intersectBox(r, bvh.nodes[right].boundsMin,
-                                         bvh.nodes[right].boundsMax, closest, tRight);
+      const bool hitLeft =
+          intersectBox(r, bvh.nodes[left].boundsMin, bvh.nodes[left].boundsMax, closest, tLeft);
+      const bool hitRight =
+          intersectBox(r, bvh.nodes[right].boundsMin, bvh.nodes[right].boundsMax, closest, tRight);
       if (hitLeft && hitRight) {
         const bool leftFirst = tLeft <= tRight;
         stack[stackSize++] = leftFirst ? right : left;

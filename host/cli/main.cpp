@@ -28,6 +28,8 @@ struct RenderArgs {
   bool validation = false;
   bool noSpecialize = false;
   std::string debugPixel;  // "X,Y"
+  std::string strategy;    // mis, nee, bsdf; empty: the scene's
+  std::string roulette;    // on, off; empty: the scene's
   int spp = 0, width = 0, height = 0, maxDepth = -1, threads = 0, leafSize = 4;
   long long seed = -1;
   std::vector<std::string> outputs;
@@ -51,6 +53,12 @@ int runRender(const RenderArgs& args) {
   settings.seed = args.seed;
   settings.maxDepth = args.maxDepth;
   settings.maxLeafSize = args.leafSize;
+  if (!args.strategy.empty()) {
+    settings.strategy = args.strategy == "mis" ? int(kStrategyMis)
+                        : args.strategy == "nee" ? int(kStrategyNee)
+                                                 : int(kStrategyBsdf);
+  }
+  if (!args.roulette.empty()) settings.russianRoulette = args.roulette == "on" ? 1 : 0;
   const SceneData data = prepareScene(scene, settings);
 
   std::vector<std::filesystem::path> outputs(args.outputs.begin(), args.outputs.end());
@@ -75,8 +83,8 @@ int runRender(const RenderArgs& args) {
     char extra = 0;
     if (std::sscanf(args.debugPixel.c_str(), "%d,%d%c", &debugX, &debugY, &extra) != 2 ||
         debugX < 0 || debugY < 0 || debugX >= int(cam.width) || debugY >= int(cam.height)) {
-      throw InputError("--debug-pixel: expected X,Y inside the " + std::to_string(cam.width) +
-                       "x" + std::to_string(cam.height) + " image, got '" + args.debugPixel + "'");
+      throw InputError("--debug-pixel: expected X,Y inside the " + std::to_string(cam.width) + "x" +
+                       std::to_string(cam.height) + " image, got '" + args.debugPixel + "'");
     }
     // The CPU reference's paths first; the shader's follow from the validation layer.
     uint64_t rays = 0;
@@ -116,9 +124,9 @@ int runRender(const RenderArgs& args) {
     stats.seconds = v.deviceSeconds;
     truncated = v.truncatedSamples;
     validationErrors = v.validationErrors;
-    backendInfo = "backend=vulkan device=\"" + v.device + "\" wall_seconds=" +
-                  std::to_string(v.seconds) + " max_loop_iterations=" +
-                  std::to_string(v.maxLoopIterations);
+    backendInfo = "backend=vulkan device=\"" + v.device +
+                  "\" wall_seconds=" + std::to_string(v.seconds) +
+                  " max_loop_iterations=" + std::to_string(v.maxLoopIterations);
     if (args.noSpecialize) effects = "all(unspecialized)";
   }
   progress.finish();
@@ -150,8 +158,8 @@ int runDevices() {
   const std::vector<DeviceInfo> devices = VulkanContext::listDevices();
   if (devices.empty()) throw NoDeviceError("no Vulkan device found");
   for (const DeviceInfo& d : devices) {
-    std::printf("%u: %s (%s; %s)%s%s\n", d.index, d.name.c_str(), d.type.c_str(),
-                d.driver.c_str(), d.suitable ? "" : " unsuitable: ", d.whyNot.c_str());
+    std::printf("%u: %s (%s; %s)%s%s\n", d.index, d.name.c_str(), d.type.c_str(), d.driver.c_str(),
+                d.suitable ? "" : " unsuitable: ", d.whyNot.c_str());
   }
   return kExitOk;
 }
@@ -161,13 +169,12 @@ int runDiff(const DiffArgs& args) {
   const Image b = readImage(args.b);
   const DiffStats d = diffImages(a, b, args.threshold);
   const double fraction = d.pixelCount ? double(d.pixelsOverThreshold) / double(d.pixelCount) : 0;
-  std::printf(
-      "rmse=%.6g relmse=%.6g max_abs=%.6g over_threshold=%zu/%zu (%.4f%%) non_finite=%zu\n",
-      d.rmse, d.relMse, d.maxAbsError, d.pixelsOverThreshold, d.pixelCount, 100.0 * fraction,
-      d.nonFinitePixels);
+  std::printf("rmse=%.6g relmse=%.6g max_abs=%.6g over_threshold=%zu/%zu (%.4f%%) non_finite=%zu\n",
+              d.rmse, d.relMse, d.maxAbsError, d.pixelsOverThreshold, d.pixelCount,
+              100.0 * fraction, d.nonFinitePixels);
   if (!args.heatmap.empty()) {
-    const double scale = args.heatmapScale > 0 ? args.heatmapScale
-                                               : (d.maxAbsError > 0 ? d.maxAbsError : 1.0);
+    const double scale =
+        args.heatmapScale > 0 ? args.heatmapScale : (d.maxAbsError > 0 ? d.maxAbsError : 1.0);
     writeImage(diffHeatmap(a, b, scale), args.heatmap);
   }
   const bool agree = d.nonFinitePixels == 0 && fraction <= args.maxFraction;
@@ -189,7 +196,8 @@ int main(int argc, char** argv) {
   render->add_option("--backend", r.backend, "vulkan (GPU, or lavapipe without one) or cpu")
       ->check(CLI::IsMember({"vulkan", "cpu"}))
       ->capture_default_str();
-  render->add_option("--device", r.device, "Vulkan device: index or part of the name (see `devices`)");
+  render->add_option("--device", r.device,
+                     "Vulkan device: index or part of the name (see `devices`)");
   render->add_flag("--validation", r.validation, "Enable the Vulkan validation layers");
   render->add_flag("--no-specialize", r.noSpecialize,
                    "Compile every effect into the shader (to measure what specialization saves)");
@@ -208,6 +216,11 @@ int main(int argc, char** argv) {
   render->add_option("--leaf-size", r.leafSize, "Maximum triangles per BVH leaf")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
+  render->add_option("--strategy", r.strategy,
+                     "Direct light: mis (default), nee (light sampling only), bsdf (no light sampling)")
+      ->check(CLI::IsMember({"mis", "nee", "bsdf"}));
+  render->add_option("--rr", r.roulette, "Russian roulette on or off (default: the scene's)")
+      ->check(CLI::IsMember({"on", "off"}));
   render->add_option("--debug-pixel", r.debugPixel,
                      "Print pixel X,Y's paths from the CPU reference and from the shader");
   render->add_option("--out", r.outputs, "Output image (.png, .exr, .pfm); repeatable");

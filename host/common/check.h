@@ -27,7 +27,7 @@ inline constexpr int kExitInternal = 4;    // an invariant failed: a bug
 }  // namespace pt
 
 // Invariant check that stays on in release builds; fails loudly with the expression.
-#define PT_CHECK(cond, ...)                                                         \
-  do {                                                                              \
+#define PT_CHECK(cond, ...)                                                              \
+  do {                                                                                   \
     if (!(cond)) ::pt::checkFailed(#cond, __FILE__, __LINE__, std::string{__VA_ARGS__}); \
   } while (0)

@@ -18,15 +18,17 @@
 namespace pt {
 namespace {
 
-float maxComponent(vec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
+float maxComponent(vec3 v) {
+  return std::max(v.x, std::max(v.y, v.z));
+}
 
 }  // namespace
 
 Ray cameraRay(const Camera& cam, vec2 filmPoint) {
   const float u = 2.0f * filmPoint.x / float(cam.width) - 1.0f;
   const float v = 1.0f - 2.0f * filmPoint.y / float(cam.height);
-  const vec3 d = cam.forward + (u * cam.tanHalfFovY * cam.aspect) * cam.right +
-                 (v * cam.tanHalfFovY) * cam.up;
+  const vec3 d =
+      cam.forward + (u * cam.tanHalfFovY * cam.aspect) * cam.right + (v * cam.tanHalfFovY) * cam.up;
   return Ray{cam.position, normalize(d)};
 }
 
@@ -40,8 +42,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
   const bool bsdfEmissionOn = params.strategy != kStrategyNee;
 
   // Primary ray through a uniformly jittered point of the pixel (box filter of width 1).
-  Ray ray = cameraRay(params.camera,
-                      vec2(pixel) + random2(pixel, sampleIndex, kDimPixel, seed));
+  Ray ray = cameraRay(params.camera, vec2(pixel) + random2(pixel, sampleIndex, kDimPixel, seed));
   vec3 L(0.0f);     // radiance gathered so far
   vec3 beta(1.0f);  // path throughput
   // The camera ray counts as specular: emission it finds is taken at full weight.
@@ -56,8 +57,8 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     const Triangle& tri = bvh.triangles[hit->triangle];
     const Material& material = scene.materials[tri.material];
     // Hit point from barycentrics (more accurate than origin + t * direction).
-    const vec3 p = hit->barycentrics.x * tri.v0 + hit->barycentrics.y * tri.v1 +
-                   hit->barycentrics.z * tri.v2;
+    const vec3 p =
+        hit->barycentrics.x * tri.v0 + hit->barycentrics.y * tri.v1 + hit->barycentrics.z * tri.v2;
     const vec3 edgeCross = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
     const vec3 ng = normalize(edgeCross);
     const vec3 wo = -ray.direction;
@@ -109,14 +110,14 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
       if (neeOn && material.reflectance != vec3(0.0f)) {
         // Pick an emitter from the alias table, then a uniform point on its triangle.
         const vec2 uChoose = random2(pixel, sampleIndex, dim + kDimLightChoose, seed);
-        const uint slot = std::min(uint(uChoose.x * float(params.emitterCount)),
-                                   params.emitterCount - 1u);
+        const uint slot =
+            std::min(uint(uChoose.x * float(params.emitterCount)), params.emitterCount - 1u);
         const Emitter& chosen = scene.emitters[slot];
         const Emitter& emitter =
             uChoose.y < chosen.aliasThreshold ? chosen : scene.emitters[chosen.alias];
         const Triangle& light = bvh.triangles[emitter.triangle];
-        const vec2 b = sampleTriangleBarycentrics(
-            random2(pixel, sampleIndex, dim + kDimLightPoint, seed));
+        const vec2 b =
+            sampleTriangleBarycentrics(random2(pixel, sampleIndex, dim + kDimLightPoint, seed));
         const vec3 lightPoint = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
         const vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
         const float lightArea = 0.5f * length(lightCross);

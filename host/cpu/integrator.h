@@ -13,8 +13,8 @@
 namespace pt {
 
 struct CpuRenderOptions {
-  int threads = 0;             // 0: all hardware threads
-  uint32_t firstSample = 0;    // sample indices [firstSample, firstSample + spp) are taken
+  int threads = 0;           // 0: all hardware threads
+  uint32_t firstSample = 0;  // sample indices [firstSample, firstSample + spp) are taken
   int spp = 1;
   // Called now and then from one thread with the fraction of work done, in [0, 1].
   std::function<void(double)> progress;

@@ -88,8 +88,9 @@ SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
   p.rrStartDepth = uint32_t(integ.rrStartDepth);
   p.emitterCount = uint32_t(data.emitters.size());
   p.seed = settings.seed >= 0 ? uint32_t(settings.seed) : integ.seed;
-  p.strategy = integ.strategy;
-  p.russianRoulette = integ.russianRoulette ? 1u : 0u;
+  p.strategy = settings.strategy >= 0 ? uint32_t(settings.strategy) : integ.strategy;
+  p.russianRoulette = settings.russianRoulette >= 0 ? uint32_t(settings.russianRoulette)
+                                                    : (integ.russianRoulette ? 1u : 0u);
 
   // Effects: which material kinds occur on triangles, and whether light sampling can matter.
   EffectSet& fx = data.effects;
@@ -100,7 +101,8 @@ SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
     if (m.type == kMaterialDiffuse && reflects) fx.diffuse = true;
   }
   const bool scatters = p.maxDepth > 0;
-  fx.lightSampling = fx.diffuse && scatters && !data.emitters.empty() && p.strategy != kStrategyBsdf;
+  fx.lightSampling =
+      fx.diffuse && scatters && !data.emitters.empty() && p.strategy != kStrategyBsdf;
   fx.bsdfEmission = !data.emitters.empty() && p.strategy != kStrategyNee;
   fx.mis = fx.lightSampling && fx.bsdfEmission && p.strategy == kStrategyMis;
   fx.russianRoulette = p.russianRoulette != 0 && scatters && (fx.diffuse || fx.mirror);

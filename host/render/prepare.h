@@ -19,15 +19,17 @@ struct RenderSettings {
   long long seed = -1;        // -1: from the scene
   int maxDepth = -1;          // -1: from the scene
   int maxLeafSize = 4;
+  int strategy = -1;          // kStrategy*, -1: from the scene
+  int russianRoulette = -1;   // 0 off, 1 on, -1: from the scene
 };
 
 // Which effects the scene calls for; the rest are compiled or switched out.
 struct EffectSet {
-  bool diffuse = false;          // some surface is Lambertian with non-zero reflectance
-  bool mirror = false;           // some surface is an ideal mirror
-  bool lightSampling = false;    // next-event estimation (needs emitters, a diffuse surface)
-  bool bsdfEmission = false;     // emission found by BSDF-sampled rays is counted (MIS/BSDF)
-  bool mis = false;              // both of the above, weighed by the power heuristic
+  bool diffuse = false;        // some surface is Lambertian with non-zero reflectance
+  bool mirror = false;         // some surface is an ideal mirror
+  bool lightSampling = false;  // next-event estimation (needs emitters, a diffuse surface)
+  bool bsdfEmission = false;   // emission found by BSDF-sampled rays is counted (MIS/BSDF)
+  bool mis = false;            // both of the above, weighed by the power heuristic
   bool russianRoulette = false;
   std::string toString() const;  // e.g. "diffuse+mirror+nee+mis+rr"
 };

@@ -23,10 +23,10 @@ struct CameraDesc {
 // Integrator settings from the scene's "integrator" object (command-line flags override).
 struct IntegratorSettings {
   int spp = 16;
-  int maxDepth = 64;        // maximum number of scattering events on a path
+  int maxDepth = 64;  // maximum number of scattering events on a path
   uint seed = 0;
   bool russianRoulette = true;
-  int rrStartDepth = 3;     // Russian roulette from this many scattering events on
+  int rrStartDepth = 3;  // Russian roulette from this many scattering events on
   uint strategy = kStrategyMis;
 };
 

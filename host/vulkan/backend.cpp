@@ -81,8 +81,8 @@ vk::raii::Pipeline makePipeline(const VulkanContext& ctx, const vk::raii::Pipeli
 }
 
 // Makes writes of one stage visible to the reads/writes of the next.
-void barrier(const vk::raii::CommandBuffer& cmd, vk::PipelineStageFlags src, vk::AccessFlags srcAccess,
-             vk::PipelineStageFlags dst, vk::AccessFlags dstAccess) {
+void barrier(const vk::raii::CommandBuffer& cmd, vk::PipelineStageFlags src,
+             vk::AccessFlags srcAccess, vk::PipelineStageFlags dst, vk::AccessFlags dstAccess) {
   const vk::MemoryBarrier mb(srcAccess, dstAccess);
   cmd.pipelineBarrier(src, dst, {}, mb, {}, {});
 }
@@ -124,8 +124,8 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
     buffers.push_back(makeBuffer(ctx, u.size, U::eStorageBuffer | U::eTransferDst, false));
     stagingSize += u.size;
   }
-  buffers.push_back(makeBuffer(ctx, accumSize,
-                               U::eStorageBuffer | U::eTransferSrc | U::eTransferDst, false));
+  buffers.push_back(
+      makeBuffer(ctx, accumSize, U::eStorageBuffer | U::eTransferSrc | U::eTransferDst, false));
   buffers.push_back(makeBuffer(ctx, sizeof(DeviceCounters),
                                U::eStorageBuffer | U::eTransferSrc | U::eTransferDst, false));
   Buffer& accum = buffers[PT_BINDING_ACCUM];
@@ -136,19 +136,28 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   // ---- Pipeline ---------------------------------------------------------------------------
   std::vector<vk::DescriptorSetLayoutBinding> bindings;
   for (uint32_t b = 0; b < PT_BINDING_COUNT; ++b)
-    bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1, vk::ShaderStageFlagBits::eCompute);
-  const vk::raii::DescriptorSetLayout setLayout(ctx.device, vk::DescriptorSetLayoutCreateInfo({}, bindings));
-  const vk::PushConstantRange pushRange(vk::ShaderStageFlagBits::eCompute, 0, sizeof(PassConstants));
-  const vk::raii::PipelineLayout pipelineLayout(ctx.device,
-                                                vk::PipelineLayoutCreateInfo({}, *setLayout, pushRange));
+    bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1,
+                          vk::ShaderStageFlagBits::eCompute);
+  const vk::raii::DescriptorSetLayout setLayout(ctx.device,
+                                                vk::DescriptorSetLayoutCreateInfo({}, bindings));
+  const vk::PushConstantRange pushRange(vk::ShaderStageFlagBits::eCompute, 0,
+                                        sizeof(PassConstants));
+  const vk::raii::PipelineLayout pipelineLayout(
+      ctx.device, vk::PipelineLayoutCreateInfo({}, *setLayout, pushRange));
   const vk::raii::ShaderModule module =
-      debugPrintf ? vk::raii::ShaderModule(ctx.device, vk::ShaderModuleCreateInfo({}, sizeof(kPathtraceDebugSpv), kPathtraceDebugSpv))
-                  : vk::raii::ShaderModule(ctx.device, vk::ShaderModuleCreateInfo({}, sizeof(kPathtraceSpv), kPathtraceSpv));
-  const vk::raii::Pipeline pipeline = makePipeline(ctx, pipelineLayout, module, scene.effects, options.specialize);
+      debugPrintf
+          ? vk::raii::ShaderModule(
+                ctx.device,
+                vk::ShaderModuleCreateInfo({}, sizeof(kPathtraceDebugSpv), kPathtraceDebugSpv))
+          : vk::raii::ShaderModule(
+                ctx.device, vk::ShaderModuleCreateInfo({}, sizeof(kPathtraceSpv), kPathtraceSpv));
+  const vk::raii::Pipeline pipeline =
+      makePipeline(ctx, pipelineLayout, module, scene.effects, options.specialize);
 
   const vk::DescriptorPoolSize poolSize(vk::DescriptorType::eStorageBuffer, PT_BINDING_COUNT);
   const vk::raii::DescriptorPool pool(
-      ctx.device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSize));
+      ctx.device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
+                                               1, poolSize));
   vk::raii::DescriptorSets sets(ctx.device, vk::DescriptorSetAllocateInfo(*pool, *setLayout));
   const vk::raii::DescriptorSet& set = sets[0];
   std::vector<vk::DescriptorBufferInfo> infos;
@@ -160,12 +169,14 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
 
   // ---- Commands ---------------------------------------------------------------------------
   const vk::raii::CommandPool commandPool(
-      ctx.device, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eResetCommandBuffer, ctx.queueFamily));
+      ctx.device, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eResetCommandBuffer,
+                                            ctx.queueFamily));
   vk::raii::CommandBuffers commandBuffers(
       ctx.device, vk::CommandBufferAllocateInfo(*commandPool, vk::CommandBufferLevel::ePrimary, 1));
   const vk::raii::CommandBuffer& cmd = commandBuffers[0];
   const vk::raii::Fence fence(ctx.device, vk::FenceCreateInfo());
-  const vk::raii::QueryPool queries(ctx.device, vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, 2));
+  const vk::raii::QueryPool queries(ctx.device,
+                                    vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, 2));
   auto submitAndWait = [&]() {
     cmd.end();
     ctx.queue.submit(vk::SubmitInfo({}, {}, *cmd), *fence);
@@ -178,13 +189,14 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   auto clearAccumulators = [&]() {
     cmd.fillBuffer(*accum.buffer, 0, VK_WHOLE_SIZE, 0);
     cmd.fillBuffer(*counters.buffer, 0, VK_WHOLE_SIZE, 0);
-    barrier(cmd, S::eTransfer, A::eTransferWrite, S::eComputeShader, A::eShaderRead | A::eShaderWrite);
+    barrier(cmd, S::eTransfer, A::eTransferWrite, S::eComputeShader,
+            A::eShaderRead | A::eShaderWrite);
   };
   const uint32_t groupsX = (cam.width + kWorkgroupSize - 1) / kWorkgroupSize;
   const uint32_t groupsY = (cam.height + kWorkgroupSize - 1) / kWorkgroupSize;
-  const uint32_t debugPixel = options.debugPixelX >= 0
-                                  ? uint32_t(options.debugPixelY) * cam.width + uint32_t(options.debugPixelX)
-                                  : ~0u;
+  const uint32_t debugPixel = options.debugPixelX >= 0 ? uint32_t(options.debugPixelY) * cam.width +
+                                                             uint32_t(options.debugPixelX)
+                                                       : ~0u;
   auto dispatch = [&](uint32_t sampleIndex, uint32_t gx, uint32_t gy) {
     const PassConstants pc{sampleIndex, debugPixel, 0u, 0u};
     cmd.pushConstants<PassConstants>(*pipelineLayout, vk::ShaderStageFlagBits::eCompute, 0, pc);
@@ -227,16 +239,19 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
     cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline);
     cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipelineLayout, 0, *set, {});
     cmd.writeTimestamp(S::eTopOfPipe, *queries, 0);
-    for (int p = 0; p < passes; ++p) dispatch(options.firstSample + uint32_t(done + p), groupsX, groupsY);
+    for (int p = 0; p < passes; ++p)
+      dispatch(options.firstSample + uint32_t(done + p), groupsX, groupsY);
     cmd.writeTimestamp(S::eBottomOfPipe, *queries, 1);
     cmd.copyBuffer(*accum.buffer, *readback.buffer, vk::BufferCopy(0, 0, accumSize));
-    cmd.copyBuffer(*counters.buffer, *readback.buffer, vk::BufferCopy(0, accumSize, sizeof(DeviceCounters)));
+    cmd.copyBuffer(*counters.buffer, *readback.buffer,
+                   vk::BufferCopy(0, accumSize, sizeof(DeviceCounters)));
     barrier(cmd, S::eTransfer, A::eTransferRead, S::eTransfer, A::eTransferWrite);
     clearAccumulators();
     submitAndWait();
 
-    const auto [result, ticks] = queries.getResults<uint64_t>(0, 2, 2 * sizeof(uint64_t), sizeof(uint64_t),
-                                                              vk::QueryResultFlagBits::e64 | vk::QueryResultFlagBits::eWait);
+    const auto [result, ticks] =
+        queries.getResults<uint64_t>(0, 2, 2 * sizeof(uint64_t), sizeof(uint64_t),
+                                     vk::QueryResultFlagBits::e64 | vk::QueryResultFlagBits::eWait);
     PT_CHECK(result == vk::Result::eSuccess);
     stats.deviceSeconds += double(ticks[1] - ticks[0]) * tickSeconds;
 

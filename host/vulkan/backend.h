@@ -21,7 +21,7 @@ struct VulkanRenderOptions {
 };
 
 struct VulkanRenderStats : RenderStats {
-  double deviceSeconds = 0.0;  // timestamp queries around the dispatches, after a warm-up
+  double deviceSeconds = 0.0;     // timestamp queries around the dispatches, after a warm-up
   uint64_t truncatedSamples = 0;  // paths given up at the shader's loop budget
   uint32_t maxLoopIterations = 0;
   uint32_t validationErrors = 0;

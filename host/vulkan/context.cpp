@@ -21,22 +21,32 @@ std::string lower(std::string s) {
 
 std::string typeName(vk::PhysicalDeviceType t) {
   switch (t) {
-    case vk::PhysicalDeviceType::eDiscreteGpu: return "discrete";
-    case vk::PhysicalDeviceType::eIntegratedGpu: return "integrated";
-    case vk::PhysicalDeviceType::eVirtualGpu: return "virtual";
-    case vk::PhysicalDeviceType::eCpu: return "cpu";
-    default: return "other";
+    case vk::PhysicalDeviceType::eDiscreteGpu:
+      return "discrete";
+    case vk::PhysicalDeviceType::eIntegratedGpu:
+      return "integrated";
+    case vk::PhysicalDeviceType::eVirtualGpu:
+      return "virtual";
+    case vk::PhysicalDeviceType::eCpu:
+      return "cpu";
+    default:
+      return "other";
   }
 }
 
 // Preference when no device is named: discrete GPU, integrated, virtual, then CPU (lavapipe).
 int typeRank(vk::PhysicalDeviceType t) {
   switch (t) {
-    case vk::PhysicalDeviceType::eDiscreteGpu: return 4;
-    case vk::PhysicalDeviceType::eIntegratedGpu: return 3;
-    case vk::PhysicalDeviceType::eVirtualGpu: return 2;
-    case vk::PhysicalDeviceType::eCpu: return 1;
-    default: return 0;
+    case vk::PhysicalDeviceType::eDiscreteGpu:
+      return 4;
+    case vk::PhysicalDeviceType::eIntegratedGpu:
+      return 3;
+    case vk::PhysicalDeviceType::eVirtualGpu:
+      return 2;
+    case vk::PhysicalDeviceType::eCpu:
+      return 1;
+    default:
+      return 0;
   }
 }
 
@@ -51,8 +61,8 @@ int computeQueueFamily(const vk::raii::PhysicalDevice& pd) {
 DeviceInfo describe(const vk::raii::PhysicalDevice& pd, uint32_t index) {
   DeviceInfo info;
   info.index = index;
-  const auto props = pd.getProperties2<vk::PhysicalDeviceProperties2,
-                                       vk::PhysicalDeviceDriverProperties>();
+  const auto props =
+      pd.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
   const auto& p = props.get<vk::PhysicalDeviceProperties2>().properties;
   const auto& d = props.get<vk::PhysicalDeviceDriverProperties>();
   info.name = p.deviceName.data();
@@ -72,13 +82,14 @@ DeviceInfo describe(const vk::raii::PhysicalDevice& pd, uint32_t index) {
   return info;
 }
 
-VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(
-    VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
-    const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                   VkDebugUtilsMessageTypeFlagsEXT,
+                                                   const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                   void* user) {
   const char* message = data->pMessage ? data->pMessage : "";
   // debugPrintfEXT output arrives as an info message; print it as is.
-  if (data->pMessageIdName && std::string(data->pMessageIdName).find("DEBUG-PRINTF") !=
-                                  std::string::npos) {
+  if (data->pMessageIdName &&
+      std::string(data->pMessageIdName).find("DEBUG-PRINTF") != std::string::npos) {
     const char* text = std::strrchr(message, '|');
     std::fprintf(stderr, "%s\n", text ? text + 2 : message);
     return VK_FALSE;
@@ -136,8 +147,9 @@ VulkanContext::VulkanContext(const ContextOptions& options) try {
   int chosen = -1;
   if (!options.device.empty()) {
     // By index, or by a case-insensitive part of the name.
-    const bool isIndex = std::all_of(options.device.begin(), options.device.end(),
-                                     [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+    const bool isIndex = std::all_of(options.device.begin(), options.device.end(), [](char c) {
+      return std::isdigit(static_cast<unsigned char>(c));
+    });
     for (uint32_t i = 0; i < devices.size() && chosen < 0; ++i) {
       const std::string name = devices[i].getProperties().deviceName.data();
       if (isIndex ? std::stoul(options.device) == i
@@ -188,7 +200,8 @@ VulkanContext::VulkanContext(const ContextOptions& options) try {
   throw;
 } catch (const std::runtime_error& e) {
   // vk::raii::Context throws this when libvulkan.so.1 cannot be loaded.
-  throw NoDeviceError(std::string("cannot load the Vulkan loader (Debian: libvulkan1): ") + e.what());
+  throw NoDeviceError(std::string("cannot load the Vulkan loader (Debian: libvulkan1): ") +
+                      e.what());
 }
 
 std::vector<DeviceInfo> VulkanContext::listDevices() {
