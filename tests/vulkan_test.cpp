@@ -6,60 +6,12 @@
 #include "render/prepare.h"
 #include "scene/scene.h"
 #include "vulkan/backend.h"
+#include "render_compare.h"
 
 namespace pt {
 namespace {
 
 const std::filesystem::path kConfigs = std::filesystem::path(PT_SOURCE_DIR) / "configs";
-
-VulkanRenderOptions validatedOptions(int spp) {
-  VulkanRenderOptions options;
-  options.context.validation = true;  // a validation error fails the test below
-  options.spp = spp;
-  options.passesPerFlush = 3;  // exercise several folds into the film
-  return options;
-}
-
-struct Comparison {
-  DiffStats diff;
-  VulkanRenderStats gpu;
-  vec3 gpuMean{0.0f}, cpuMean{0.0f};
-};
-
-Comparison renderBoth(const SceneData& data, int spp, bool specialize = true) {
-  const Camera& cam = data.params.camera;
-  Film cpu(int(cam.width), int(cam.height)), gpu(int(cam.width), int(cam.height));
-  const RenderStats cpuStats = renderCpu(data, CpuRenderOptions{.threads = 2, .spp = spp}, cpu);
-  EXPECT_EQ(cpuStats.invalidSamples, 0u);
-  VulkanRenderOptions options = validatedOptions(spp);
-  options.specialize = specialize;
-  Comparison c;
-  c.gpu = renderVulkan(data, options, gpu);
-  const Image a = gpu.resolve(), b = cpu.resolve();
-  c.diff = diffImages(a, b, 1e-3);
-  for (size_t i = 0; i < a.pixels.size(); ++i) {
-    c.gpuMean += a.pixels[i] / float(a.pixels.size());
-    c.cpuMean += b.pixels[i] / float(b.pixels.size());
-  }
-  return c;
-}
-
-// The acceptance rule: within 1e-3 relative on at least 99.5 % of pixels, no validation
-// errors, nothing invalid or cut short, and image means equal to 1e-3 (diverged paths are
-// rare and unbiased, so they cannot move the mean).
-void expectAgreement(const Comparison& c) {
-  EXPECT_EQ(c.gpu.validationErrors, 0u);
-  EXPECT_EQ(c.gpu.invalidSamples, 0u);
-  EXPECT_EQ(c.gpu.truncatedSamples, 0u);
-  EXPECT_EQ(c.diff.nonFinitePixels, 0u);
-  EXPECT_LE(double(c.diff.pixelsOverThreshold), 0.005 * double(c.diff.pixelCount))
-      << "rmse " << c.diff.rmse << " max " << c.diff.maxAbsError;
-  for (int ch = 0; ch < 3; ++ch) {
-    EXPECT_GT(c.cpuMean[ch], 0.0f);
-    EXPECT_NEAR(c.gpuMean[ch], c.cpuMean[ch], 1e-3f * c.cpuMean[ch]) << "channel " << ch;
-  }
-  EXPECT_GT(c.gpu.rays, 0u);
-}
 
 SceneData prepare(const std::string& config, int size) {
   return prepareScene(loadScene(kConfigs / config), RenderSettings{.width = size, .height = size});

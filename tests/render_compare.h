@@ -1,0 +1,67 @@
+// Renders a scene on both backends and compares them: the harness of the Vulkan and the
+// robustness tests.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include "cpu/integrator.h"
+#include "render/prepare.h"
+#include "vulkan/backend.h"
+
+namespace pt {
+
+inline VulkanRenderOptions validatedOptions(int spp) {
+  VulkanRenderOptions options;
+  options.context.validation = true;  // a validation error fails the test below
+  options.spp = spp;
+  options.passesPerFlush = 3;  // exercise several folds into the film
+  return options;
+}
+
+struct Comparison {
+  DiffStats diff;
+  RenderStats cpu;
+  VulkanRenderStats gpu;
+  Image cpuImage, gpuImage;
+  vec3 gpuMean{0.0f}, cpuMean{0.0f};
+};
+
+inline Comparison renderBoth(const SceneData& data, int spp, bool specialize = true) {
+  const Camera& cam = data.params.camera;
+  Film cpu(int(cam.width), int(cam.height)), gpu(int(cam.width), int(cam.height));
+  Comparison c;
+  c.cpu = renderCpu(data, CpuRenderOptions{.threads = 2, .spp = spp}, cpu);
+  EXPECT_EQ(c.cpu.invalidSamples, 0u);
+  VulkanRenderOptions options = validatedOptions(spp);
+  options.specialize = specialize;
+  c.gpu = renderVulkan(data, options, gpu);
+  c.gpuImage = gpu.resolve();
+  c.cpuImage = cpu.resolve();
+  const Image& a = c.gpuImage;
+  const Image& b = c.cpuImage;
+  c.diff = diffImages(a, b, 1e-3);
+  for (size_t i = 0; i < a.pixels.size(); ++i) {
+    c.gpuMean += a.pixels[i] / float(a.pixels.size());
+    c.cpuMean += b.pixels[i] / float(b.pixels.size());
+  }
+  return c;
+}
+
+// The acceptance rule: within 1e-3 relative on at least 99.5 % of pixels, no validation
+// errors, nothing invalid or cut short, and image means equal to 1e-3 (diverged paths are
+// rare and unbiased, so they cannot move the mean).
+inline void expectAgreement(const Comparison& c) {
+  EXPECT_EQ(c.gpu.validationErrors, 0u);
+  EXPECT_EQ(c.gpu.invalidSamples, 0u);
+  EXPECT_EQ(c.gpu.truncatedSamples, 0u);
+  EXPECT_EQ(c.diff.nonFinitePixels, 0u);
+  EXPECT_LE(double(c.diff.pixelsOverThreshold), 0.005 * double(c.diff.pixelCount))
+      << "rmse " << c.diff.rmse << " max " << c.diff.maxAbsError;
+  for (int ch = 0; ch < 3; ++ch) {
+    EXPECT_GT(c.cpuMean[ch], 0.0f);
+    EXPECT_NEAR(c.gpuMean[ch], c.cpuMean[ch], 1e-3f * c.cpuMean[ch]) << "channel " << ch;
+  }
+  EXPECT_GT(c.gpu.rays, 0u);
+}
+
+}  // namespace pt

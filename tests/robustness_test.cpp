@@ -1,0 +1,178 @@
+// Hard cases on both backends: energy conservation against closed forms, and degenerate
+// geometry and light that must never produce NaN, Inf or unbounded pixels.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "render_compare.h"
+#include "scene/scene.h"
+#include "test_util.h"
+
+namespace pt {
+namespace {
+
+// Adds quad (c -/+ u -/+ v) as two triangles whose geometric normal is cross(u, v).
+void addQuad(Scene& scene, vec3 c, vec3 u, vec3 v, uint material) {
+  scene.triangles.push_back(Triangle{c - u - v, material, c + u - v, kNoEmitter, c + u + v, 0});
+  scene.triangles.push_back(Triangle{c - u - v, material, c + u + v, kNoEmitter, c - u + v, 0});
+}
+
+// The six inward-facing faces of the cube [-1, 1]^3; face f gets materials[f].
+void addClosedCube(Scene& scene, const uint (&materials)[6]) {
+  const vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  addQuad(scene, -x, y, z, materials[0]);
+  addQuad(scene, x, z, y, materials[1]);
+  addQuad(scene, -y, z, x, materials[2]);
+  addQuad(scene, y, x, z, materials[3]);
+  addQuad(scene, -z, x, y, materials[4]);
+  addQuad(scene, z, y, x, materials[5]);
+}
+
+SceneData finish(Scene& scene, CameraDesc camera, int maxDepth = 100000) {
+  for (uint i = 0; i < scene.triangles.size(); ++i) scene.triangles[i].primitive = i;
+  scene.camera = camera;
+  scene.integrator.maxDepth = maxDepth;
+  return prepareScene(scene, RenderSettings{});
+}
+
+// Mean pixel value and its standard error, for images whose pixels share one expectation.
+void expectImageMean(const Image& image, vec3 expected, const char* backend) {
+  glm::dvec3 mean(0.0), sq(0.0);
+  const double n = double(image.pixels.size());
+  for (const vec3& p : image.pixels) mean += glm::dvec3(p) / n;
+  for (const vec3& p : image.pixels) sq += (glm::dvec3(p) - mean) * (glm::dvec3(p) - mean);
+  const glm::dvec3 se = sqrt(sq / (n - 1.0) / n);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_GT(se[c], 0.0) << backend;
+    EXPECT_NEAR(mean[c], expected[c], 3.0 * se[c])
+        << backend << " channel " << c << " (standard error " << se[c] << ")";
+  }
+}
+
+// White furnace: a closed cube whose every face emits Le and reflects a fraction a has
+// radiance Le / (1 - a) everywhere, whatever mix of diffuse and mirror faces it has.
+TEST(RobustFurnace, ClosedFormOnBothBackendsUpToAlbedo099) {
+  for (float a : {0.5f, 0.9f, 0.99f}) {
+    for (bool mirrors : {false, true}) {
+      SCOPED_TRACE("albedo " + std::to_string(a) + (mirrors ? " with mirrors" : " diffuse"));
+      const vec3 Le(1.0f, 0.5f, 0.25f);
+      Scene scene;
+      scene.materials = {Material{vec3(a), kMaterialDiffuse, Le, 0},
+                         Material{vec3(a), kMaterialMirror, Le, 0}};
+      const uint m = mirrors ? 1u : 0u;
+      addClosedCube(scene, {0, m, 0, m, 0, 0});
+      // Paths at albedo 0.99 average 100 bounces: fewer pixels, more samples each.
+      const int size = a > 0.95f ? 8 : 16;
+      const SceneData data =
+          finish(scene, CameraDesc{vec3(0.1f, -0.2f, 0.05f), vec3(1, 0.3f, 0.7f), vec3(0, 1, 0),
+                                   90.0f, size, size});
+      const int spp = a > 0.95f ? 64 : 16;
+      const Comparison c = renderBoth(data, spp);
+      EXPECT_EQ(c.cpu.invalidSamples + c.gpu.invalidSamples, 0u);
+      EXPECT_EQ(c.gpu.validationErrors, 0u);
+      expectImageMean(c.cpuImage, Le / (1.0f - a), "cpu");
+      expectImageMean(c.gpuImage, Le / (1.0f - a), "vulkan");
+    }
+  }
+}
+
+// Every pixel finite and below `bound`, no invalid samples, backends in agreement (unless
+// the scene has coincident surfaces: which of two coplanar triangles a ray sees is decided
+// by the last bit of two equal distances, which the backends may round apart).
+void expectSaneAndAgreeing(const SceneData& data, int spp, float bound,
+                           bool requireAgreement = true) {
+  const Comparison c = renderBoth(data, spp);
+  EXPECT_EQ(c.cpu.invalidSamples, 0u);
+  EXPECT_EQ(c.gpu.invalidSamples, 0u);
+  EXPECT_EQ(c.gpu.validationErrors, 0u);
+  for (const Image* image : {&c.cpuImage, &c.gpuImage}) {
+    for (const vec3& p : image->pixels) {
+      ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+      ASSERT_LE(std::max(p.x, std::max(p.y, p.z)), bound);
+      ASSERT_GE(std::min(p.x, std::min(p.y, p.z)), 0.0f);
+    }
+  }
+  if (!requireAgreement) return;
+  EXPECT_LE(double(c.diff.pixelsOverThreshold), 0.005 * double(c.diff.pixelCount))
+      << "max " << c.diff.maxAbsError;
+}
+
+// A white box lit through its ceiling, with `extra` added by the caller.
+SceneData litBox(const std::function<void(Scene&)>& extra) {
+  Scene scene;
+  scene.materials = {Material{vec3(0.7f), kMaterialDiffuse, vec3(0.0f), 0},
+                     Material{vec3(0.2f, 0.6f, 0.2f), kMaterialDiffuse, vec3(0.0f), 0},
+                     Material{vec3(0.0f), kMaterialDiffuse, vec3(4.0f), 0}};
+  addClosedCube(scene, {0, 0, 0, 2, 0, 0});
+  extra(scene);
+  return finish(scene,
+                CameraDesc{vec3(0, 0, -0.9f), vec3(0, -0.3f, 0), vec3(0, 1, 0), 80.0f, 24, 24}, 64);
+}
+
+TEST(RobustDegenerate, SliverAndZeroAreaEmitters) {
+  const SceneData data = litBox([](Scene& scene) {
+    // A needle-thin sliver emitter, and a zero-area (collinear) one that must never be sampled.
+    scene.triangles.push_back(Triangle{vec3(-0.5f, 0, 0), 2, vec3(0.5f, 0, 0), kNoEmitter,
+                                       vec3(0.5f, 1e-6f, 0), 0});
+    scene.triangles.push_back(Triangle{vec3(-0.5f, 0.2f, 0), 2, vec3(0.5f, 0.2f, 0), kNoEmitter,
+                                       vec3(0, 0.2f, 0), 0});
+  });
+  for (const Emitter& e : data.emitters) {
+    const Triangle& t = data.bvh.triangles[e.triangle];
+    EXPECT_GT(length(cross(t.v1 - t.v0, t.v2 - t.v0)), 0.0f) << "zero-area emitter sampled";
+  }
+  expectSaneAndAgreeing(data, 8, 100.0f);
+}
+
+TEST(RobustDegenerate, CoplanarOverlappingSurfaces) {
+  const SceneData data = litBox([](Scene& scene) {
+    addQuad(scene, vec3(0, -0.999f, 0), vec3(0, 0, 0.5f), vec3(0.5f, 0, 0), 1);
+    addQuad(scene, vec3(0.2f, -0.999f, 0), vec3(0, 0, 0.5f), vec3(0.5f, 0, 0), 0);
+  });
+  expectSaneAndAgreeing(data, 8, 100.0f, /*requireAgreement=*/false);
+}
+
+TEST(RobustDegenerate, CameraInsideAClosedObject) {
+  // Inside a closed sphere of diffuse triangles lit by nothing: black, never NaN.
+  Scene scene;
+  scene.materials = {Material{vec3(0.8f), kMaterialDiffuse, vec3(0.0f), 0},
+                     Material{vec3(0.0f), kMaterialDiffuse, vec3(5.0f), 0}};
+  for (Triangle t : test::makeSphere(vec3(0), 0.3f, 12, 16)) scene.triangles.push_back(t);
+  addQuad(scene, vec3(0, 2, 0), vec3(0.5f, 0, 0), vec3(0, 0, 0.5f), 1);  // light outside
+  const SceneData data =
+      finish(scene, CameraDesc{vec3(0.01f, 0.02f, 0), vec3(0, 0, 1), vec3(0, 1, 0), 90, 16, 16}, 64);
+  const Comparison c = renderBoth(data, 8);
+  EXPECT_EQ(c.cpu.invalidSamples + c.gpu.invalidSamples, 0u);
+  for (const vec3& p : c.gpuImage.pixels) EXPECT_EQ(p, vec3(0.0f));
+  for (const vec3& p : c.cpuImage.pixels) EXPECT_EQ(p, vec3(0.0f));
+}
+
+TEST(RobustDegenerate, EmitterFacingAwayAndGrazingLight) {
+  // A floor lit by an emitter standing on it edge-on (cos at the light -> 0 along the floor)
+  // and by one that faces away from everything (it lights nothing).
+  Scene scene;
+  scene.materials = {Material{vec3(0.7f), kMaterialDiffuse, vec3(0.0f), 0},
+                     Material{vec3(0.0f), kMaterialDiffuse, vec3(10.0f), 0}};
+  addQuad(scene, vec3(0), vec3(0, 0, 2), vec3(2, 0, 0), 0);                // floor, normal +y
+  addQuad(scene, vec3(0, 0.25f, 0), vec3(0, 0.25f, 0), vec3(0.5f, 0, 0) * -1.0f, 1);  // upright
+  addQuad(scene, vec3(0, 3, 0), vec3(0.5f, 0, 0), vec3(0, 0, 0.5f), 1);    // faces up, away
+  const SceneData data =
+      finish(scene, CameraDesc{vec3(0, 1.5f, -2.5f), vec3(0), vec3(0, 1, 0), 60, 24, 24}, 64);
+  expectSaneAndAgreeing(data, 8, 100.0f);
+}
+
+TEST(RobustDegenerate, TwoFacingMirrorsAtMaxDepth64) {
+  Scene scene;
+  scene.materials = {Material{vec3(1.0f), kMaterialMirror, vec3(0.0f), 0},
+                     Material{vec3(0.5f), kMaterialDiffuse, vec3(1.0f), 0}};
+  addQuad(scene, vec3(0, 0, 1), vec3(0, 3, 0), vec3(3, 0, 0), 0);   // faces -z
+  addQuad(scene, vec3(0, 0, -1), vec3(3, 0, 0), vec3(0, 3, 0), 0);  // faces +z
+  addQuad(scene, vec3(0, 2, 0), vec3(0.3f, 0, 0), vec3(0, 0, 0.3f), 1);
+  const SceneData data =
+      finish(scene, CameraDesc{vec3(0.1f, 0, 0.5f), vec3(0.2f, -0.2f, -1), vec3(0, 1, 0), 50, 16, 16}, 64);
+  expectSaneAndAgreeing(data, 8, 100.0f);
+}
+
+}  // namespace
+}  // namespace pt
