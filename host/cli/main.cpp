@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/converge.h"
 #include "cli/progress.h"
 #include "common/check.h"
 #include "cpu/integrator.h"
@@ -240,6 +241,43 @@ int main(int argc, char** argv) {
                    "The images agree when at most this fraction of pixels differ")
       ->capture_default_str();
 
+  // ---- converge: error against a reference as samples double (host/cli/converge.h) ----
+  ConvergeArgs c;
+  CLI::App* converge = app.add_subcommand(
+      "converge", "Render at 1, 2, 4, ... N spp, writing the error against a reference and the time");
+  converge->add_option("scene", c.scene, "Scene file (JSON)")->required();
+  converge->add_option("--reference", c.reference, "Reference image (.exr, .pfm), same size")
+      ->required();
+  converge->add_option("--csv", c.csv, "CSV output, one row per level")->required();
+  converge->add_option("--label", c.label, "First CSV column, names the configuration")
+      ->capture_default_str();
+  converge->add_option("--backend", c.backend, "vulkan or cpu")
+      ->check(CLI::IsMember({"vulkan", "cpu"}))
+      ->capture_default_str();
+  converge->add_option("--device", c.device, "Vulkan device: index or part of the name");
+  converge->add_option("--max-spp", c.maxSpp, "Largest samples per pixel")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  converge->add_option("--seed", c.seed, "Random seed (default: the scene's)")
+      ->check(CLI::Range(0LL, 4294967295LL));
+  converge->add_option("--width", c.width, "Image width (default: the scene's)")
+      ->check(CLI::PositiveNumber);
+  converge->add_option("--height", c.height, "Image height (default: the scene's)")
+      ->check(CLI::PositiveNumber);
+  converge->add_option("--max-depth", c.maxDepth, "Maximum scattering events per path")
+      ->check(CLI::Range(0, 100000));
+  converge->add_option("--threads", c.threads, "CPU threads (default: all)")
+      ->check(CLI::PositiveNumber);
+  converge->add_option("--leaf-size", c.leafSize, "Maximum triangles per BVH leaf")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  converge->add_option("--strategy", c.strategy, "Direct light: mis, nee or bsdf")
+      ->check(CLI::IsMember({"mis", "nee", "bsdf"}));
+  converge->add_option("--rr", c.roulette, "Russian roulette on or off (default: the scene's)")
+      ->check(CLI::IsMember({"on", "off"}));
+  converge->add_flag("--no-specialize", c.noSpecialize, "Vulkan: compile every effect in");
+  // ---- end converge ----
+
   CLI::App* devices = app.add_subcommand("devices", "List Vulkan devices");
 
   try {
@@ -255,6 +293,7 @@ int main(int argc, char** argv) {
     if (*render) return runRender(r);
     if (*diff) return runDiff(d);
     if (*devices) return runDevices();
+    if (*converge) return runConvergeCommand(c);  // converge
   } catch (const InputError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitInputError;
