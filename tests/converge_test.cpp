@@ -21,7 +21,7 @@ namespace pt {
 namespace {
 
 const std::filesystem::path kConfigs = std::filesystem::path(PT_SOURCE_DIR) / "configs";
-constexpr int kSize = 16;
+constexpr int kSize = 32;  // 4 tiles, so both CPU threads work
 
 SceneData cornell(long long seed) {
   RenderSettings settings;
@@ -30,7 +30,7 @@ SceneData cornell(long long seed) {
   return prepareScene(loadScene(kConfigs / "cornell-box.json"), settings);
 }
 
-// The Cornell box at 1024 spp with seed 7 (the runs use seed 0), rendered once (~2 s).
+// The Cornell box at 1024 spp with seed 7 (the runs use seed 0), rendered once (~3 s).
 const Image& reference() {
   static const Image image = [] {
     const SceneData data = cornell(7);
@@ -74,11 +74,13 @@ TEST(Converge, CpuErrorFallsAsSamplesDouble) {
     EXPECT_TRUE(std::isfinite(rows[i].rmse) && std::isfinite(rows[i].relMse));
     if (i > 0) EXPECT_GE(rows[i].seconds, rows[i - 1].seconds) << "time is cumulative";
   }
-  // Unbiased Monte Carlo: 16x the samples should cut the RMSE about 4x (to 0.25x, a little
-  // more with the reference's own noise); 0.35x leaves room for the heavy-tailed 1 spp image.
-  EXPECT_LT(rows[4].rmse, 0.35 * rows[0].rmse);     // 16 vs 1 spp
-  EXPECT_LT(rows[6].rmse, 0.35 * rows[2].rmse);     // 64 vs 4 spp
-  EXPECT_LT(rows[6].relMse, 0.2 * rows[2].relMse);  // relMSE is squared: ~1/16
+  // Unbiased Monte Carlo: N times the samples divide the MSE by about N. RMSE is heavy-tailed
+  // here (pixels on the light's edge are either ~17 or ~0.5 at 1 spp), so its bound is loose;
+  // relMSE, normalised by the reference, follows 1/N closely (measured: 0.09x for 16x, 0.02x
+  // for 64x over seeds 0..3).
+  EXPECT_LT(rows[6].rmse, 0.35 * rows[0].rmse);      // 64 vs 1 spp: ~0.125x expected
+  EXPECT_LT(rows[4].relMse, 0.35 * rows[0].relMse);  // 16 vs 1 spp: ~0.06x expected
+  EXPECT_LT(rows[6].relMse, 0.1 * rows[0].relMse);   // 64 vs 1 spp: ~0.016x expected
 }
 
 TEST(Converge, ProgressiveLevelsEqualOneRenderOfAllSamples) {

@@ -1,6 +1,7 @@
 // `pt converge`; see converge.h.
 #include "cli/converge.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -97,7 +98,8 @@ int runConvergeCommand(const ConvergeArgs& args) {
   if (args.noSpecialize && args.backend != "vulkan") {
     throw InputError("--no-specialize applies to the Vulkan backend only");
   }
-  const std::string refExt = std::filesystem::path(args.reference).extension().string();
+  std::string refExt = std::filesystem::path(args.reference).extension().string();
+  for (char& ch : refExt) ch = char(std::tolower(static_cast<unsigned char>(ch)));
   if (refExt != ".exr" && refExt != ".pfm") {
     throw InputError(args.reference + ": the reference must be a float image (.exr or .pfm)");
   }

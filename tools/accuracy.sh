@@ -1,0 +1,303 @@
+#!/usr/bin/env bash
+# What accuracy costs in time: renders a high-spp CPU reference of the Cornell box and of the
+# bunny, runs `pt converge` for each knob on the CPU and on the Vulkan backend, merges the
+# CSVs, plots relMSE against seconds (docs/plots/*.png) and writes docs/accuracy.md.
+#   tools/accuracy.sh [SIZE] [MAX_SPP]        (default 64 128)
+# Environment:
+#   REF_SPP  reference samples per pixel (default 32 x MAX_SPP)
+#   TARGET   relMSE whose time to reach is tabulated (default 0.01)
+#   THREADS  CPU threads, and LP_NUM_THREADS for lavapipe (default: all cores)
+#   BUILD    build directory (default build)
+#   REUSE_REF=1 keeps a reference already rendered with the same size, spp and seed
+# Renders run one at a time. Outputs: out/accuracy/ (references, CSVs, logs), docs/plots/,
+# docs/accuracy.md (a hand-written block between the notes markers survives a rerun).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+size=${1:-64}
+max_spp=${2:-128}
+ref_spp=${REF_SPP:-$((32 * max_spp))}
+target=${TARGET:-0.01}
+threads=${THREADS:-$(nproc)}
+build=${BUILD:-build}
+ref_seed=1000003  # the studied runs use the scenes' own seed, 0
+out=out/accuracy
+plots=docs/plots
+doc=docs/accuracy.md
+scenes=(cornell-box bunny-box)
+
+# Configurations: label and `pt converge` flags. "baseline" is the scenes' own settings:
+# NEE+MIS, Russian roulette on (from depth 3), max depth 64, BVH leaf size 4, specialized.
+declare -A flags=(
+  [baseline]="" [nee]="--strategy nee" [bsdf]="--strategy bsdf" [rr-off]="--rr off"
+  [depth-1]="--max-depth 1" [depth-2]="--max-depth 2" [depth-4]="--max-depth 4"
+  [leaf-1]="--leaf-size 1" [leaf-8]="--leaf-size 8" [leaf-16]="--leaf-size 16"
+  [unspecialized]="--no-specialize"
+)
+cpu_labels="baseline nee bsdf rr-off depth-1 depth-2 depth-4 leaf-1 leaf-8 leaf-16"
+vulkan_labels="$cpu_labels unspecialized"
+# Knob groups: file name, title, labels (each plot and table shows one group).
+groups=(
+  "strategy|Direct light: NEE+MIS (baseline) vs NEE only vs BSDF only|baseline nee bsdf"
+  "depth|Russian roulette on (baseline) / off, max depth 64 (baseline), 4, 2, 1|baseline rr-off depth-4 depth-2 depth-1"
+  "leaf|BVH leaf size 1, 4 (baseline), 8, 16|leaf-1 baseline leaf-8 leaf-16"
+  "specialize|Specialization constants on (baseline) / off, Vulkan only|baseline unspecialized"
+)
+
+tools/setup.sh
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$build" --target pt
+pt=$build/pt
+export LP_NUM_THREADS=$threads
+mkdir -p "$out/csv" "$out/logs" "$out/dat" "$plots"
+rm -f "$out"/csv/*.csv "$out"/dat/*.dat "$plots"/accuracy-*.png
+started=$SECONDS
+problems=()
+
+for scene in "${scenes[@]}"; do
+  ref=$out/$scene-ref-${size}px-${ref_spp}spp-seed$ref_seed.exr
+  if [[ ${REUSE_REF:-0} == 1 && -f $ref ]]; then
+    echo "== $scene: reusing $ref"
+  else
+    echo "== $scene: reference, CPU, $ref_spp spp, seed $ref_seed"
+    "$pt" render "configs/$scene.json" --backend cpu --threads "$threads" --width "$size" \
+      --height "$size" --spp "$ref_spp" --seed "$ref_seed" --out "$ref" 2>/dev/null
+  fi
+  for backend in cpu vulkan; do
+    labels=$cpu_labels
+    [[ $backend == vulkan ]] && labels=$vulkan_labels
+    for label in $labels; do
+      name=$scene.$backend.$label
+      # shellcheck disable=SC2086  # flags are words
+      if "$pt" converge "configs/$scene.json" --backend "$backend" --threads "$threads" \
+        --width "$size" --height "$size" --max-spp "$max_spp" --reference "$ref" \
+        --label "$label" --csv "$out/csv/$name.csv" ${flags[$label]} >"$out/logs/$name.txt" \
+        2>"$out/logs/$name.err"; then
+        status=0
+      else
+        status=$?
+      fi
+      # Status 1: some samples were NaN/Inf or cut short; the rows are kept and flagged.
+      if ((status == 1)); then
+        problems+=("$name: $(tail -1 "$out/logs/$name.err")")
+      elif ((status != 0)); then
+        cat "$out/logs/$name.err" >&2
+        exit "$status"
+      fi
+      echo "$name: $(tail -1 "$out/logs/$name.txt")  (elapsed ${SECONDS}s)"
+    done
+  done
+done
+elapsed=$((SECONDS - started))
+
+# ---- Merge, split per curve for gnuplot ------------------------------------------------------
+merged=$out/accuracy.csv
+{
+  echo "label,backend,scene,width,height,spp,seconds,rmse,relmse,mrays_per_s"
+  for f in "$out"/csv/*.csv; do tail -n +2 "$f"; done
+} >"$merged"
+awk -F, -v dir="$out/dat" 'NR > 1 {
+  f = dir "/" $3 "." $2 "." $1 ".dat"; print $6, $7, $9 > f }' "$merged"
+
+# ---- Plots: one per scene and knob group; CPU solid, Vulkan dashed, a colour per config ------
+if gnuplot -e 'set terminal' 2>&1 | grep -q pngcairo; then
+  term="pngcairo size 900,620 font ',10'"
+else
+  term="png size 900,620"
+fi
+declare -A pretty=([cornell-box]="Cornell box" [bunny-box]="Bunny box")
+for scene in "${scenes[@]}"; do
+  for g in "${groups[@]}"; do
+    IFS='|' read -r gname gtitle glabels <<<"$g"
+    cmds=() color=1
+    for label in $glabels; do
+      for backend in cpu vulkan; do
+        dat=$out/dat/$scene.$backend.$label.dat
+        [[ -f $dat ]] || continue
+        [[ $gname == specialize && $backend == cpu ]] && continue
+        dt=1 pt_=7
+        [[ $backend == vulkan ]] && dt=2 pt_=6
+        cmds+=("'$dat' using 2:3 with linespoints lc $color dt $dt pt $pt_ ps 0.8 title '$label ($backend)'")
+      done
+      color=$((color + 1))
+    done
+    cmds+=("$target with lines lc rgb 'gray50' dt 3 title 'target relMSE $target'")
+    plot=$(IFS=,; echo "${cmds[*]}")
+    gnuplot <<EOF
+set terminal $term
+set output '$plots/accuracy-$scene-$gname.png'
+set title "${pretty[$scene]} ${size}x${size}: $gtitle" noenhanced
+set logscale xy
+set format x '10^{%L}'
+set format y '10^{%L}'
+set xlabel 'cumulative render time (s): CPU wall clock, Vulkan device timestamps'
+set ylabel 'relMSE against the reference'
+set grid xtics ytics mxtics mytics lc rgb '#dddddd'
+set key outside right top noenhanced
+plot $plot
+EOF
+  done
+done
+
+# ---- Tables --------------------------------------------------------------------------------
+# For one scene and group: per configuration and backend, the last level (spp, seconds,
+# relMSE, Mrays/s), the log-log slope of relMSE against spp over the last three levels, the
+# time to reach the target relMSE and the relMSE at equal time T, where T (per backend) is
+# the smallest final time in the group, so that every curve reaches it. Both by linear
+# interpolation between levels on the log-log curve.
+table() {  # scene, labels
+  awk -F, -v scene="$1" -v labels="$2" -v target="$target" '
+    function g(x) { return sprintf("%.3g", x) }
+    function lerp(x, x0, x1, y0, y1) { return y0 + (x - x0) / (x1 - x0) * (y1 - y0) }
+    function timeTo(k,   i) {
+      if (r[k, 1] <= target) return "≤ " g(t[k, 1])
+      for (i = 2; i <= n[k]; ++i) if (r[k, i] <= target)
+        return g(exp(lerp(log(target), log(r[k, i - 1]), log(r[k, i]), log(t[k, i - 1]), log(t[k, i]))))
+      return "not reached"
+    }
+    function atTime(k, T,   i) {
+      if (T < t[k, 1]) return "—"
+      if (T <= t[k, 1]) return g(r[k, 1])
+      for (i = 2; i <= n[k]; ++i) if (t[k, i] >= T)
+        return g(exp(lerp(log(T), log(t[k, i - 1]), log(t[k, i]), log(r[k, i - 1]), log(r[k, i]))))
+      return "—"
+    }
+    function slope(k,   i, m, x, y, sx, sy, sxx, sxy) {
+      m = n[k] < 3 ? n[k] : 3
+      if (m < 2) return "—"
+      for (i = n[k] - m + 1; i <= n[k]; ++i) {
+        x = log(s[k, i]); y = log(r[k, i]); sx += x; sy += y; sxx += x * x; sxy += x * y
+      }
+      return sprintf("%.2f", (m * sxy - sx * sy) / (m * sxx - sx * sx))
+    }
+    NR > 1 && $3 == scene {
+      k = $1 SUBSEP $2; i = ++n[k]; s[k, i] = $6; t[k, i] = $7; r[k, i] = $9; mr[k, i] = $10
+    }
+    END {
+      nl = split(labels, L, " "); split("cpu vulkan", B, " ")
+      for (b = 1; b <= 2; ++b) for (l = 1; l <= nl; ++l) {
+        k = L[l] SUBSEP B[b]
+        if (n[k] && (!(B[b] in T) || t[k, n[k]] < T[B[b]])) T[B[b]] = t[k, n[k]]
+      }
+      print "| configuration | backend | spp | seconds | relMSE | slope | Mrays/s | seconds to relMSE " target " | relMSE at equal time |"
+      print "|---|---|--:|--:|--:|--:|--:|--:|--:|"
+      for (l = 1; l <= nl; ++l) for (b = 1; b <= 2; ++b) {
+        k = L[l] SUBSEP B[b]
+        if (!n[k]) continue
+        printf "| %s | %s | %d | %s | %s | %s | %s | %s | %s (at %s s) |\n", L[l], B[b], s[k, n[k]],
+          g(t[k, n[k]]), g(r[k, n[k]]), slope(k), g(mr[k, n[k]]), timeTo(k), atTime(k, T[B[b]]),
+          g(T[B[b]])
+      }
+    }' "$merged"
+}
+field() {  # scene backend label column(6 spp, 7 seconds, 9 relmse, 10 mrays): the last level
+  awk -F, -v s="$1" -v b="$2" -v l="$3" -v c="$4" '$3 == s && $2 == b && $1 == l {v = $c} END {print v}' "$merged"
+}
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN {printf "%.2f", a / b}'; }
+
+# ---- The document ------------------------------------------------------------------------------
+notes=""
+if [[ -f $doc ]] && grep -q '<!-- notes:begin -->' "$doc"; then
+  notes=$(sed -n '/<!-- notes:begin -->/,/<!-- notes:end -->/p' "$doc")
+fi
+[[ -n $notes ]] || notes=$'<!-- notes:begin -->\n(none yet)\n<!-- notes:end -->'
+cpu_model=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
+vk_device=$("$pt" devices 2>/dev/null | head -1 | sed 's/^[0-9]*: //') || vk_device="(none)"
+{
+  cat <<EOF
+# What accuracy costs in time
+
+Generated by \`tools/accuracy.sh $size $max_spp\` on $(date -u +%Y-%m-%d) (UTC): every number
+and plot below comes from that run. Machine: $(nproc) cores ($cpu_model), $threads CPU
+threads; Vulkan device: $vk_device. Image ${size}x${size}, \`pt converge\` levels 1, 2, 4, …
+$max_spp spp; references rendered on the CPU at $ref_spp spp with seed $ref_seed (the studied
+runs use the scenes' seed 0). The whole run took $((elapsed / 60)) min $((elapsed % 60)) s of
+wall time. The machine was shared with other work, so timings carry some noise.
+
+## How to rerun
+
+\`\`\`sh
+tools/accuracy.sh [SIZE] [MAX_SPP]     # e.g. tools/accuracy.sh $size $max_spp
+\`\`\`
+
+It installs packages and builds like the other tools, renders the references into
+\`out/accuracy/\`, runs \`pt converge\` once per configuration and backend, one render at a
+time, merges the rows into \`out/accuracy/accuracy.csv\`, draws \`docs/plots/accuracy-*.png\`
+with gnuplot and rewrites this file (the notes block at the end is kept). \`REF_SPP\`,
+\`TARGET\`, \`THREADS\` and \`BUILD\` override the defaults (32 × MAX_SPP, 0.01, all cores,
+\`build\`). One configuration by hand:
+
+\`\`\`sh
+build/pt converge configs/cornell-box.json --backend cpu --width $size --height $size \\
+  --max-spp $max_spp --reference out/accuracy/cornell-box-ref-${size}px-${ref_spp}spp-seed$ref_seed.exr \\
+  --strategy nee --label nee --csv nee.csv
+\`\`\`
+
+## How to read it
+
+- **relMSE** is the mean over pixels and channels of (image − reference)² / (reference² +
+  0.01), as \`pt diff\` computes it; **seconds** is the cumulative render time of the levels
+  so far (CPU: wall clock of the render; Vulkan: device timestamps around the dispatches,
+  without set-up, shader compilation or upload). Each level adds the next sample indices to
+  the film, so the last row of a run is the same image as one render at MAX_SPP.
+- **slope** is the log-log slope of relMSE against spp over the last three levels. An
+  unbiased estimator gives about −1 (MSE ∝ 1/N); a slope towards 0 means the error has hit a
+  floor: bias. A biased configuration converges to a different image than the reference.
+- **seconds to relMSE $target**: when the curve first crosses the target (interpolated
+  linearly on the log-log curve between levels); "not reached" within MAX_SPP.
+- **relMSE at equal time**: the curve read at time T, the smallest final time among the
+  group's configurations on that backend (so every curve reaches it), again interpolated on
+  the log-log curve; "—" when T is before a configuration's first level.
+- The reference is itself noisy: at $ref_spp spp its own relMSE is roughly the baseline's
+  error at $max_spp spp times $max_spp/$ref_spp, and that floor is included in every number.
+  RMSE is in the CSV too but is dominated by the few pixels on the light's edge (about 17
+  against about 0.5 at 1 spp), so the plots and tables use relMSE.
+- Identical sample indices give (nearly) identical images on both backends, so at equal
+  spp the two backends' relMSE agree and only their times differ.
+- The plots: CPU solid with filled points, Vulkan dashed with open points, one colour per
+  configuration, the target relMSE as a dotted line.
+EOF
+  for scene in "${scenes[@]}"; do
+    printf '\n## %s\n' "${pretty[$scene]}"
+    for g in "${groups[@]}"; do
+      IFS='|' read -r gname gtitle glabels <<<"$g"
+      printf '\n### %s\n\n![%s, %s](plots/accuracy-%s-%s.png)\n\n' "$gtitle" "${pretty[$scene]}" \
+        "$gname" "$scene" "$gname"
+      table "$scene" "$glabels"
+    done
+    spec=$(field "$scene" vulkan baseline 7) unspec=$(field "$scene" vulkan unspecialized 7)
+    if [[ -n $spec && -n $unspec ]]; then
+      printf '\nSpecialization on Vulkan, %s: %s s specialized vs %s s unspecialized for %s spp, a speed-up of %s× (Mrays/s %s vs %s).\n' \
+        "${pretty[$scene]}" "$(printf %.3g "$spec")" "$(printf %.3g "$unspec")" \
+        "$(field "$scene" vulkan baseline 6)" "$(ratio "$unspec" "$spec")" \
+        "$(printf %.3g "$(field "$scene" vulkan baseline 10)")" \
+        "$(printf %.3g "$(field "$scene" vulkan unspecialized 10)")"
+    fi
+  done
+  if ((${#problems[@]})); then
+    printf '\n## Runs with invalid samples\n\nThese runs reported NaN/Inf or truncated samples (left out of the image, rows kept):\n\n'
+    for p in "${problems[@]}"; do printf -- '- %s\n' "$p"; done
+  fi
+  cat <<EOF
+
+## Notes on this run
+
+Hand-written observations; they describe the run this file was generated from and are kept
+when the script rewrites the file, so check them against the tables after a rerun.
+
+$notes
+
+## Not measured yet
+
+These knobs are not implemented, so there is nothing to measure:
+
+- a low-discrepancy sampler (Sobol, blue noise): random numbers are a pcg4d hash of (pixel,
+  sample, dimension, seed);
+- a binned-SAH BVH builder: the only builder is the Morton-code LBVH (\`--leaf-size\` is its
+  one knob);
+- non-watertight ray/triangle intersection (Möller–Trumbore): only the watertight test is
+  implemented;
+- a double-precision CPU reference: the CPU integrator computes in float (only the film
+  accumulates in double), so the reference shares the renderer's float arithmetic.
+EOF
+} >"$doc"
+echo "wrote $doc and $plots/accuracy-*.png in ${elapsed}s of rendering"
