@@ -41,6 +41,7 @@ struct SceneData {
   RenderParams params{};
   int spp = 0;
   EffectSet effects;
+  vec3 shift{0.0f};  // subtracted from every coordinate of a scene far from the origin
 };
 
 SceneData prepareScene(const Scene& scene, const RenderSettings& settings);
