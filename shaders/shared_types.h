@@ -145,6 +145,28 @@ struct DeviceCounters {
   uint maxLoopIterations;  // 4 bytes: most loop iterations one invocation counted
 };                         // 16 bytes
 
+// ---- Ray queries (shaders/raycast.comp: traversal tested on its own) --------------------
+
+#define PT_RAYCAST_BINDING_NODES 0      // BvhNode[]
+#define PT_RAYCAST_BINDING_TRIANGLES 1  // Triangle[]
+#define PT_RAYCAST_BINDING_QUERIES 2    // RayQuery[]
+#define PT_RAYCAST_BINDING_RESULTS 3    // RayResult[]
+PT_CONST uint kRaycastWorkgroupSize = 64u;
+
+struct RayQuery {
+  vec3 origin;     // 12 bytes
+  float tMax;      //  4 bytes: hits with 0 < t < tMax count
+  vec3 direction;  // 12 bytes: need not be unit length
+  uint anyHit;     //  4 bytes: 1: stop at the first hit found (shadow ray), 0: closest
+};                 // 32 bytes
+
+struct RayResult {
+  float t;         // 4 bytes: distance of the hit, tMax when none
+  uint triangle;   // 4 bytes: index into the triangle buffer (leaf order)
+  uint found;      // 4 bytes: 1 when something was hit
+  uint truncated;  // 4 bytes: 1 when lavapipe's loop cap cut the traversal short
+};                 // 16 bytes
+
 // ---- Random-number dimensions ----------------------------------------------------------
 // Random numbers are a pure function of (pixel, sample index, dimension, seed); see
 // sampling.h. One dimension yields up to two numbers. Each path uses dimension kDimPixel for

@@ -2,6 +2,7 @@
 // one staging buffer, one descriptor set, one compute pipeline specialised to the scene's
 // effect set, one command buffer re-recorded per batch of passes.
 #include "vulkan/backend.h"
+#include "vulkan/resources.h"
 
 #include <algorithm>
 #include <chrono>
@@ -14,78 +15,10 @@
 namespace pt {
 namespace {
 
-struct Buffer {
-  vk::raii::Buffer buffer{nullptr};
-  vk::raii::DeviceMemory memory{nullptr};
-  vk::DeviceSize size = 0;
-  void* mapped = nullptr;  // host-visible buffers only
-};
-
-uint32_t findMemoryType(const VulkanContext& ctx, uint32_t typeBits, vk::MemoryPropertyFlags want) {
-  const auto props = ctx.physicalDevice.getMemoryProperties();
-  for (uint32_t i = 0; i < props.memoryTypeCount; ++i) {
-    if ((typeBits & (1u << i)) && (props.memoryTypes[i].propertyFlags & want) == want) return i;
-  }
-  throw vk::SystemError(vk::make_error_code(vk::Result::eErrorOutOfDeviceMemory),
-                        "no memory type with the required properties");
-}
-
-Buffer makeBuffer(const VulkanContext& ctx, vk::DeviceSize size, vk::BufferUsageFlags usage,
-                  bool hostVisible) {
-  Buffer b;
-  b.size = size;
-  b.buffer = vk::raii::Buffer(ctx.device, vk::BufferCreateInfo({}, size, usage));
-  const vk::MemoryRequirements req = b.buffer.getMemoryRequirements();
-  const auto props = hostVisible ? vk::MemoryPropertyFlagBits::eHostVisible |
-                                       vk::MemoryPropertyFlagBits::eHostCoherent
-                                 : vk::MemoryPropertyFlagBits::eDeviceLocal;
-  b.memory = vk::raii::DeviceMemory(
-      ctx.device, vk::MemoryAllocateInfo(req.size, findMemoryType(ctx, req.memoryTypeBits, props)));
-  b.buffer.bindMemory(*b.memory, 0);
-  if (hostVisible) b.mapped = b.memory.mapMemory(0, size);
-  return b;
-}
-
-// Storage buffers larger than the device allows would be silently cut short (lavapipe's
-// maxStorageBufferRange is 128 MiB): refuse them with the numbers instead.
-void checkRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size) {
-  if (size > ctx.limits.maxStorageBufferRange) {
-    throw InputError("scene too large for " + ctx.info().name + ": the " + what + " buffer is " +
-                     std::to_string(size >> 20) + " MiB, the device's maxStorageBufferRange is " +
-                     std::to_string(ctx.limits.maxStorageBufferRange >> 20) + " MiB");
-  }
-}
-
 // The effect set as specialization constants, in PT_SPEC_* id order.
 struct SpecData {
   vk::Bool32 values[6];
 };
-
-vk::raii::Pipeline makePipeline(const VulkanContext& ctx, const vk::raii::PipelineLayout& layout,
-                                const vk::raii::ShaderModule& module, const EffectSet& fx,
-                                bool specialize) {
-  SpecData spec{};
-  spec.values[PT_SPEC_DIFFUSE] = !specialize || fx.diffuse;
-  spec.values[PT_SPEC_MIRROR] = !specialize || fx.mirror;
-  spec.values[PT_SPEC_NEE] = !specialize || fx.lightSampling;
-  spec.values[PT_SPEC_BSDF_EMISSION] = !specialize || fx.bsdfEmission;
-  spec.values[PT_SPEC_MIS] = !specialize || fx.mis;
-  spec.values[PT_SPEC_RR] = !specialize || fx.russianRoulette;
-  std::vector<vk::SpecializationMapEntry> entries;
-  for (uint32_t id = 0; id < 6; ++id)
-    entries.emplace_back(id, uint32_t(id * sizeof(vk::Bool32)), sizeof(vk::Bool32));
-  const vk::SpecializationInfo specInfo(entries, vk::ArrayProxyNoTemporaries<const SpecData>(spec));
-  const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *module,
-                                                "main", &specInfo);
-  return vk::raii::Pipeline(ctx.device, nullptr, vk::ComputePipelineCreateInfo({}, stage, *layout));
-}
-
-// Makes writes of one stage visible to the reads/writes of the next.
-void barrier(const vk::raii::CommandBuffer& cmd, vk::PipelineStageFlags src,
-             vk::AccessFlags srcAccess, vk::PipelineStageFlags dst, vk::AccessFlags dstAccess) {
-  const vk::MemoryBarrier mb(srcAccess, dstAccess);
-  cmd.pipelineBarrier(src, dst, {}, mb, {}, {});
-}
 
 }  // namespace
 
@@ -133,57 +66,32 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   Buffer staging = makeBuffer(ctx, stagingSize, U::eTransferSrc, true);
   Buffer readback = makeBuffer(ctx, accumSize + sizeof(DeviceCounters), U::eTransferDst, true);
 
-  // ---- Pipeline ---------------------------------------------------------------------------
-  std::vector<vk::DescriptorSetLayoutBinding> bindings;
-  for (uint32_t b = 0; b < PT_BINDING_COUNT; ++b)
-    bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1,
-                          vk::ShaderStageFlagBits::eCompute);
-  const vk::raii::DescriptorSetLayout setLayout(ctx.device,
-                                                vk::DescriptorSetLayoutCreateInfo({}, bindings));
-  const vk::PushConstantRange pushRange(vk::ShaderStageFlagBits::eCompute, 0,
-                                        sizeof(PassConstants));
-  const vk::raii::PipelineLayout pipelineLayout(
-      ctx.device, vk::PipelineLayoutCreateInfo({}, *setLayout, pushRange));
-  const vk::raii::ShaderModule module =
-      debugPrintf
-          ? vk::raii::ShaderModule(
-                ctx.device,
-                vk::ShaderModuleCreateInfo({}, sizeof(kPathtraceDebugSpv), kPathtraceDebugSpv))
-          : vk::raii::ShaderModule(
-                ctx.device, vk::ShaderModuleCreateInfo({}, sizeof(kPathtraceSpv), kPathtraceSpv));
-  const vk::raii::Pipeline pipeline =
-      makePipeline(ctx, pipelineLayout, module, scene.effects, options.specialize);
-
-  const vk::DescriptorPoolSize poolSize(vk::DescriptorType::eStorageBuffer, PT_BINDING_COUNT);
-  const vk::raii::DescriptorPool pool(
-      ctx.device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
-                                               1, poolSize));
-  vk::raii::DescriptorSets sets(ctx.device, vk::DescriptorSetAllocateInfo(*pool, *setLayout));
-  const vk::raii::DescriptorSet& set = sets[0];
-  std::vector<vk::DescriptorBufferInfo> infos;
-  for (const Buffer& b : buffers) infos.emplace_back(*b.buffer, 0, b.size);
-  std::vector<vk::WriteDescriptorSet> writes;
-  for (uint32_t b = 0; b < PT_BINDING_COUNT; ++b)
-    writes.emplace_back(*set, b, 0, vk::DescriptorType::eStorageBuffer, nullptr, infos[b]);
-  ctx.device.updateDescriptorSets(writes, {});
+  // ---- Pipeline, specialised to the scene's effect set --------------------------------------
+  const EffectSet& fx = scene.effects;
+  const bool all = !options.specialize;
+  const SpecData spec{{all || fx.diffuse, all || fx.mirror, all || fx.lightSampling,
+                       all || fx.bsdfEmission, all || fx.mis, all || fx.russianRoulette}};
+  static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
+                PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5);
+  std::vector<vk::SpecializationMapEntry> entries;
+  for (uint32_t id = 0; id < 6; ++id) {
+    entries.emplace_back(id, uint32_t(id * sizeof(vk::Bool32)), sizeof(vk::Bool32));
+  }
+  const vk::SpecializationInfo specInfo(entries,
+                                        vk::ArrayProxyNoTemporaries<const SpecData>(spec));
+  std::vector<const Buffer*> bound;
+  for (const Buffer& b : buffers) bound.push_back(&b);
+  const std::span<const uint32_t> spirv =
+      debugPrintf ? std::span<const uint32_t>(kPathtraceDebugSpv) : std::span<const uint32_t>(kPathtraceSpv);
+  const ComputeProgram program =
+      makeComputeProgram(ctx, spirv, bound, sizeof(PassConstants), &specInfo);
 
   // ---- Commands ---------------------------------------------------------------------------
-  const vk::raii::CommandPool commandPool(
-      ctx.device, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eResetCommandBuffer,
-                                            ctx.queueFamily));
-  vk::raii::CommandBuffers commandBuffers(
-      ctx.device, vk::CommandBufferAllocateInfo(*commandPool, vk::CommandBufferLevel::ePrimary, 1));
-  const vk::raii::CommandBuffer& cmd = commandBuffers[0];
-  const vk::raii::Fence fence(ctx.device, vk::FenceCreateInfo());
+  const Commands commands(ctx);
+  const vk::raii::CommandBuffer& cmd = commands.cmd;
   const vk::raii::QueryPool queries(ctx.device,
                                     vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, 2));
-  auto submitAndWait = [&]() {
-    cmd.end();
-    ctx.queue.submit(vk::SubmitInfo({}, {}, *cmd), *fence);
-    const vk::Result r = ctx.device.waitForFences(*fence, VK_TRUE, UINT64_MAX);
-    PT_CHECK(r == vk::Result::eSuccess);
-    ctx.device.resetFences(*fence);
-  };
+  auto submitAndWait = [&]() { commands.submitAndWait(ctx); };
   using S = vk::PipelineStageFlagBits;
   using A = vk::AccessFlagBits;
   auto clearAccumulators = [&]() {
@@ -199,7 +107,7 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
                                                        : ~0u;
   auto dispatch = [&](uint32_t sampleIndex, uint32_t gx, uint32_t gy) {
     const PassConstants pc{sampleIndex, debugPixel, 0u, 0u};
-    cmd.pushConstants<PassConstants>(*pipelineLayout, vk::ShaderStageFlagBits::eCompute, 0, pc);
+    cmd.pushConstants<PassConstants>(*program.layout, vk::ShaderStageFlagBits::eCompute, 0, pc);
     cmd.dispatch(gx, gy, 1);
     barrier(cmd, S::eComputeShader, A::eShaderWrite, S::eComputeShader | S::eTransfer,
             A::eShaderRead | A::eShaderWrite | A::eTransferRead);
@@ -212,15 +120,14 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
     std::memcpy(static_cast<char*>(staging.mapped) + offset, uploads[i].data, uploads[i].size);
     offset += uploads[i].size;
   }
-  cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
+  commands.begin();
   offset = 0;
   for (size_t i = 0; i < std::size(uploads); ++i) {
     cmd.copyBuffer(*staging.buffer, *buffers[i].buffer, vk::BufferCopy(offset, 0, uploads[i].size));
     offset += uploads[i].size;
   }
   clearAccumulators();
-  cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline);
-  cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipelineLayout, 0, *set, {});
+  program.bind(cmd);
   dispatch(0u, 1u, 1u);
   barrier(cmd, S::eComputeShader, A::eShaderWrite, S::eTransfer, A::eTransferWrite);
   clearAccumulators();
@@ -234,10 +141,9 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   const int perFlush = std::max(1, options.passesPerFlush);
   for (int done = 0; done < options.spp;) {
     const int passes = std::min(perFlush, options.spp - done);
-    cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
+    commands.begin();
     cmd.resetQueryPool(*queries, 0, 2);
-    cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline);
-    cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipelineLayout, 0, *set, {});
+    program.bind(cmd);
     cmd.writeTimestamp(S::eTopOfPipe, *queries, 0);
     for (int p = 0; p < passes; ++p)
       dispatch(options.firstSample + uint32_t(done + p), groupsX, groupsY);

@@ -1,0 +1,114 @@
+// Vulkan helpers; see resources.h.
+#include "vulkan/resources.h"
+
+#include <string>
+
+#include "common/check.h"
+
+namespace pt {
+namespace {
+
+uint32_t findMemoryType(const VulkanContext& ctx, uint32_t typeBits, vk::MemoryPropertyFlags want) {
+  const auto props = ctx.physicalDevice.getMemoryProperties();
+  for (uint32_t i = 0; i < props.memoryTypeCount; ++i) {
+    if ((typeBits & (1u << i)) && (props.memoryTypes[i].propertyFlags & want) == want) return i;
+  }
+  throw vk::SystemError(vk::make_error_code(vk::Result::eErrorOutOfDeviceMemory),
+                        "no memory type with the required properties");
+}
+
+}  // namespace
+
+Buffer makeBuffer(const VulkanContext& ctx, vk::DeviceSize size, vk::BufferUsageFlags usage,
+                  bool hostVisible) {
+  Buffer b;
+  b.size = size;
+  b.buffer = vk::raii::Buffer(ctx.device, vk::BufferCreateInfo({}, size, usage));
+  const vk::MemoryRequirements req = b.buffer.getMemoryRequirements();
+  const auto props = hostVisible ? vk::MemoryPropertyFlagBits::eHostVisible |
+                                       vk::MemoryPropertyFlagBits::eHostCoherent
+                                 : vk::MemoryPropertyFlagBits::eDeviceLocal;
+  b.memory = vk::raii::DeviceMemory(
+      ctx.device, vk::MemoryAllocateInfo(req.size, findMemoryType(ctx, req.memoryTypeBits, props)));
+  b.buffer.bindMemory(*b.memory, 0);
+  if (hostVisible) b.mapped = b.memory.mapMemory(0, size);
+  return b;
+}
+
+void checkRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size) {
+  if (size > ctx.limits.maxStorageBufferRange) {
+    throw InputError("scene too large for " + ctx.info().name + ": the " + what + " buffer is " +
+                     std::to_string(size >> 20) + " MiB, the device's maxStorageBufferRange is " +
+                     std::to_string(ctx.limits.maxStorageBufferRange >> 20) + " MiB");
+  }
+}
+
+void barrier(const vk::raii::CommandBuffer& cmd, vk::PipelineStageFlags src,
+             vk::AccessFlags srcAccess, vk::PipelineStageFlags dst, vk::AccessFlags dstAccess) {
+  const vk::MemoryBarrier mb(srcAccess, dstAccess);
+  cmd.pipelineBarrier(src, dst, {}, mb, {}, {});
+}
+
+ComputeProgram makeComputeProgram(const VulkanContext& ctx, std::span<const uint32_t> spirv,
+                                  const std::vector<const Buffer*>& buffers,
+                                  uint32_t pushConstantSize,
+                                  const vk::SpecializationInfo* specialization) {
+  ComputeProgram p;
+  const uint32_t n = uint32_t(buffers.size());
+  std::vector<vk::DescriptorSetLayoutBinding> bindings;
+  for (uint32_t b = 0; b < n; ++b) {
+    bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1,
+                          vk::ShaderStageFlagBits::eCompute);
+  }
+  p.setLayout = vk::raii::DescriptorSetLayout(ctx.device, vk::DescriptorSetLayoutCreateInfo({}, bindings));
+  const vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, pushConstantSize);
+  p.layout = vk::raii::PipelineLayout(ctx.device, vk::PipelineLayoutCreateInfo({}, *p.setLayout, push));
+  p.module = vk::raii::ShaderModule(
+      ctx.device, vk::ShaderModuleCreateInfo({}, spirv.size_bytes(), spirv.data()));
+  const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *p.module,
+                                                "main", specialization);
+  p.pipeline = vk::raii::Pipeline(ctx.device, nullptr, vk::ComputePipelineCreateInfo({}, stage, *p.layout));
+
+  const vk::DescriptorPoolSize poolSize(vk::DescriptorType::eStorageBuffer, n);
+  p.pool = vk::raii::DescriptorPool(
+      ctx.device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
+                                               1, poolSize));
+  vk::raii::DescriptorSets sets(ctx.device, vk::DescriptorSetAllocateInfo(*p.pool, *p.setLayout));
+  p.set = std::move(sets.front());
+  std::vector<vk::DescriptorBufferInfo> infos;
+  for (const Buffer* b : buffers) infos.emplace_back(*b->buffer, 0, b->size);
+  std::vector<vk::WriteDescriptorSet> writes;
+  for (uint32_t b = 0; b < n; ++b) {
+    writes.emplace_back(*p.set, b, 0, vk::DescriptorType::eStorageBuffer, nullptr, infos[b]);
+  }
+  ctx.device.updateDescriptorSets(writes, {});
+  return p;
+}
+
+void ComputeProgram::bind(const vk::raii::CommandBuffer& cmd) const {
+  cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline);
+  cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *layout, 0, *set, {});
+}
+
+Commands::Commands(const VulkanContext& ctx)
+    : pool(ctx.device, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eResetCommandBuffer,
+                                                 ctx.queueFamily)),
+      fence(ctx.device, vk::FenceCreateInfo()) {
+  vk::raii::CommandBuffers buffers(
+      ctx.device, vk::CommandBufferAllocateInfo(*pool, vk::CommandBufferLevel::ePrimary, 1));
+  cmd = std::move(buffers.front());
+}
+
+void Commands::begin() const {
+  cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
+}
+
+void Commands::submitAndWait(const VulkanContext& ctx) const {
+  cmd.end();
+  ctx.queue.submit(vk::SubmitInfo({}, {}, *cmd), *fence);
+  const vk::Result r = ctx.device.waitForFences(*fence, VK_TRUE, UINT64_MAX);
+  PT_CHECK(r == vk::Result::eSuccess);
+  ctx.device.resetFences(*fence);
+}
+
+}  // namespace pt

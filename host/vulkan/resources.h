@@ -1,0 +1,61 @@
+// Small Vulkan helpers shared by the render and the ray-query pipelines: buffers with their
+// memory, the storage-buffer size check, a memory barrier.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "vulkan/context.h"
+
+namespace pt {
+
+struct Buffer {
+  vk::raii::Buffer buffer{nullptr};
+  vk::raii::DeviceMemory memory{nullptr};
+  vk::DeviceSize size = 0;
+  void* mapped = nullptr;  // host-visible buffers only
+};
+
+// A buffer in device-local memory, or host-visible coherent memory mapped for its lifetime.
+Buffer makeBuffer(const VulkanContext& ctx, vk::DeviceSize size, vk::BufferUsageFlags usage,
+                  bool hostVisible);
+
+// Storage buffers larger than the device allows would be silently cut short (lavapipe's
+// maxStorageBufferRange is 128 MiB): refuse them with the numbers instead (InputError).
+void checkRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size);
+
+// Makes writes of one stage visible to the reads/writes of the next.
+void barrier(const vk::raii::CommandBuffer& cmd, vk::PipelineStageFlags src,
+             vk::AccessFlags srcAccess, vk::PipelineStageFlags dst, vk::AccessFlags dstAccess);
+
+// A compute pipeline whose set 0 binds `buffers` as storage buffers 0, 1, ..., with a push
+// constant block of pushConstantSize bytes. Members in creation order: C++ destroys them in
+// reverse, the set before its pool, the pipeline before its layouts.
+struct ComputeProgram {
+  vk::raii::DescriptorSetLayout setLayout{nullptr};
+  vk::raii::PipelineLayout layout{nullptr};
+  vk::raii::ShaderModule module{nullptr};
+  vk::raii::Pipeline pipeline{nullptr};
+  vk::raii::DescriptorPool pool{nullptr};
+  vk::raii::DescriptorSet set{nullptr};
+
+  void bind(const vk::raii::CommandBuffer& cmd) const;
+};
+
+ComputeProgram makeComputeProgram(const VulkanContext& ctx, std::span<const uint32_t> spirv,
+                                  const std::vector<const Buffer*>& buffers,
+                                  uint32_t pushConstantSize,
+                                  const vk::SpecializationInfo* specialization = nullptr);
+
+// One command buffer, recorded and submitted synchronously, again and again.
+struct Commands {
+  explicit Commands(const VulkanContext& ctx);
+  void begin() const;
+  void submitAndWait(const VulkanContext& ctx) const;
+
+  vk::raii::CommandPool pool;
+  vk::raii::CommandBuffer cmd{nullptr};
+  vk::raii::Fence fence;
+};
+
+}  // namespace pt
