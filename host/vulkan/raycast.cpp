@@ -1,0 +1,57 @@
+// Ray queries on the device; see raycast.h.
+#include "vulkan/raycast.h"
+
+#include <cstring>
+
+#include "common/check.h"
+#include "raycast_spv.h"  // kRaycastSpv: shaders/raycast.comp
+#include "vulkan/resources.h"
+
+namespace pt {
+
+std::vector<RayResult> traceRaysVulkan(const Bvh& bvh, const std::vector<RayQuery>& queries,
+                                       const ContextOptions& options, RaycastStats* stats) {
+  std::vector<RayResult> results(queries.size());
+  if (queries.empty()) return results;
+  VulkanContext ctx(options);
+  using U = vk::BufferUsageFlagBits;
+  const vk::DeviceSize sizes[] = {bvh.nodes.size() * sizeof(BvhNode),
+                                  bvh.triangles.size() * sizeof(Triangle),
+                                  queries.size() * sizeof(RayQuery),
+                                  queries.size() * sizeof(RayResult)};
+  const char* names[] = {"BVH node", "triangle", "ray query", "ray result"};
+  const void* data[] = {bvh.nodes.data(), bvh.triangles.data(), queries.data()};
+  // Host-visible buffers throughout: this is a test tool, not a hot path.
+  std::vector<Buffer> buffers;
+  for (int i = 0; i < 4; ++i) {
+    checkRange(ctx, names[i], sizes[i]);
+    buffers.push_back(makeBuffer(ctx, sizes[i], U::eStorageBuffer, /*hostVisible=*/true));
+    if (i < 3) std::memcpy(buffers[i].mapped, data[i], sizes[i]);
+  }
+  const std::vector<const Buffer*> bound = {&buffers[0], &buffers[1], &buffers[2], &buffers[3]};
+  const ComputeProgram program = makeComputeProgram(ctx, kRaycastSpv, bound, sizeof(uint32_t));
+
+  const uint64_t groups = (queries.size() + kRaycastWorkgroupSize - 1) / kRaycastWorkgroupSize;
+  PT_CHECK(groups <= ctx.limits.maxComputeWorkGroupCount[0], "too many rays for one dispatch");
+  const Commands commands(ctx);
+  commands.begin();
+  program.bind(commands.cmd);
+  const uint32_t count = uint32_t(queries.size());
+  commands.cmd.pushConstants<uint32_t>(*program.layout, vk::ShaderStageFlagBits::eCompute, 0,
+                                       count);
+  commands.cmd.dispatch(uint32_t(groups), 1, 1);
+  barrier(commands.cmd, vk::PipelineStageFlagBits::eComputeShader,
+          vk::AccessFlagBits::eShaderWrite, vk::PipelineStageFlagBits::eHost,
+          vk::AccessFlagBits::eHostRead);
+  commands.submitAndWait(ctx);
+
+  std::memcpy(results.data(), buffers[3].mapped, sizes[3]);
+  if (stats) {
+    stats->validationErrors = ctx.validationErrors();
+    stats->truncated = 0;
+    for (const RayResult& r : results) stats->truncated += r.truncated;
+  }
+  return results;
+}
+
+}  // namespace pt
