@@ -40,4 +40,8 @@ static_assert(sizeof(PassConstants) == 16 && offsetof(PassConstants, debugPixel)
 static_assert(sizeof(AccumPixel) == 16 && offsetof(AccumPixel, invalid) == 12);
 static_assert(sizeof(DeviceCounters) == 16 && offsetof(DeviceCounters, truncated) == 8);
 
+static_assert(sizeof(RayQuery) == 32 && offsetof(RayQuery, direction) == 16);
+static_assert(offsetof(RayQuery, anyHit) == 28);
+static_assert(sizeof(RayResult) == 16 && offsetof(RayResult, truncated) == 12);
+
 }  // namespace pt
