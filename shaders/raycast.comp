@@ -21,7 +21,9 @@ layout(std430, set = 0, binding = PT_RAYCAST_BINDING_RESULTS) writeonly buffer R
   RayResult results[];
 };
 
-layout(push_constant) uniform Count { uint queryCount; };
+layout(push_constant) uniform Count {
+  uint queryCount;
+};
 
 bool gTruncated = false;
 uint gLoopIterations = 0u;
@@ -34,5 +36,6 @@ void main() {
   RayQuery q = queries[i];
   HitData hit;
   bool found = traceRay(q.origin, q.direction, q.tMax, q.anyHit != 0u, hit);
-  results[i] = RayResult(found ? hit.t : q.tMax, hit.triangle, found ? 1u : 0u, gTruncated ? 1u : 0u);
+  results[i] =
+      RayResult(found ? hit.t : q.tMax, hit.triangle, found ? 1u : 0u, gTruncated ? 1u : 0u);
 }

@@ -13,9 +13,7 @@
 #include "test_util.h"
 #include "vulkan/backend.h"
 
-// pt_tests links ptcore only and the converge logic lives with the command line, so this
-// file compiles it in directly (the `pt` target compiles it on its own).
-#include "cli/converge.cpp"
+#include "cli/converge.h"
 
 namespace pt {
 namespace {

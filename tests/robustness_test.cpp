@@ -64,9 +64,8 @@ TEST(RobustFurnace, ClosedFormOnBothBackendsUpToAlbedo099) {
       addClosedCube(scene, {0, m, 0, m, 0, 0});
       // Paths at albedo 0.99 average 100 bounces: fewer pixels, more samples each.
       const int size = a > 0.95f ? 8 : 16;
-      const SceneData data =
-          finish(scene, CameraDesc{vec3(0.1f, -0.2f, 0.05f), vec3(1, 0.3f, 0.7f), vec3(0, 1, 0),
-                                   90.0f, size, size});
+      const SceneData data = finish(scene, CameraDesc{vec3(0.1f, -0.2f, 0.05f), vec3(1, 0.3f, 0.7f),
+                                                      vec3(0, 1, 0), 90.0f, size, size});
       const int spp = a > 0.95f ? 64 : 16;
       const Comparison c = renderBoth(data, spp);
       EXPECT_EQ(c.cpu.invalidSamples + c.gpu.invalidSamples, 0u);
@@ -113,10 +112,10 @@ SceneData litBox(const std::function<void(Scene&)>& extra) {
 TEST(RobustDegenerate, SliverAndZeroAreaEmitters) {
   const SceneData data = litBox([](Scene& scene) {
     // A needle-thin sliver emitter, and a zero-area (collinear) one that must never be sampled.
-    scene.triangles.push_back(Triangle{vec3(-0.5f, 0, 0), 2, vec3(0.5f, 0, 0), kNoEmitter,
-                                       vec3(0.5f, 1e-6f, 0), 0});
-    scene.triangles.push_back(Triangle{vec3(-0.5f, 0.2f, 0), 2, vec3(0.5f, 0.2f, 0), kNoEmitter,
-                                       vec3(0, 0.2f, 0), 0});
+    scene.triangles.push_back(
+        Triangle{vec3(-0.5f, 0, 0), 2, vec3(0.5f, 0, 0), kNoEmitter, vec3(0.5f, 1e-6f, 0), 0});
+    scene.triangles.push_back(
+        Triangle{vec3(-0.5f, 0.2f, 0), 2, vec3(0.5f, 0.2f, 0), kNoEmitter, vec3(0, 0.2f, 0), 0});
   });
   for (const Emitter& e : data.emitters) {
     const Triangle& t = data.bvh.triangles[e.triangle];
@@ -140,8 +139,8 @@ TEST(RobustDegenerate, CameraInsideAClosedObject) {
                      Material{vec3(0.0f), kMaterialDiffuse, vec3(5.0f), 0}};
   for (Triangle t : test::makeSphere(vec3(0), 0.3f, 12, 16)) scene.triangles.push_back(t);
   addQuad(scene, vec3(0, 2, 0), vec3(0.5f, 0, 0), vec3(0, 0, 0.5f), 1);  // light outside
-  const SceneData data =
-      finish(scene, CameraDesc{vec3(0.01f, 0.02f, 0), vec3(0, 0, 1), vec3(0, 1, 0), 90, 16, 16}, 64);
+  const SceneData data = finish(
+      scene, CameraDesc{vec3(0.01f, 0.02f, 0), vec3(0, 0, 1), vec3(0, 1, 0), 90, 16, 16}, 64);
   const Comparison c = renderBoth(data, 8);
   EXPECT_EQ(c.cpu.invalidSamples + c.gpu.invalidSamples, 0u);
   for (const vec3& p : c.gpuImage.pixels) EXPECT_EQ(p, vec3(0.0f));
@@ -154,9 +153,9 @@ TEST(RobustDegenerate, EmitterFacingAwayAndGrazingLight) {
   Scene scene;
   scene.materials = {Material{vec3(0.7f), kMaterialDiffuse, vec3(0.0f), 0},
                      Material{vec3(0.0f), kMaterialDiffuse, vec3(10.0f), 0}};
-  addQuad(scene, vec3(0), vec3(0, 0, 2), vec3(2, 0, 0), 0);                // floor, normal +y
+  addQuad(scene, vec3(0), vec3(0, 0, 2), vec3(2, 0, 0), 0);  // floor, normal +y
   addQuad(scene, vec3(0, 0.25f, 0), vec3(0, 0.25f, 0), vec3(0.5f, 0, 0) * -1.0f, 1);  // upright
-  addQuad(scene, vec3(0, 3, 0), vec3(0.5f, 0, 0), vec3(0, 0, 0.5f), 1);    // faces up, away
+  addQuad(scene, vec3(0, 3, 0), vec3(0.5f, 0, 0), vec3(0, 0, 0.5f), 1);  // faces up, away
   const SceneData data =
       finish(scene, CameraDesc{vec3(0, 1.5f, -2.5f), vec3(0), vec3(0, 1, 0), 60, 24, 24}, 64);
   expectSaneAndAgreeing(data, 8, 100.0f);
@@ -169,8 +168,8 @@ TEST(RobustDegenerate, TwoFacingMirrorsAtMaxDepth64) {
   addQuad(scene, vec3(0, 0, 1), vec3(0, 3, 0), vec3(3, 0, 0), 0);   // faces -z
   addQuad(scene, vec3(0, 0, -1), vec3(3, 0, 0), vec3(0, 3, 0), 0);  // faces +z
   addQuad(scene, vec3(0, 2, 0), vec3(0.3f, 0, 0), vec3(0, 0, 0.3f), 1);
-  const SceneData data =
-      finish(scene, CameraDesc{vec3(0.1f, 0, 0.5f), vec3(0.2f, -0.2f, -1), vec3(0, 1, 0), 50, 16, 16}, 64);
+  const SceneData data = finish(
+      scene, CameraDesc{vec3(0.1f, 0, 0.5f), vec3(0.2f, -0.2f, -1), vec3(0, 1, 0), 50, 16, 16}, 64);
   expectSaneAndAgreeing(data, 8, 100.0f);
 }
 

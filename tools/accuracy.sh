@@ -2,19 +2,20 @@
 # What accuracy costs in time: renders a high-spp CPU reference of the Cornell box and of the
 # bunny, runs `pt converge` for each knob on the CPU and on the Vulkan backend, merges the
 # CSVs, plots relMSE against seconds (docs/plots/*.png) and writes docs/accuracy.md.
-#   tools/accuracy.sh [SIZE] [MAX_SPP]        (default 64 128)
+#   tools/accuracy.sh [SIZE] [MAX_SPP]        (default 64 256)
 # Environment:
 #   REF_SPP  reference samples per pixel (default 32 x MAX_SPP)
 #   TARGET   relMSE whose time to reach is tabulated (default 0.01)
 #   THREADS  CPU threads, and LP_NUM_THREADS for lavapipe (default: all cores)
 #   BUILD    build directory (default build)
 #   REUSE_REF=1 keeps a reference already rendered with the same size, spp and seed
+#   REPORT_ONLY=1 renders nothing: redraws the plots and the document from the last run
 # Renders run one at a time. Outputs: out/accuracy/ (references, CSVs, logs), docs/plots/,
 # docs/accuracy.md (a hand-written block between the notes markers survives a rerun).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 size=${1:-64}
-max_spp=${2:-128}
+max_spp=${2:-256}
 ref_spp=${REF_SPP:-$((32 * max_spp))}
 target=${TARGET:-0.01}
 threads=${THREADS:-$(nproc)}
@@ -49,45 +50,54 @@ cmake --build "$build" --target pt
 pt=$build/pt
 export LP_NUM_THREADS=$threads
 mkdir -p "$out/csv" "$out/logs" "$out/dat" "$plots"
-rm -f "$out"/csv/*.csv "$out"/dat/*.dat "$plots"/accuracy-*.png
-started=$SECONDS
-problems=()
-
-for scene in "${scenes[@]}"; do
-  ref=$out/$scene-ref-${size}px-${ref_spp}spp-seed$ref_seed.exr
-  if [[ ${REUSE_REF:-0} == 1 && -f $ref ]]; then
-    echo "== $scene: reusing $ref"
-  else
-    echo "== $scene: reference, CPU, $ref_spp spp, seed $ref_seed"
-    "$pt" render "configs/$scene.json" --backend cpu --threads "$threads" --width "$size" \
-      --height "$size" --spp "$ref_spp" --seed "$ref_seed" --out "$ref" 2>/dev/null
-  fi
-  for backend in cpu vulkan; do
-    labels=$cpu_labels
-    [[ $backend == vulkan ]] && labels=$vulkan_labels
-    for label in $labels; do
-      name=$scene.$backend.$label
-      # shellcheck disable=SC2086  # flags are words
-      if "$pt" converge "configs/$scene.json" --backend "$backend" --threads "$threads" \
-        --width "$size" --height "$size" --max-spp "$max_spp" --reference "$ref" \
-        --label "$label" --csv "$out/csv/$name.csv" ${flags[$label]} >"$out/logs/$name.txt" \
-        2>"$out/logs/$name.err"; then
-        status=0
-      else
-        status=$?
-      fi
-      # Status 1: some samples were NaN/Inf or cut short; the rows are kept and flagged.
-      if ((status == 1)); then
-        problems+=("$name: $(tail -1 "$out/logs/$name.err")")
-      elif ((status != 0)); then
-        cat "$out/logs/$name.err" >&2
-        exit "$status"
-      fi
-      echo "$name: $(tail -1 "$out/logs/$name.txt")  (elapsed ${SECONDS}s)"
+run_info=$out/run.env  # what the document says about the run: kept for REPORT_ONLY=1
+if [[ ${REPORT_ONLY:-0} == 1 ]]; then
+  # shellcheck source=/dev/null
+  source "$run_info"
+else
+  rm -f "$out"/csv/*.csv "$out"/problems.txt
+  started=$SECONDS
+  for scene in "${scenes[@]}"; do
+    ref=$out/$scene-ref-${size}px-${ref_spp}spp-seed$ref_seed.exr
+    if [[ ${REUSE_REF:-0} == 1 && -f $ref ]]; then
+      echo "== $scene: reusing $ref"
+    else
+      echo "== $scene: reference, CPU, $ref_spp spp, seed $ref_seed"
+      "$pt" render "configs/$scene.json" --backend cpu --threads "$threads" --width "$size" \
+        --height "$size" --spp "$ref_spp" --seed "$ref_seed" --out "$ref" 2>/dev/null
+    fi
+    for backend in cpu vulkan; do
+      labels=$cpu_labels
+      [[ $backend == vulkan ]] && labels=$vulkan_labels
+      for label in $labels; do
+        name=$scene.$backend.$label
+        # shellcheck disable=SC2086  # flags are words
+        if "$pt" converge "configs/$scene.json" --backend "$backend" --threads "$threads" \
+          --width "$size" --height "$size" --max-spp "$max_spp" --reference "$ref" \
+          --label "$label" --csv "$out/csv/$name.csv" ${flags[$label]} >"$out/logs/$name.txt" \
+          2>"$out/logs/$name.err"; then
+          status=0
+        else
+          status=$?
+        fi
+        # Status 1: some samples were NaN/Inf or cut short; the rows are kept and flagged.
+        if ((status == 1)); then
+          echo "$name: $(tail -1 "$out/logs/$name.err")" >>"$out/problems.txt"
+        elif ((status != 0)); then
+          cat "$out/logs/$name.err" >&2
+          exit "$status"
+        fi
+        echo "$name: $(tail -1 "$out/logs/$name.txt")  (elapsed ${SECONDS}s)"
+      done
     done
   done
-done
-elapsed=$((SECONDS - started))
+  elapsed=$((SECONDS - started))
+  cpu_model=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
+  vk_device=$("$pt" devices 2>/dev/null | head -1 | sed 's/^[0-9]*: //') || vk_device="(none)"
+  run_date=$(date -u +%Y-%m-%d)
+  declare -p size max_spp ref_spp threads elapsed cpu_model vk_device run_date >"$run_info"
+fi
+rm -f "$out"/dat/*.dat "$out"/dat/*.guide "$plots"/accuracy-*.png
 
 # ---- Merge, split per curve for gnuplot ------------------------------------------------------
 merged=$out/accuracy.csv
@@ -105,10 +115,11 @@ else
   term="png size 900,620"
 fi
 declare -A pretty=([cornell-box]="Cornell box" [bunny-box]="Bunny box")
+colors=('#000000' '#d95f02' '#1b9e77' '#7570b3' '#e7298a')
 for scene in "${scenes[@]}"; do
   for g in "${groups[@]}"; do
     IFS='|' read -r gname gtitle glabels <<<"$g"
-    cmds=() color=1
+    cmds=() color=0
     for label in $glabels; do
       for backend in cpu vulkan; do
         dat=$out/dat/$scene.$backend.$label.dat
@@ -116,11 +127,19 @@ for scene in "${scenes[@]}"; do
         [[ $gname == specialize && $backend == cpu ]] && continue
         dt=1 pt_=7
         [[ $backend == vulkan ]] && dt=2 pt_=6
-        cmds+=("'$dat' using 2:3 with linespoints lc $color dt $dt pt $pt_ ps 0.8 title '$label ($backend)'")
+        cmds+=("'$dat' using 2:3 with linespoints lc rgb '${colors[$color]}' dt $dt pt $pt_ ps 0.8 title '$label ($backend)'")
       done
       color=$((color + 1))
     done
     cmds+=("$target with lines lc rgb 'gray50' dt 3 title 'target relMSE $target'")
+    # A slope -1 guide (relMSE proportional to 1/time, what an unbiased estimator follows
+    # at constant speed) through the baseline's last point.
+    guide_backend=cpu
+    [[ $gname == specialize ]] && guide_backend=vulkan
+    base=$out/dat/$scene.$guide_backend.baseline.dat
+    guide=$out/dat/$scene.$gname.guide
+    awk 'NR == 1 {t0 = $2} {t = $2; r = $3} END {print t0, r * t / t0; print t, r}' "$base" >"$guide"
+    cmds+=("'$guide' using 1:2 with lines lc rgb 'gray60' dt 4 title 'slope -1 through baseline ($guide_backend)'")
     plot=$(IFS=,; echo "${cmds[*]}")
     gnuplot <<EOF
 set terminal $term
@@ -132,7 +151,7 @@ set format y '10^{%L}'
 set xlabel 'cumulative render time (s): CPU wall clock, Vulkan device timestamps'
 set ylabel 'relMSE against the reference'
 set grid xtics ytics mxtics mytics lc rgb '#dddddd'
-set key outside right top noenhanced
+set key inside bottom left noenhanced box opaque
 plot $plot
 EOF
   done
@@ -144,8 +163,8 @@ done
 # time to reach the target relMSE and the relMSE at equal time T, where T (per backend) is
 # the smallest final time in the group, so that every curve reaches it. Both by linear
 # interpolation between levels on the log-log curve.
-table() {  # scene, labels
-  awk -F, -v scene="$1" -v labels="$2" -v target="$target" '
+table() {  # scene, labels, backends
+  awk -F, -v scene="$1" -v labels="$2" -v backends="$3" -v target="$target" '
     function g(x) { return sprintf("%.3g", x) }
     function lerp(x, x0, x1, y0, y1) { return y0 + (x - x0) / (x1 - x0) * (y1 - y0) }
     function timeTo(k,   i) {
@@ -173,14 +192,14 @@ table() {  # scene, labels
       k = $1 SUBSEP $2; i = ++n[k]; s[k, i] = $6; t[k, i] = $7; r[k, i] = $9; mr[k, i] = $10
     }
     END {
-      nl = split(labels, L, " "); split("cpu vulkan", B, " ")
-      for (b = 1; b <= 2; ++b) for (l = 1; l <= nl; ++l) {
+      nl = split(labels, L, " "); nb = split(backends, B, " ")
+      for (b = 1; b <= nb; ++b) for (l = 1; l <= nl; ++l) {
         k = L[l] SUBSEP B[b]
         if (n[k] && (!(B[b] in T) || t[k, n[k]] < T[B[b]])) T[B[b]] = t[k, n[k]]
       }
       print "| configuration | backend | spp | seconds | relMSE | slope | Mrays/s | seconds to relMSE " target " | relMSE at equal time |"
       print "|---|---|--:|--:|--:|--:|--:|--:|--:|"
-      for (l = 1; l <= nl; ++l) for (b = 1; b <= 2; ++b) {
+      for (l = 1; l <= nl; ++l) for (b = 1; b <= nb; ++b) {
         k = L[l] SUBSEP B[b]
         if (!n[k]) continue
         printf "| %s | %s | %d | %s | %s | %s | %s | %s | %s (at %s s) |\n", L[l], B[b], s[k, n[k]],
@@ -200,18 +219,21 @@ if [[ -f $doc ]] && grep -q '<!-- notes:begin -->' "$doc"; then
   notes=$(sed -n '/<!-- notes:begin -->/,/<!-- notes:end -->/p' "$doc")
 fi
 [[ -n $notes ]] || notes=$'<!-- notes:begin -->\n(none yet)\n<!-- notes:end -->'
-cpu_model=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
-vk_device=$("$pt" devices 2>/dev/null | head -1 | sed 's/^[0-9]*: //') || vk_device="(none)"
 {
   cat <<EOF
 # What accuracy costs in time
 
-Generated by \`tools/accuracy.sh $size $max_spp\` on $(date -u +%Y-%m-%d) (UTC): every number
-and plot below comes from that run. Machine: $(nproc) cores ($cpu_model), $threads CPU
-threads; Vulkan device: $vk_device. Image ${size}x${size}, \`pt converge\` levels 1, 2, 4, …
-$max_spp spp; references rendered on the CPU at $ref_spp spp with seed $ref_seed (the studied
-runs use the scenes' seed 0). The whole run took $((elapsed / 60)) min $((elapsed % 60)) s of
-wall time. The machine was shared with other work, so timings carry some noise.
+Generated by \`tools/accuracy.sh $size $max_spp\` on $run_date (UTC); every number and plot
+below comes from that run.
+
+- Machine: $(nproc) cores ($cpu_model), $threads CPU threads; Vulkan on
+  $vk_device.
+- Image ${size}x${size}; \`pt converge\` levels 1, 2, 4, … $max_spp spp; references rendered on
+  the CPU at $ref_spp spp with seed $ref_seed (the studied runs use the scenes' seed 0).
+- Rendering took $((elapsed / 60)) min $((elapsed % 60)) s of wall time, one render at a time.
+- Each configuration ran once, so its times carry whatever else the machine was doing (see
+  the notes on this run); the errors (relMSE at a given spp) are deterministic and do not
+  depend on the load.
 
 ## How to rerun
 
@@ -224,7 +246,8 @@ It installs packages and builds like the other tools, renders the references int
 time, merges the rows into \`out/accuracy/accuracy.csv\`, draws \`docs/plots/accuracy-*.png\`
 with gnuplot and rewrites this file (the notes block at the end is kept). \`REF_SPP\`,
 \`TARGET\`, \`THREADS\` and \`BUILD\` override the defaults (32 × MAX_SPP, 0.01, all cores,
-\`build\`). One configuration by hand:
+\`build\`); \`REPORT_ONLY=1\` redraws the plots and this file from the last run's CSVs without
+rendering. One configuration by hand:
 
 \`\`\`sh
 build/pt converge configs/cornell-box.json --backend cpu --width $size --height $size \\
@@ -249,12 +272,14 @@ build/pt converge configs/cornell-box.json --backend cpu --width $size --height 
   the log-log curve; "—" when T is before a configuration's first level.
 - The reference is itself noisy: at $ref_spp spp its own relMSE is roughly the baseline's
   error at $max_spp spp times $max_spp/$ref_spp, and that floor is included in every number.
-  RMSE is in the CSV too but is dominated by the few pixels on the light's edge (about 17
-  against about 0.5 at 1 spp), so the plots and tables use relMSE.
+  RMSE is in the CSV too but is dominated by the few pixels on the light's edge (a sample
+  there sees either the light, radiance about 17, or the ceiling, below 1), so the plots and
+  tables use relMSE.
 - Identical sample indices give (nearly) identical images on both backends, so at equal
   spp the two backends' relMSE agree and only their times differ.
 - The plots: CPU solid with filled points, Vulkan dashed with open points, one colour per
-  configuration, the target relMSE as a dotted line.
+  configuration; the target relMSE dotted; a slope −1 guide (relMSE ∝ 1/time) through the
+  baseline's last point.
 EOF
   for scene in "${scenes[@]}"; do
     printf '\n## %s\n' "${pretty[$scene]}"
@@ -262,7 +287,9 @@ EOF
       IFS='|' read -r gname gtitle glabels <<<"$g"
       printf '\n### %s\n\n![%s, %s](plots/accuracy-%s-%s.png)\n\n' "$gtitle" "${pretty[$scene]}" \
         "$gname" "$scene" "$gname"
-      table "$scene" "$glabels"
+      backends="cpu vulkan"
+      [[ $gname == specialize ]] && backends=vulkan
+      table "$scene" "$glabels" "$backends"
     done
     spec=$(field "$scene" vulkan baseline 7) unspec=$(field "$scene" vulkan unspecialized 7)
     if [[ -n $spec && -n $unspec ]]; then
@@ -273,9 +300,9 @@ EOF
         "$(printf %.3g "$(field "$scene" vulkan unspecialized 10)")"
     fi
   done
-  if ((${#problems[@]})); then
+  if [[ -s $out/problems.txt ]]; then
     printf '\n## Runs with invalid samples\n\nThese runs reported NaN/Inf or truncated samples (left out of the image, rows kept):\n\n'
-    for p in "${problems[@]}"; do printf -- '- %s\n' "$p"; done
+    sed 's/^/- /' "$out/problems.txt"
   fi
   cat <<EOF
 

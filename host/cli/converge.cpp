@@ -145,11 +145,11 @@ int runConvergeCommand(const ConvergeArgs& args) {
   options.threads = args.threads;
   options.specialize = !args.noSpecialize;
   options.onRow = [&](const ConvergeRow& r) {
-    char line[256];
-    std::snprintf(line, sizeof line, "%s,%s,%s,%u,%u,%d,%.6g,%.6g,%.6g,%.6g\n", args.label.c_str(),
-                  args.backend.c_str(), sceneName.c_str(), cam.width, cam.height, r.spp, r.seconds,
-                  r.rmse, r.relMse, r.mraysPerSecond);
-    csv << line << std::flush;  // a run cut short keeps the levels it finished
+    // Default stream precision: 6 significant digits, like %g.
+    csv << args.label << ',' << args.backend << ',' << sceneName << ',' << cam.width << ','
+        << cam.height << ',' << r.spp << ',' << r.seconds << ',' << r.rmse << ',' << r.relMse << ','
+        << r.mraysPerSecond << '\n'
+        << std::flush;  // a run cut short keeps the levels it finished
     std::printf("%7d %10.4f %11.5g %11.5g %9.3f\n", r.spp, r.seconds, r.rmse, r.relMse,
                 r.mraysPerSecond);
     std::fflush(stdout);

@@ -244,7 +244,8 @@ int main(int argc, char** argv) {
   // ---- converge: error against a reference as samples double (host/cli/converge.h) ----
   ConvergeArgs c;
   CLI::App* converge = app.add_subcommand(
-      "converge", "Render at 1, 2, 4, ... N spp, writing the error against a reference and the time");
+      "converge",
+      "Render at 1, 2, 4, ... N spp, writing the error against a reference and the time");
   converge->add_option("scene", c.scene, "Scene file (JSON)")->required();
   converge->add_option("--reference", c.reference, "Reference image (.exr, .pfm), same size")
       ->required();

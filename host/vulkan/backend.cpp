@@ -77,12 +77,12 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   for (uint32_t id = 0; id < 6; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(vk::Bool32)), sizeof(vk::Bool32));
   }
-  const vk::SpecializationInfo specInfo(entries,
-                                        vk::ArrayProxyNoTemporaries<const SpecData>(spec));
+  const vk::SpecializationInfo specInfo(entries, vk::ArrayProxyNoTemporaries<const SpecData>(spec));
   std::vector<const Buffer*> bound;
   for (const Buffer& b : buffers) bound.push_back(&b);
-  const std::span<const uint32_t> spirv =
-      debugPrintf ? std::span<const uint32_t>(kPathtraceDebugSpv) : std::span<const uint32_t>(kPathtraceSpv);
+  const std::span<const uint32_t> spirv = debugPrintf
+                                              ? std::span<const uint32_t>(kPathtraceDebugSpv)
+                                              : std::span<const uint32_t>(kPathtraceSpv);
   const ComputeProgram program =
       makeComputeProgram(ctx, spirv, bound, sizeof(PassConstants), &specInfo);
 

@@ -15,10 +15,9 @@ std::vector<RayResult> traceRaysVulkan(const Bvh& bvh, const std::vector<RayQuer
   if (queries.empty()) return results;
   VulkanContext ctx(options);
   using U = vk::BufferUsageFlagBits;
-  const vk::DeviceSize sizes[] = {bvh.nodes.size() * sizeof(BvhNode),
-                                  bvh.triangles.size() * sizeof(Triangle),
-                                  queries.size() * sizeof(RayQuery),
-                                  queries.size() * sizeof(RayResult)};
+  const vk::DeviceSize sizes[] = {
+      bvh.nodes.size() * sizeof(BvhNode), bvh.triangles.size() * sizeof(Triangle),
+      queries.size() * sizeof(RayQuery), queries.size() * sizeof(RayResult)};
   const char* names[] = {"BVH node", "triangle", "ray query", "ray result"};
   const void* data[] = {bvh.nodes.data(), bvh.triangles.data(), queries.data()};
   // Host-visible buffers throughout: this is a test tool, not a hot path.
@@ -40,9 +39,8 @@ std::vector<RayResult> traceRaysVulkan(const Bvh& bvh, const std::vector<RayQuer
   commands.cmd.pushConstants<uint32_t>(*program.layout, vk::ShaderStageFlagBits::eCompute, 0,
                                        count);
   commands.cmd.dispatch(uint32_t(groups), 1, 1);
-  barrier(commands.cmd, vk::PipelineStageFlagBits::eComputeShader,
-          vk::AccessFlagBits::eShaderWrite, vk::PipelineStageFlagBits::eHost,
-          vk::AccessFlagBits::eHostRead);
+  barrier(commands.cmd, vk::PipelineStageFlagBits::eComputeShader, vk::AccessFlagBits::eShaderWrite,
+          vk::PipelineStageFlagBits::eHost, vk::AccessFlagBits::eHostRead);
   commands.submitAndWait(ctx);
 
   std::memcpy(results.data(), buffers[3].mapped, sizes[3]);

@@ -16,6 +16,7 @@ struct RaycastStats {
 };
 
 std::vector<RayResult> traceRaysVulkan(const Bvh& bvh, const std::vector<RayQuery>& queries,
-                                       const ContextOptions& options, RaycastStats* stats = nullptr);
+                                       const ContextOptions& options,
+                                       RaycastStats* stats = nullptr);
 
 }  // namespace pt

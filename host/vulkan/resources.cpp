@@ -60,14 +60,17 @@ ComputeProgram makeComputeProgram(const VulkanContext& ctx, std::span<const uint
     bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1,
                           vk::ShaderStageFlagBits::eCompute);
   }
-  p.setLayout = vk::raii::DescriptorSetLayout(ctx.device, vk::DescriptorSetLayoutCreateInfo({}, bindings));
+  p.setLayout =
+      vk::raii::DescriptorSetLayout(ctx.device, vk::DescriptorSetLayoutCreateInfo({}, bindings));
   const vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, pushConstantSize);
-  p.layout = vk::raii::PipelineLayout(ctx.device, vk::PipelineLayoutCreateInfo({}, *p.setLayout, push));
+  p.layout =
+      vk::raii::PipelineLayout(ctx.device, vk::PipelineLayoutCreateInfo({}, *p.setLayout, push));
   p.module = vk::raii::ShaderModule(
       ctx.device, vk::ShaderModuleCreateInfo({}, spirv.size_bytes(), spirv.data()));
   const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *p.module,
                                                 "main", specialization);
-  p.pipeline = vk::raii::Pipeline(ctx.device, nullptr, vk::ComputePipelineCreateInfo({}, stage, *p.layout));
+  p.pipeline =
+      vk::raii::Pipeline(ctx.device, nullptr, vk::ComputePipelineCreateInfo({}, stage, *p.layout));
 
   const vk::DescriptorPoolSize poolSize(vk::DescriptorType::eStorageBuffer, n);
   p.pool = vk::raii::DescriptorPool(
