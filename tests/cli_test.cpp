@@ -116,12 +116,6 @@ TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
   }
 }
 
-}  // namespace
-}  // namespace pt
-
-namespace pt {
-namespace {
-
 TEST(CliVulkan, RendersOnTheDefaultBackendWithValidation) {
   test::TempDir dir;
   const Result r =

@@ -107,18 +107,7 @@ int runConvergeCommand(const ConvergeArgs& args) {
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
   // The same overrides as `pt render`.
-  RenderSettings settings;
-  settings.width = args.width;
-  settings.height = args.height;
-  settings.seed = args.seed;
-  settings.maxDepth = args.maxDepth;
-  settings.maxLeafSize = args.leafSize;
-  if (!args.strategy.empty()) {
-    settings.strategy = args.strategy == "mis"   ? int(kStrategyMis)
-                        : args.strategy == "nee" ? int(kStrategyNee)
-                                                 : int(kStrategyBsdf);
-  }
-  if (!args.roulette.empty()) settings.russianRoulette = args.roulette == "on" ? 1 : 0;
+  const RenderSettings settings = args.overrides.toSettings();
   const SceneData data = prepareScene(scene, settings);
   const Camera& cam = data.params.camera;
 

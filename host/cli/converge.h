@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "image/image.h"
+#include "cli/overrides.h"
 #include "render/prepare.h"
 
 namespace pt {
@@ -46,10 +47,8 @@ std::vector<ConvergeRow> runConvergence(const SceneData& scene, const Image& ref
 struct ConvergeArgs {
   std::string scene, reference, csv, label = "default";
   std::string backend = "vulkan", device;
-  std::string strategy;  // mis, nee, bsdf
-  std::string roulette;  // on, off
-  int maxSpp = 256, width = 0, height = 0, maxDepth = -1, threads = 0, leafSize = 4;
-  long long seed = -1;
+  SceneOverrides overrides;
+  int maxSpp = 256, threads = 0;
   bool noSpecialize = false;
 };
 

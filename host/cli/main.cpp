@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/converge.h"
+#include "cli/overrides.h"
 #include "cli/progress.h"
 #include "common/check.h"
 #include "cpu/integrator.h"
@@ -29,10 +30,8 @@ struct RenderArgs {
   bool validation = false;
   bool noSpecialize = false;
   std::string debugPixel;  // "X,Y"
-  std::string strategy;    // mis, nee, bsdf; empty: the scene's
-  std::string roulette;    // on, off; empty: the scene's
-  int spp = 0, width = 0, height = 0, maxDepth = -1, threads = 0, leafSize = 4;
-  long long seed = -1;
+  SceneOverrides overrides;
+  int spp = 0, threads = 0;
   std::vector<std::string> outputs;
 };
 
@@ -47,19 +46,8 @@ int runRender(const RenderArgs& args) {
   const Scene scene = loadScene(args.scene);
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
-  RenderSettings settings;
-  settings.width = args.width;
-  settings.height = args.height;
+  RenderSettings settings = args.overrides.toSettings();
   settings.spp = args.spp;
-  settings.seed = args.seed;
-  settings.maxDepth = args.maxDepth;
-  settings.maxLeafSize = args.leafSize;
-  if (!args.strategy.empty()) {
-    settings.strategy = args.strategy == "mis" ? int(kStrategyMis)
-                        : args.strategy == "nee" ? int(kStrategyNee)
-                                                 : int(kStrategyBsdf);
-  }
-  if (!args.roulette.empty()) settings.russianRoulette = args.roulette == "on" ? 1 : 0;
   const SceneData data = prepareScene(scene, settings);
 
   std::vector<std::filesystem::path> outputs(args.outputs.begin(), args.outputs.end());
@@ -183,6 +171,27 @@ int runDiff(const DiffArgs& args) {
   return agree ? kExitOk : kExitFailure;
 }
 
+// Options both `render` and `converge` take: overrides of the scene's settings.
+void addOverrideOptions(CLI::App* cmd, SceneOverrides& o) {
+  cmd->add_option("--seed", o.seed, "Random seed (default: the scene's)")
+      ->check(CLI::Range(0LL, 4294967295LL));
+  cmd->add_option("--width", o.width, "Image width (default: the scene's)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--height", o.height, "Image height (default: the scene's)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-depth", o.maxDepth, "Maximum scattering events per path")
+      ->check(CLI::Range(0, 100000));
+  cmd->add_option("--leaf-size", o.leafSize, "Maximum triangles per BVH leaf")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  cmd->add_option(
+         "--strategy", o.strategy,
+         "Direct light: mis (default), nee (light sampling only), bsdf (no light sampling)")
+      ->check(CLI::IsMember({"mis", "nee", "bsdf"}));
+  cmd->add_option("--rr", o.roulette, "Russian roulette on or off (default: the scene's)")
+      ->check(CLI::IsMember({"on", "off"}));
+}
+
 }  // namespace
 }  // namespace pt
 
@@ -204,24 +213,9 @@ int main(int argc, char** argv) {
                    "Compile every effect into the shader (to measure what specialization saves)");
   render->add_option("--spp", r.spp, "Samples per pixel (default: the scene's)")
       ->check(CLI::PositiveNumber);
-  render->add_option("--seed", r.seed, "Random seed (default: the scene's)")
-      ->check(CLI::Range(0LL, 4294967295LL));
-  render->add_option("--width", r.width, "Image width (default: the scene's)")
-      ->check(CLI::PositiveNumber);
-  render->add_option("--height", r.height, "Image height (default: the scene's)")
-      ->check(CLI::PositiveNumber);
-  render->add_option("--max-depth", r.maxDepth, "Maximum scattering events per path")
-      ->check(CLI::Range(0, 100000));
   render->add_option("--threads", r.threads, "CPU threads (default: all)")
       ->check(CLI::PositiveNumber);
-  render->add_option("--leaf-size", r.leafSize, "Maximum triangles per BVH leaf")
-      ->check(CLI::Range(1, 64))
-      ->capture_default_str();
-  render->add_option("--strategy", r.strategy,
-                     "Direct light: mis (default), nee (light sampling only), bsdf (no light sampling)")
-      ->check(CLI::IsMember({"mis", "nee", "bsdf"}));
-  render->add_option("--rr", r.roulette, "Russian roulette on or off (default: the scene's)")
-      ->check(CLI::IsMember({"on", "off"}));
+  addOverrideOptions(render, r.overrides);
   render->add_option("--debug-pixel", r.debugPixel,
                      "Print pixel X,Y's paths from the CPU reference and from the shader");
   render->add_option("--out", r.outputs, "Output image (.png, .exr, .pfm); repeatable");
@@ -259,23 +253,9 @@ int main(int argc, char** argv) {
   converge->add_option("--max-spp", c.maxSpp, "Largest samples per pixel")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  converge->add_option("--seed", c.seed, "Random seed (default: the scene's)")
-      ->check(CLI::Range(0LL, 4294967295LL));
-  converge->add_option("--width", c.width, "Image width (default: the scene's)")
-      ->check(CLI::PositiveNumber);
-  converge->add_option("--height", c.height, "Image height (default: the scene's)")
-      ->check(CLI::PositiveNumber);
-  converge->add_option("--max-depth", c.maxDepth, "Maximum scattering events per path")
-      ->check(CLI::Range(0, 100000));
   converge->add_option("--threads", c.threads, "CPU threads (default: all)")
       ->check(CLI::PositiveNumber);
-  converge->add_option("--leaf-size", c.leafSize, "Maximum triangles per BVH leaf")
-      ->check(CLI::Range(1, 64))
-      ->capture_default_str();
-  converge->add_option("--strategy", c.strategy, "Direct light: mis, nee or bsdf")
-      ->check(CLI::IsMember({"mis", "nee", "bsdf"}));
-  converge->add_option("--rr", c.roulette, "Russian roulette on or off (default: the scene's)")
-      ->check(CLI::IsMember({"on", "off"}));
+  addOverrideOptions(converge, c.overrides);
   converge->add_flag("--no-specialize", c.noSpecialize, "Vulkan: compile every effect in");
   // ---- end converge ----
 
