@@ -19,8 +19,8 @@ struct RenderSettings {
   long long seed = -1;        // -1: from the scene
   int maxDepth = -1;          // -1: from the scene
   int maxLeafSize = 4;
-  int strategy = -1;          // kStrategy*, -1: from the scene
-  int russianRoulette = -1;   // 0 off, 1 on, -1: from the scene
+  int strategy = -1;         // kStrategy*, -1: from the scene
+  int russianRoulette = -1;  // 0 off, 1 on, -1: from the scene
 };
 
 // Which effects the scene calls for; the rest are compiled or switched out.
