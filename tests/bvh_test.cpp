@@ -131,6 +131,20 @@ TEST(BvhBuild, InvariantsHoldForSeveralLeafSizes) {
   }
 }
 
+TEST(BvhBuild, BinnedSahInvariantsHoldForSeveralLeafSizes) {
+  const std::vector<Triangle> sphere = test::makeSphere(vec3(1, 2, 3), 5.0f, 40, 60);
+  for (int leafSize : {1, 4, 8}) {
+    SCOPED_TRACE("leaf size " + std::to_string(leafSize));
+    expectValidBvh(buildBvh(sphere, BvhBuildOptions{leafSize, BvhBuilder::kBinnedSah}),
+                   sphere.size(), leafSize);
+  }
+  // Coincident triangles and a deep chain still respect the stack.
+  std::vector<Triangle> same(100,
+                             Triangle{vec3(0), 0, vec3(1, 0, 0), kNoEmitter, vec3(0, 1, 0), 0});
+  for (uint i = 0; i < same.size(); ++i) same[i].primitive = i;
+  expectValidBvh(buildBvh(same, BvhBuildOptions{1, BvhBuilder::kBinnedSah}), same.size(), 1);
+}
+
 TEST(BvhBuild, SingleTriangleIsOneLeaf) {
   const Bvh bvh = buildBvh({Triangle{vec3(0), 0, vec3(1, 0, 0), kNoEmitter, vec3(0, 1, 0), 0}});
   ASSERT_EQ(bvh.nodes.size(), 1u);
@@ -265,6 +279,30 @@ TEST(BvhTraversal, MatchesBruteForceOnBunny) {
   EXPECT_EQ(mismatches, 0);
   EXPECT_EQ(anyHitMismatches, 0);
   EXPECT_GT(hits, kRays / 2);  // the test exercises hits, not just misses
+}
+
+TEST(BvhTraversal, BinnedSahTracesLikeTheLbvhOnBunny) {
+  // The LBVH is checked against brute force above; the SAH tree must give the same hits.
+  const std::vector<Triangle> bunny = loadBunny();
+  const Bvh lbvh = buildBvh(bunny, BvhBuildOptions{4, BvhBuilder::kLbvh});
+  const Bvh sah = buildBvh(bunny, BvhBuildOptions{4, BvhBuilder::kBinnedSah});
+  expectValidBvh(sah, bunny.size(), 4);
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<float> uni(-2.0f, 2.0f);
+  int hits = 0, differ = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const vec3 o(uni(rng), uni(rng), uni(rng));
+    const Triangle& t = bunny[size_t(i) * 7919 % bunny.size()];
+    const vec3 d = i % 2 ? (t.v0 + t.v1 + t.v2) / 3.0f - o : vec3(uni(rng), uni(rng), uni(rng));
+    const auto a = closestHit(lbvh, Ray{o, d});
+    const auto b = closestHit(sah, Ray{o, d});
+    hits += a.has_value();
+    differ += a.has_value() != b.has_value() || (a && a->t != b->t);
+    const float tMax = std::abs(uni(rng));
+    differ += anyHit(lbvh, Ray{o, d}, tMax) != anyHit(sah, Ray{o, d}, tMax);
+  }
+  EXPECT_EQ(differ, 0);
+  EXPECT_GT(hits, 30000);
 }
 
 TEST(BvhTraversal, AxisParallelRaysInFacePlanes) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <utility>
 
+#include "bvh/bvh_build.h"
 #include "common/check.h"
 
 namespace pt {
@@ -52,27 +53,6 @@ void radixSort(std::vector<uint64_t>& codes, std::vector<uint32_t>& index) {
     codes.swap(codesTmp);
     index.swap(indexTmp);
   }
-}
-
-struct Bounds {
-  vec3 lo{INFINITY};
-  vec3 hi{-INFINITY};
-  void grow(vec3 p) {
-    lo = min(lo, p);
-    hi = max(hi, p);
-  }
-  void grow(const Bounds& b) {
-    lo = min(lo, b.lo);
-    hi = max(hi, b.hi);
-  }
-};
-
-// Smallest number of levels below a node that a balanced split of `count` triangles needs.
-int balancedLevels(size_t count, size_t leafSize) {
-  int levels = 0;
-  for (size_t leaves = (count + leafSize - 1) / leafSize; leaves > 1; leaves = (leaves + 1) / 2)
-    ++levels;
-  return levels;
 }
 
 class Builder {
@@ -154,6 +134,9 @@ Bvh buildBvh(std::vector<Triangle> triangles, const BvhBuildOptions& options) {
   PT_CHECK(!triangles.empty(), "a BVH needs at least one triangle");
   PT_CHECK(options.maxLeafSize >= 1);
   PT_CHECK(triangles.size() < size_t(UINT32_MAX));
+  if (options.builder == BvhBuilder::kBinnedSah) {
+    return buildBinnedSahBvh(std::move(triangles), size_t(options.maxLeafSize));
+  }
   const auto start = std::chrono::steady_clock::now();
   const size_t n = triangles.size();
 

@@ -1,6 +1,7 @@
-// Linear BVH over triangles: Morton codes of centroids, radix sort, split at the highest
-// differing bit (Karras 2012), DFS-linearized into the 32-byte BvhNode the GPU reads.
-// Knows nothing of materials, cameras or Vulkan.
+// BVH over triangles, DFS-linearized into the 32-byte BvhNode the GPU reads. The default
+// builder is the linear BVH: Morton codes of centroids, radix sort, split at the highest
+// differing bit (Karras 2012). A binned-SAH builder (bvh_sah.cpp) is there to measure what
+// that choice costs. Knows nothing of materials, cameras or Vulkan.
 #pragma once
 
 #include <cstdint>
@@ -10,8 +11,14 @@
 
 namespace pt {
 
+enum class BvhBuilder {
+  kLbvh,       // Morton order, split at the highest differing bit: fast to build
+  kBinnedSah,  // top-down, 16 bins per node on the widest centroid axis, surface-area cost
+};
+
 struct BvhBuildOptions {
   int maxLeafSize = 4;  // a range of at most this many triangles becomes a leaf (>= 1)
+  BvhBuilder builder = BvhBuilder::kLbvh;
 };
 
 struct Bvh {

@@ -190,6 +190,9 @@ void addOverrideOptions(CLI::App* cmd, SceneOverrides& o) {
       ->check(CLI::IsMember({"mis", "nee", "bsdf"}));
   cmd->add_option("--rr", o.roulette, "Russian roulette on or off (default: the scene's)")
       ->check(CLI::IsMember({"on", "off"}));
+  cmd->add_option("--builder", o.builder, "BVH builder: lbvh (Morton, fast) or sah (binned SAH)")
+      ->check(CLI::IsMember({"lbvh", "sah"}))
+      ->capture_default_str();
 }
 
 }  // namespace

@@ -113,7 +113,8 @@ SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
   std::vector<Triangle> triangles = scene.triangles;
   CameraDesc camera = scene.camera;
   data.shift = recentre(triangles, camera);
-  data.bvh = buildBvh(std::move(triangles), BvhBuildOptions{settings.maxLeafSize});
+  data.bvh =
+      buildBvh(std::move(triangles), BvhBuildOptions{settings.maxLeafSize, settings.builder});
   // Emitters index triangles in leaf order, so they are built after the reorder.
   data.emitters = buildEmitters(data.bvh.triangles, data.materials);
 

@@ -19,6 +19,7 @@ struct RenderSettings {
   long long seed = -1;        // -1: from the scene
   int maxDepth = -1;          // -1: from the scene
   int maxLeafSize = 4;
+  BvhBuilder builder = BvhBuilder::kLbvh;
   int strategy = -1;         // kStrategy*, -1: from the scene
   int russianRoulette = -1;  // 0 off, 1 on, -1: from the scene
 };
