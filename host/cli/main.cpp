@@ -133,7 +133,7 @@ int runRender(const RenderArgs& args) {
   if (stats.invalidSamples > 0) {
     std::fprintf(stderr, "error: %llu samples were NaN or Inf%s; they were left out of the image\n",
                  (unsigned long long)stats.invalidSamples,
-                 truncated ? " or cut short by the shader's loop budget" : "");
+                 truncated ? " or cut short by lavapipe's loop-iteration cap" : "");
     status = kExitFailure;
   }
   if (validationErrors > 0) {
