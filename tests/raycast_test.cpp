@@ -9,12 +9,13 @@
 #include "bvh/traverse.h"
 #include "scene/scene.h"
 #include "test_util.h"
+#include "render_compare.h"
 #include "vulkan/raycast.h"
 
 namespace pt {
 namespace {
 
-const ContextOptions kValidated{.validation = true};
+const ContextOptions kValidated{.validation = validationWanted()};
 
 TEST(GpuTraversal, WatertightAtSharedEdgesAndVertices) {
   // The CPU test's 1.26 million rays, on the device.
