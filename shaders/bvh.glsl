@@ -2,7 +2,8 @@
 // Wald 2013), the slab test with Ize's (2013) widened far distance, and iterative traversal
 // with a fixed stack, near child first, closest-hit and any-hit. The same algorithms as
 // host/bvh/traverse.cpp, written for the GPU. Expects the buffers `nodes` and `triangles`
-// and the globals `gLoopIterations` and `gTruncated` to be declared by the including shader.
+// the globals `gLoopIterations` and `gTruncated`, and PT_WATERTIGHT (a boolean expression) to be
+// declared by the including shader.
 
 // Smallest |direction| component used for 1/direction: keeps every slab product finite.
 const float kMinDirection = 1e-30;
@@ -12,6 +13,7 @@ const float kFarScale =
 
 struct RayData {
   vec3 origin;
+  vec3 direction;
   vec3 invDirection;
   int kx, ky, kz;    // kz: axis of the largest |direction|; (kx, ky) keep the winding
   float sx, sy, sz;  // shear constants
@@ -30,6 +32,7 @@ float safeInverse(float d) {
 RayData prepareRay(vec3 origin, vec3 direction) {
   RayData r;
   r.origin = origin;
+  r.direction = direction;
   r.invDirection =
       vec3(safeInverse(direction.x), safeInverse(direction.y), safeInverse(direction.z));
   vec3 a = abs(direction);
@@ -82,6 +85,28 @@ bool intersectTriangle(RayData r, Triangle tri, float tMax, out HitData hit) {
   return true;
 }
 
+// Moller and Trumbore (1997): fewer operations, not watertight. Only for measuring what
+// watertightness costs (--intersection fast).
+bool intersectTriangleFast(RayData r, Triangle tri, float tMax, out HitData hit) {
+  vec3 e1 = tri.v1 - tri.v0;
+  vec3 e2 = tri.v2 - tri.v0;
+  vec3 p = cross(r.direction, e2);
+  float det = dot(e1, p);
+  if (det == 0.0) return false;
+  float invDet = 1.0 / det;
+  vec3 s = r.origin - tri.v0;
+  float u = dot(s, p) * invDet;
+  if (u < 0.0 || u > 1.0) return false;
+  vec3 q = cross(s, e1);
+  float v = dot(r.direction, q) * invDet;
+  if (v < 0.0 || u + v > 1.0) return false;
+  float t = dot(e2, q) * invDet;
+  if (t <= 0.0 || t >= tMax) return false;
+  hit.t = t;
+  hit.barycentrics = vec3(1.0 - u - v, u, v);
+  return true;
+}
+
 bool intersectBox(RayData r, vec3 lo, vec3 hi, float tMax, out float tNear) {
   vec3 t0 = (lo - r.origin) * r.invDirection;
   vec3 t1 = (hi - r.origin) * r.invDirection;
@@ -118,7 +143,9 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
       for (; i < end; ++i) {
         gLoopIterations++;
         HitData hit;
-        if (intersectTriangle(r, triangles[i], best.t, hit)) {
+        bool hitTriangle = PT_WATERTIGHT ? intersectTriangle(r, triangles[i], best.t, hit)
+                                         : intersectTriangleFast(r, triangles[i], best.t, hit);
+        if (hitTriangle) {
           hit.triangle = i;
           best = hit;
           found = true;

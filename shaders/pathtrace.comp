@@ -20,6 +20,7 @@ layout(constant_id = PT_SPEC_NEE) const bool kNee = true;
 layout(constant_id = PT_SPEC_BSDF_EMISSION) const bool kBsdfEmission = true;
 layout(constant_id = PT_SPEC_MIS) const bool kMis = true;
 layout(constant_id = PT_SPEC_RR) const bool kRussianRoulette = true;
+layout(constant_id = PT_SPEC_WATERTIGHT) const bool kWatertight = true;
 
 layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer {
   RenderParams params;
@@ -55,6 +56,8 @@ uint gLoopIterations = 0u;  // this invocation's count, for the statistics
 uint gRays = 0u;
 bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 
+// Watertight unless switched off by specialization or, unspecialized, by the parameters.
+#define PT_WATERTIGHT (kWatertight && params.fastIntersection == 0u)
 #include "bvh.glsl"
 
 float maxComponent(vec3 v) {

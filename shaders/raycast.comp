@@ -25,6 +25,7 @@ layout(push_constant) uniform Count {
   uint queryCount;
 };
 
+#define PT_WATERTIGHT true
 bool gTruncated = false;
 uint gLoopIterations = 0u;
 

@@ -90,16 +90,16 @@ PT_CONST uint kStrategyNee = 1u;   // light sampling only (emission hit by BSDF 
 PT_CONST uint kStrategyBsdf = 2u;  // BSDF sampling only (no shadow rays)
 
 struct RenderParams {
-  Camera camera;         // 64 bytes
-  uint maxDepth;         //  4 bytes: maximum number of scattering events on a path
-  uint rrStartDepth;     //  4 bytes: Russian roulette from this many scattering events on
-  uint emitterCount;     //  4 bytes
-  uint seed;             //  4 bytes
-  uint strategy;         //  4 bytes: kStrategyMis, kStrategyNee or kStrategyBsdf
-  uint russianRoulette;  // 4 bytes: 0 or 1
-  uint reserved0;        //  4 bytes: zero (std430 rounds the struct to 16 bytes)
-  uint reserved1;        //  4 bytes: zero
-};                       // 96 bytes
+  Camera camera;          // 64 bytes
+  uint maxDepth;          //  4 bytes: maximum number of scattering events on a path
+  uint rrStartDepth;      //  4 bytes: Russian roulette from this many scattering events on
+  uint emitterCount;      //  4 bytes
+  uint seed;              //  4 bytes
+  uint strategy;          //  4 bytes: kStrategyMis, kStrategyNee or kStrategyBsdf
+  uint russianRoulette;   // 4 bytes: 0 or 1
+  uint fastIntersection;  // 4 bytes: 1: Moller-Trumbore (not watertight), 0: watertight
+  uint reserved;          //  4 bytes: zero (std430 rounds the struct to 16 bytes)
+};                        // 96 bytes
 
 // ---- Compute pipeline interface (Vulkan backend) ----------------------------------------
 
@@ -120,6 +120,7 @@ struct RenderParams {
 #define PT_SPEC_BSDF_EMISSION 3  // bool: count emission reached by BSDF-sampled rays
 #define PT_SPEC_MIS 4            // bool: weigh the two with the power heuristic
 #define PT_SPEC_RR 5             // bool: Russian roulette
+#define PT_SPEC_WATERTIGHT 6     // bool: watertight intersection (false: Moller-Trumbore)
 
 PT_CONST uint kWorkgroupSize = 8u;  // workgroups of 8 x 8 pixels
 

@@ -32,6 +32,16 @@ TEST(Vulkan, BunnyMeshMatchesCpuReference) {
   expectAgreement(renderBoth(prepare("bunny-box.json", 40), 4));
 }
 
+TEST(Vulkan, FastIntersectionMatchesCpuReference) {
+  // The Moller-Trumbore knob (--intersection fast) on both backends, specialised and not.
+  RenderSettings settings{.width = 48, .height = 48};
+  settings.fastIntersection = true;
+  const SceneData data = prepareScene(loadScene(kConfigs / "cornell-box.json"), settings);
+  EXPECT_FALSE(data.effects.watertight);
+  expectAgreement(renderBoth(data, 4));
+  expectAgreement(renderBoth(data, 4, /*specialize=*/false));
+}
+
 TEST(Vulkan, UnspecializedShaderGivesTheSameImage) {
   // Every effect compiled in and decided at run time must not change the result.
   const SceneData data = prepare("cornell-mirror.json", 32);

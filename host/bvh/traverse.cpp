@@ -23,7 +23,7 @@ float safeInverse(float d) {
 
 }  // namespace
 
-RayPrecomputed::RayPrecomputed(const Ray& ray) : origin(ray.origin) {
+RayPrecomputed::RayPrecomputed(const Ray& ray) : origin(ray.origin), direction(ray.direction) {
   const vec3 d = ray.direction;
   invDirection = vec3(safeInverse(d.x), safeInverse(d.y), safeInverse(d.z));
   // Woop et al. 2013: make the largest axis z, and swap x and y when it points down z so
@@ -76,6 +76,26 @@ bool intersectTriangle(const RayPrecomputed& ray, const Triangle& tri, float tMa
   return true;
 }
 
+bool intersectTriangleFast(const RayPrecomputed& ray, const Triangle& tri, float tMax, Hit& hit) {
+  const vec3 e1 = tri.v1 - tri.v0;
+  const vec3 e2 = tri.v2 - tri.v0;
+  const vec3 p = cross(ray.direction, e2);
+  const float det = dot(e1, p);
+  if (det == 0.0f) return false;
+  const float invDet = 1.0f / det;
+  const vec3 s = ray.origin - tri.v0;
+  const float u = dot(s, p) * invDet;
+  if (u < 0.0f || u > 1.0f) return false;
+  const vec3 q = cross(s, e1);
+  const float v = dot(ray.direction, q) * invDet;
+  if (v < 0.0f || u + v > 1.0f) return false;
+  const float t = dot(e2, q) * invDet;
+  if (t <= 0.0f || t >= tMax) return false;
+  hit.t = t;
+  hit.barycentrics = vec3(1.0f - u - v, u, v);
+  return true;
+}
+
 bool intersectBox(const RayPrecomputed& ray, vec3 lo, vec3 hi, float tMax, float& tNear) {
   const vec3 t0 = (lo - ray.origin) * ray.invDirection;
   const vec3 t1 = (hi - ray.origin) * ray.invDirection;
@@ -92,7 +112,7 @@ namespace {
 // One loop for both query kinds. Near child first: both children's boxes are tested, the
 // nearer is visited next and the farther pushed. A popped node is visited without
 // re-testing its box (it was hit when pushed).
-template <bool kAnyHit>
+template <bool kAnyHit, bool kWatertight>
 bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best, TraversalStats* stats) {
   const RayPrecomputed r(ray);
   float tNear = 0.0f;
@@ -111,7 +131,10 @@ bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best, TraversalSt
       for (uint32_t i = node.offset; i < node.offset + node.count; ++i) {
         if (stats) stats->triangleTests++;
         Hit hit;
-        if (intersectTriangle(r, bvh.triangles[i], closest, hit)) {
+        const bool hitTriangle = kWatertight
+                                     ? intersectTriangle(r, bvh.triangles[i], closest, hit)
+                                     : intersectTriangleFast(r, bvh.triangles[i], closest, hit);
+        if (hitTriangle) {
           hit.triangle = i;
           best = hit;
           closest = hit.t;
@@ -147,15 +170,21 @@ bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best, TraversalSt
 
 }  // namespace
 
-std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats) {
+std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats,
+                              Intersection test) {
   Hit hit;
-  if (traverse</*kAnyHit=*/false>(bvh, ray, tMax, hit, stats)) return hit;
+  const bool found = test == Intersection::kWatertight
+                         ? traverse</*kAnyHit=*/false, true>(bvh, ray, tMax, hit, stats)
+                         : traverse</*kAnyHit=*/false, false>(bvh, ray, tMax, hit, stats);
+  if (found) return hit;
   return std::nullopt;
 }
 
-bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats) {
+bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats, Intersection test) {
   Hit hit;
-  return traverse</*kAnyHit=*/true>(bvh, ray, tMax, hit, stats);
+  return test == Intersection::kWatertight
+             ? traverse</*kAnyHit=*/true, true>(bvh, ray, tMax, hit, stats)
+             : traverse</*kAnyHit=*/true, false>(bvh, ray, tMax, hit, stats);
 }
 
 }  // namespace pt

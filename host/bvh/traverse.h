@@ -19,6 +19,7 @@ struct Ray {
 // Per-ray constants of the watertight test and the slab test, computed once per ray.
 struct RayPrecomputed {
   vec3 origin;
+  vec3 direction;
   vec3 invDirection;  // 1 / direction, with |direction| clamped away from 0 (no inf, no NaN)
   int kx, ky, kz;     // kz: axis of the largest |direction|; (kx, ky) keep the winding
   float sx, sy, sz;   // shear constants
@@ -34,6 +35,12 @@ struct Hit {
 // Watertight intersection; accepts hits from both sides with 0 < t < tMax.
 bool intersectTriangle(const RayPrecomputed& ray, const Triangle& tri, float tMax, Hit& hit);
 
+// Moller and Trumbore (1997): fewer operations, not watertight (rays through shared edges
+// and vertices can pass between triangles). Only for measuring what watertightness costs.
+bool intersectTriangleFast(const RayPrecomputed& ray, const Triangle& tri, float tMax, Hit& hit);
+
+enum class Intersection { kWatertight, kFast };
+
 // Slab test; on a hit, tNear is the entry distance (clamped to 0).
 bool intersectBox(const RayPrecomputed& ray, vec3 lo, vec3 hi, float tMax, float& tNear);
 
@@ -44,9 +51,11 @@ struct TraversalStats {
 };
 
 std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax = INFINITY,
-                              TraversalStats* stats = nullptr);
+                              TraversalStats* stats = nullptr,
+                              Intersection test = Intersection::kWatertight);
 
 // True if anything lies on the ray with 0 < t < tMax. Stops at the first hit found.
-bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats = nullptr);
+bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats = nullptr,
+            Intersection test = Intersection::kWatertight);
 
 }  // namespace pt

@@ -193,6 +193,10 @@ void addOverrideOptions(CLI::App* cmd, SceneOverrides& o) {
   cmd->add_option("--builder", o.builder, "BVH builder: lbvh (Morton, fast) or sah (binned SAH)")
       ->check(CLI::IsMember({"lbvh", "sah"}))
       ->capture_default_str();
+  cmd->add_option("--intersection", o.intersection,
+                  "Ray/triangle test: watertight (Woop et al.) or fast (Moller-Trumbore, leaks)")
+      ->check(CLI::IsMember({"watertight", "fast"}))
+      ->capture_default_str();
 }
 
 }  // namespace

@@ -12,10 +12,11 @@ struct SceneOverrides {
   int width = 0, height = 0;  // 0: the scene's
   int maxDepth = -1;          // -1: the scene's
   int leafSize = 4;
-  long long seed = -1;           // -1: the scene's
-  std::string strategy;          // mis, nee, bsdf; empty: the scene's
-  std::string roulette;          // on, off; empty: the scene's
-  std::string builder = "lbvh";  // lbvh, sah
+  long long seed = -1;                      // -1: the scene's
+  std::string strategy;                     // mis, nee, bsdf; empty: the scene's
+  std::string roulette;                     // on, off; empty: the scene's
+  std::string builder = "lbvh";             // lbvh, sah
+  std::string intersection = "watertight";  // watertight, fast
 
   RenderSettings toSettings() const {
     RenderSettings s;
@@ -29,6 +30,7 @@ struct SceneOverrides {
     if (strategy == "bsdf") s.strategy = int(kStrategyBsdf);
     if (!roulette.empty()) s.russianRoulette = roulette == "on" ? 1 : 0;
     s.builder = builder == "sah" ? BvhBuilder::kBinnedSah : BvhBuilder::kLbvh;
+    s.fastIntersection = intersection == "fast";
     return s;
   }
 };

@@ -40,6 +40,8 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
   const bool misOn = params.strategy == kStrategyMis;
   const bool neeOn = params.strategy != kStrategyBsdf && params.emitterCount > 0;
   const bool bsdfEmissionOn = params.strategy != kStrategyNee;
+  const Intersection test =
+      params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
 
   // Primary ray through a uniformly jittered point of the pixel (box filter of width 1).
   Ray ray = cameraRay(params.camera, vec2(pixel) + random2(pixel, sampleIndex, kDimPixel, seed));
@@ -52,7 +54,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
   for (uint depth = 0;;) {
     // Find the closest surface along the ray; the background is black.
     ++rays;
-    const std::optional<Hit> hit = closestHit(bvh, ray);
+    const std::optional<Hit> hit = closestHit(bvh, ray, INFINITY, nullptr, test);
     if (!hit) break;
     const Triangle& tri = bvh.triangles[hit->triangle];
     const Material& material = scene.materials[tri.material];
@@ -134,7 +136,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
           const vec3 to = offsetRayOrigin(lightPoint, lightNormal,
                                           triangleMagnitude(light.v0, light.v1, light.v2));
           ++rays;
-          if (!anyHit(bvh, Ray{from, to - from}, 1.0f)) {
+          if (!anyHit(bvh, Ray{from, to - from}, 1.0f, nullptr, test)) {
             const float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
             const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
             const vec3 Le = scene.materials[light.material].emission;

@@ -19,6 +19,7 @@ std::string EffectSet::toString() const {
   add(lightSampling, "nee");
   add(mis, "mis");
   add(russianRoulette, "rr");
+  add(!watertight, "fast-isect");
   return s.empty() ? "none" : s;
 }
 
@@ -125,6 +126,7 @@ SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
   p.emitterCount = uint32_t(data.emitters.size());
   p.seed = settings.seed >= 0 ? uint32_t(settings.seed) : integ.seed;
   p.strategy = settings.strategy >= 0 ? uint32_t(settings.strategy) : integ.strategy;
+  p.fastIntersection = settings.fastIntersection ? 1u : 0u;
   p.russianRoulette = settings.russianRoulette >= 0 ? uint32_t(settings.russianRoulette)
                                                     : (integ.russianRoulette ? 1u : 0u);
 
@@ -140,6 +142,7 @@ SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
   fx.lightSampling =
       fx.diffuse && scatters && !data.emitters.empty() && p.strategy != kStrategyBsdf;
   fx.bsdfEmission = !data.emitters.empty() && p.strategy != kStrategyNee;
+  fx.watertight = !settings.fastIntersection;
   fx.mis = fx.lightSampling && fx.bsdfEmission && p.strategy == kStrategyMis;
   fx.russianRoulette = p.russianRoulette != 0 && scatters && (fx.diffuse || fx.mirror);
   return data;

@@ -20,8 +20,9 @@ struct RenderSettings {
   int maxDepth = -1;          // -1: from the scene
   int maxLeafSize = 4;
   BvhBuilder builder = BvhBuilder::kLbvh;
-  int strategy = -1;         // kStrategy*, -1: from the scene
-  int russianRoulette = -1;  // 0 off, 1 on, -1: from the scene
+  bool fastIntersection = false;  // Moller-Trumbore instead of the watertight test
+  int strategy = -1;              // kStrategy*, -1: from the scene
+  int russianRoulette = -1;       // 0 off, 1 on, -1: from the scene
 };
 
 // Which effects the scene calls for; the rest are compiled or switched out.
@@ -32,7 +33,8 @@ struct EffectSet {
   bool bsdfEmission = false;   // emission found by BSDF-sampled rays is counted (MIS/BSDF)
   bool mis = false;            // both of the above, weighed by the power heuristic
   bool russianRoulette = false;
-  std::string toString() const;  // e.g. "diffuse+mirror+nee+mis+rr"
+  bool watertight = true;        // false: the faster, leaky Moller-Trumbore test
+  std::string toString() const;  // e.g. "diffuse+mirror+nee+mis+rr" (+"fast-isect")
 };
 
 struct SceneData {
