@@ -321,8 +321,8 @@ These knobs are not implemented, so there is nothing to measure:
   sample, dimension, seed);
 - the BVH builder in the sweep: \`--builder sah\` exists (binned SAH; measured by hand in the
   notes above) but the script does not sweep it yet;
-- non-watertight ray/triangle intersection (Möller–Trumbore): only the watertight test is
-  implemented;
+- the intersection test in the sweep: \`--intersection fast\` exists (measured by hand in the
+  notes above) but the script does not sweep it yet;
 - a double-precision CPU reference: the CPU integrator computes in float (only the film
   accumulates in double), so the reference shares the renderer's float arithmetic.
 EOF
