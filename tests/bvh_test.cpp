@@ -347,7 +347,7 @@ TEST(BvhTraversal, WatertightAtSharedEdgesAndVertices) {
       for (vec3 target : {t.v0, 0.5f * (t.v0 + t.v1), 0.5f * (t.v1 + t.v2)}) {
         ++rays;
         if (!closestHit(bvh, Ray{o, target - o}).has_value()) ++leaks;
-        if (!closestHit(bvh, Ray{o, target - o}, INFINITY, nullptr, Intersection::kFast)) {
+        if (!closestHit(bvh, Ray{o, target - o}, INFINITY, Intersection::kFast)) {
           ++fastLeaks;
         }
       }

@@ -14,7 +14,9 @@ namespace pt {
 
 // Validation layers on (a validation error fails the tests), unless PT_NO_VALIDATION is set:
 // for machines without the layers, such as a lent GPU machine (tools/gpu-check.sh).
-inline bool validationWanted() { return std::getenv("PT_NO_VALIDATION") == nullptr; }
+inline bool validationWanted() {
+  return std::getenv("PT_NO_VALIDATION") == nullptr;
+}
 
 inline VulkanRenderOptions validatedOptions(int spp) {
   VulkanRenderOptions options;

@@ -113,7 +113,7 @@ namespace {
 // nearer is visited next and the farther pushed. A popped node is visited without
 // re-testing its box (it was hit when pushed).
 template <bool kAnyHit, bool kWatertight>
-bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best, TraversalStats* stats) {
+bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best) {
   const RayPrecomputed r(ray);
   float tNear = 0.0f;
   const BvhNode& root = bvh.nodes[0];
@@ -125,11 +125,9 @@ bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best, TraversalSt
   float closest = tMax;
   for (;;) {
     const BvhNode& node = bvh.nodes[nodeIndex];
-    if (stats) stats->nodes++;
     if (node.count > 0) {
       // Leaf: test its triangles, shrinking the search range as hits are found.
       for (uint32_t i = node.offset; i < node.offset + node.count; ++i) {
-        if (stats) stats->triangleTests++;
         Hit hit;
         const bool hitTriangle = kWatertight
                                      ? intersectTriangle(r, bvh.triangles[i], closest, hit)
@@ -170,21 +168,19 @@ bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best, TraversalSt
 
 }  // namespace
 
-std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats,
-                              Intersection test) {
+std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax, Intersection test) {
   Hit hit;
   const bool found = test == Intersection::kWatertight
-                         ? traverse</*kAnyHit=*/false, true>(bvh, ray, tMax, hit, stats)
-                         : traverse</*kAnyHit=*/false, false>(bvh, ray, tMax, hit, stats);
+                         ? traverse</*kAnyHit=*/false, true>(bvh, ray, tMax, hit)
+                         : traverse</*kAnyHit=*/false, false>(bvh, ray, tMax, hit);
   if (found) return hit;
   return std::nullopt;
 }
 
-bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats, Intersection test) {
+bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, Intersection test) {
   Hit hit;
-  return test == Intersection::kWatertight
-             ? traverse</*kAnyHit=*/true, true>(bvh, ray, tMax, hit, stats)
-             : traverse</*kAnyHit=*/true, false>(bvh, ray, tMax, hit, stats);
+  return test == Intersection::kWatertight ? traverse</*kAnyHit=*/true, true>(bvh, ray, tMax, hit)
+                                           : traverse</*kAnyHit=*/true, false>(bvh, ray, tMax, hit);
 }
 
 }  // namespace pt

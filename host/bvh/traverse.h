@@ -44,18 +44,11 @@ enum class Intersection { kWatertight, kFast };
 // Slab test; on a hit, tNear is the entry distance (clamped to 0).
 bool intersectBox(const RayPrecomputed& ray, vec3 lo, vec3 hi, float tMax, float& tNear);
 
-// Counters for statistics and tests: nodes visited and triangles tested.
-struct TraversalStats {
-  uint64_t nodes = 0;
-  uint64_t triangleTests = 0;
-};
-
 std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax = INFINITY,
-                              TraversalStats* stats = nullptr,
                               Intersection test = Intersection::kWatertight);
 
 // True if anything lies on the ray with 0 < t < tMax. Stops at the first hit found.
-bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, TraversalStats* stats = nullptr,
+bool anyHit(const Bvh& bvh, const Ray& ray, float tMax,
             Intersection test = Intersection::kWatertight);
 
 }  // namespace pt

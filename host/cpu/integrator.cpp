@@ -54,7 +54,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
   for (uint depth = 0;;) {
     // Find the closest surface along the ray; the background is black.
     ++rays;
-    const std::optional<Hit> hit = closestHit(bvh, ray, INFINITY, nullptr, test);
+    const std::optional<Hit> hit = closestHit(bvh, ray, INFINITY, test);
     if (!hit) break;
     const Triangle& tri = bvh.triangles[hit->triangle];
     const Material& material = scene.materials[tri.material];
@@ -136,7 +136,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
           const vec3 to = offsetRayOrigin(lightPoint, lightNormal,
                                           triangleMagnitude(light.v0, light.v1, light.v2));
           ++rays;
-          if (!anyHit(bvh, Ray{from, to - from}, 1.0f, nullptr, test)) {
+          if (!anyHit(bvh, Ray{from, to - from}, 1.0f, test)) {
             const float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
             const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
             const vec3 Le = scene.materials[light.material].emission;
