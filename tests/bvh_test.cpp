@@ -9,19 +9,13 @@
 #include "bvh/bvh.h"
 #include "bvh/traverse.h"
 #include "scene/scene.h"
+#include "closed_mesh.h"
 #include "test_util.h"
 
 namespace pt {
 namespace {
 
-std::vector<Triangle> loadBunny() {
-  test::TempDir dir;
-  std::ofstream(dir / "bunny.json") << R"({
-    "materials": [{"name": "white", "reflectance": [0.5, 0.5, 0.5]}],
-    "shapes": [{"type": "obj", "file": "/usr/share/glmark2/models/bunny.obj",
-                "material": "white"}]})";
-  return loadScene(dir / "bunny.json").triangles;
-}
+using test::loadBunny;
 
 // Checks every structural invariant of a built BVH.
 void expectValidBvh(const Bvh& bvh, size_t triangleCount, int maxLeafSize) {
@@ -358,6 +352,35 @@ TEST(BvhTraversal, WatertightAtSharedEdgesAndVertices) {
   // The same rays find the cracks of a non-watertight test (Moller-Trumbore): the rays are
   // hard enough to tell the two apart.
   EXPECT_GT(fastLeaks, 1000);
+}
+
+TEST(BvhTraversal, WatertightOnAClosedScannedMesh) {
+  // The same probe on a real scan: rays from points inside the bunny aimed at each of its
+  // vertices and edge midpoints must stop at the surface there, not slip through and
+  // then hit the bunny from outside or nothing at all.
+  const std::vector<Triangle> bunny = loadBunny();
+  ASSERT_EQ(test::openOrMisorientedEdges(bunny), 0u) << "the bunny is expected to be closed";
+  const Bvh bvh = buildBvh(bunny);
+  const std::vector<vec3> origins = test::interiorPoints(bvh, 8, 6);
+  ASSERT_EQ(origins.size(), 6u);
+  const std::vector<RayQuery> queries = test::aimedRays(bvh.triangles, origins);
+  ASSERT_GE(queries.size(), 1000000u);
+  const float outward = test::outwardSign(bvh.triangles);
+  size_t leaks = 0, fastLeaks = 0;
+  for (const RayQuery& q : queries) {
+    const Ray ray{q.origin, q.direction};
+    const auto hit = closestHit(bvh, ray);
+    leaks += test::escaped(bvh.triangles, outward, q, hit.has_value(), hit ? hit->t : 0.0f,
+                           hit ? hit->triangle : 0u);
+    const auto fast = closestHit(bvh, ray, INFINITY, Intersection::kFast);
+    fastLeaks += test::escaped(bvh.triangles, outward, q, fast.has_value(), fast ? fast->t : 0.0f,
+                               fast ? fast->triangle : 0u);
+  }
+  EXPECT_EQ(leaks, 0u);
+  // The rays are hard enough to tell a watertight test from one that is not.
+  EXPECT_GT(fastLeaks, 1000u);
+  std::printf("bunny: %zu rays, %zu escape with the watertight test, %zu with Moller-Trumbore\n",
+              queries.size(), leaks, fastLeaks);
 }
 
 }  // namespace
