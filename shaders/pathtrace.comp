@@ -1,7 +1,7 @@
-// The GPU path tracer: one invocation traces one path sample of one pixel and adds it to the
-// accumulation buffer. The same integrator as host/cpu/integrator.cpp (NEE + BSDF sampling
-// with MIS, Russian roulette, Lambertian and mirror), written separately in GLSL; the
-// layouts (shared_types.h) and random numbers (sampling.h) are shared.
+// The GPU path tracer: one invocation traces a pass's samples of one pixel (one by default)
+// and adds them to the accumulation buffer. The same integrator as host/cpu/integrator.cpp
+// (NEE + BSDF sampling with MIS, Russian roulette, Lambertian and mirror), written
+// separately in GLSL; the layouts (shared_types.h) and random numbers (sampling.h) are shared.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #ifdef PT_DEBUG_PRINTF
@@ -237,20 +237,38 @@ void main() {
   uint index = pixel.y * params.camera.width + pixel.x;
   gDebug = index == pass.debugPixel;
 
-  vec3 L = sampleRadiance(pixel, pass.sampleIndex);
-
+  // This dispatch's samples of the pixel, summed in float: a few thousand samples at most
+  // (the host folds the buffer into double precision after every few dispatches).
+  vec3 sum = vec3(0.0);
+  uint invalid = 0u;
+  uint truncated = 0u;
+  uint done = 0u;
+  for (uint s = 0u; s < pass.sampleCount; ++s) {
+    gTruncated = false;
+    vec3 L = sampleRadiance(pixel, pass.sampleIndex + s);
 #ifdef PT_DEBUG_PRINTF
-  if (gDebug) debugPrintfEXT("gpu sample %u: L=(%g, %g, %g)", pass.sampleIndex, L.x, L.y, L.z);
+    if (gDebug) {
+      debugPrintfEXT("gpu sample %u: L=(%g, %g, %g)", pass.sampleIndex + s, L.x, L.y, L.z);
+    }
 #endif
-  // A path given up at the loop budget is reported, never added as if complete.
-  if (gTruncated) {
-    atomicAdd(counters.truncated, 1u);
-    accum[index].invalid += 1u;
-  } else if (any(isnan(L)) || any(isinf(L))) {
-    accum[index].invalid += 1u;  // counted, never silently dropped
-  } else {
-    accum[index].sum += L;
+    // A path given up at the loop budget is reported, never added as if complete.
+    if (gTruncated) {
+      truncated++;
+      invalid++;
+    } else if (any(isnan(L)) || any(isinf(L))) {
+      invalid++;  // counted, never silently dropped
+    } else {
+      sum += L;
+    }
+    done++;
   }
+  // The sample loop itself can be cut short by lavapipe's cap: the samples it never ran.
+  truncated += pass.sampleCount - done;
+  invalid += pass.sampleCount - done;
+
+  accum[index].sum += sum;
+  accum[index].invalid += invalid;
+  if (truncated > 0u) atomicAdd(counters.truncated, truncated);
   atomicMax(counters.maxLoopIterations, gLoopIterations);
   uint before = atomicAdd(counters.raysLow, gRays);
   if (before + gRays < before) atomicAdd(counters.raysHigh, 1u);  // carry into the high word

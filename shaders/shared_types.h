@@ -126,10 +126,10 @@ PT_CONST uint kWorkgroupSize = 8u;  // workgroups of 8 x 8 pixels
 
 // Push constants of one dispatch (one pass): which sample index every pixel takes.
 struct PassConstants {
-  uint sampleIndex;  // 4 bytes
+  uint sampleIndex;  // 4 bytes: the first sample index of this dispatch
+  uint sampleCount;  // 4 bytes: samples per pixel in this dispatch, indices sampleIndex + i
   uint debugPixel;   // 4 bytes: y * width + x of the pixel whose path is printed, or ~0u
-  uint reserved0;    // 4 bytes
-  uint reserved1;    // 4 bytes
+  uint reserved;     // 4 bytes
 };                   // 16 bytes
 
 // Per-pixel accumulation on the device, in float; the host folds it into its double

@@ -76,6 +76,51 @@ TEST(RobustFurnace, ClosedFormOnBothBackendsUpToAlbedo099) {
   }
 }
 
+// Long renders: one pixel accumulated over a million samples equals the double-precision sum
+// of the same samples. The device sums a dispatch's samples in float and the host folds the
+// float sums into double every few dispatches; a plain float running sum of the same
+// samples is shown to be far off, so the bound can tell.
+TEST(RobustEnergy, MillionSamplePixelMatchesADoubleSum) {
+  Scene scene;
+  scene.materials = {Material{vec3(0.5f, 0.6f, 0.7f), kMaterialDiffuse, vec3(0.0f), 0},
+                     Material{vec3(0.0f), kMaterialDiffuse, vec3(5.0f, 4.0f, 3.0f), 0}};
+  const vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  addQuad(scene, -y, z, x, 0);               // a floor facing up
+  addQuad(scene, y, 0.3f * x, 0.3f * z, 1);  // a small light above it, facing down
+  // One pixel on the floor; direct light only (NEE and BSDF sampling with MIS), so each
+  // sample is cheap and the samples still vary.
+  const SceneData data =
+      finish(scene, CameraDesc{vec3(0, 0.5f, -2), vec3(0, -1, 0), vec3(0, 1, 0), 10.0f, 1, 1}, 1);
+  constexpr uint32_t kSamples = 1000000;
+
+  glm::dvec3 exact(0.0);
+  vec3 naive(0.0f);
+  uint64_t rays = 0;
+  for (uint32_t s = 0; s < kSamples; ++s) {
+    const vec3 L = sampleRadiance(data, uvec2(0), s, rays);
+    exact += glm::dvec3(L);
+    naive += L;
+  }
+  VulkanRenderOptions options = validatedOptions(int(kSamples));
+  options.samplesPerPass = 2000;
+  options.passesPerFlush = 16;
+  Film film(1, 1);
+  const VulkanRenderStats stats = renderVulkan(data, options, film);
+  EXPECT_EQ(stats.validationErrors, 0u);
+  EXPECT_EQ(stats.truncatedSamples, 0u);
+  EXPECT_EQ(stats.invalidSamples, 0u);
+  ASSERT_EQ(film.sampleCount[0], kSamples);
+  for (int c = 0; c < 3; ++c) {
+    ASSERT_GT(exact[c], 0.0);
+    const double gpuError = std::abs(film.sum[0][c] - exact[c]) / exact[c];
+    const double floatError = std::abs(double(naive[c]) - exact[c]) / exact[c];
+    std::printf("channel %d: relative error of the device sum %.3g, of a float sum %.3g\n", c,
+                gpuError, floatError);
+    EXPECT_LT(gpuError, 1e-6) << "channel " << c;
+    EXPECT_GT(floatError, 1e-5) << "channel " << c;
+  }
+}
+
 // Every pixel finite and below `bound`, no invalid samples, backends in agreement (unless
 // the scene has coincident surfaces: which of two coplanar triangles a ray sees is decided
 // by the last bit of two equal distances, which the backends may round apart).

@@ -32,6 +32,7 @@ struct RenderArgs {
   std::string debugPixel;  // "X,Y"
   SceneOverrides overrides;
   int spp = 0, threads = 0;
+  int samplesPerPass = 1;
   std::vector<std::string> outputs;
 };
 
@@ -43,6 +44,9 @@ struct DiffArgs {
 };
 
 int runRender(const RenderArgs& args) {
+  if (args.backend == "cpu" && args.samplesPerPass != 1) {
+    throw InputError("--samples-per-pass applies to the Vulkan backend only");
+  }
   const Scene scene = loadScene(args.scene);
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
@@ -102,6 +106,7 @@ int runRender(const RenderArgs& args) {
     const char* env = std::getenv("PT_VALIDATION");
     options.context.validation = args.validation || (env && std::string(env) == "1");
     options.spp = data.spp;
+    options.samplesPerPass = args.samplesPerPass;
     options.specialize = !args.noSpecialize;
     options.context.debugPrintf = debugX >= 0;
     options.debugPixelX = debugX;
@@ -222,6 +227,12 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   render->add_option("--threads", r.threads, "CPU threads (default: all)")
       ->check(CLI::PositiveNumber);
+  render
+      ->add_option("--samples-per-pass", r.samplesPerPass,
+                   "Vulkan: samples per pixel in one dispatch (fewer dispatches for small "
+                   "images; lavapipe's loop cap limits it)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   addOverrideOptions(render, r.overrides);
   render->add_option("--debug-pixel", r.debugPixel,
                      "Print pixel X,Y's paths from the CPU reference and from the shader");

@@ -36,7 +36,8 @@ static_assert(sizeof(RenderParams) == 96);
 static_assert(offsetof(RenderParams, maxDepth) == 64 && offsetof(RenderParams, seed) == 76);
 static_assert(offsetof(RenderParams, russianRoulette) == 84);
 
-static_assert(sizeof(PassConstants) == 16 && offsetof(PassConstants, debugPixel) == 4);
+static_assert(sizeof(PassConstants) == 16 && offsetof(PassConstants, sampleCount) == 4 &&
+              offsetof(PassConstants, debugPixel) == 8);
 static_assert(sizeof(AccumPixel) == 16 && offsetof(AccumPixel, invalid) == 12);
 static_assert(sizeof(DeviceCounters) == 16 && offsetof(DeviceCounters, truncated) == 8);
 

@@ -107,8 +107,8 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   const uint32_t debugPixel = options.debugPixelX >= 0 ? uint32_t(options.debugPixelY) * cam.width +
                                                              uint32_t(options.debugPixelX)
                                                        : ~0u;
-  auto dispatch = [&](uint32_t sampleIndex, uint32_t gx, uint32_t gy) {
-    const PassConstants pc{sampleIndex, debugPixel, 0u, 0u};
+  auto dispatch = [&](uint32_t sampleIndex, uint32_t sampleCount, uint32_t gx, uint32_t gy) {
+    const PassConstants pc{sampleIndex, sampleCount, debugPixel, 0u};
     cmd.pushConstants<PassConstants>(*program.layout, vk::ShaderStageFlagBits::eCompute, 0, pc);
     cmd.dispatch(gx, gy, 1);
     barrier(cmd, S::eComputeShader, A::eShaderWrite, S::eComputeShader | S::eTransfer,
@@ -130,25 +130,30 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   }
   clearAccumulators();
   program.bind(cmd);
-  dispatch(0u, 1u, 1u);
+  dispatch(0u, 1u, 1u, 1u);
   barrier(cmd, S::eComputeShader, A::eShaderWrite, S::eTransfer, A::eTransferWrite);
   clearAccumulators();
   submitAndWait();
 
-  // ---- Passes: one sample per pixel per dispatch, folded into the film every few passes ----
+  // ---- Passes: samplesPerPass samples per pixel per dispatch, folded into the film after
+  // every passesPerFlush dispatches -----------------------------------------------------------
   VulkanRenderStats stats;
   stats.device = ctx.info().name;
   stats.threads = 0;
   const double tickSeconds = double(ctx.limits.timestampPeriod) * 1e-9;
   const int perFlush = std::max(1, options.passesPerFlush);
+  const int perPass = std::max(1, options.samplesPerPass);
   for (int done = 0; done < options.spp;) {
-    const int passes = std::min(perFlush, options.spp - done);
     commands.begin();
     cmd.resetQueryPool(*queries, 0, 2);
     program.bind(cmd);
     cmd.writeTimestamp(S::eTopOfPipe, *queries, 0);
-    for (int p = 0; p < passes; ++p)
-      dispatch(options.firstSample + uint32_t(done + p), groupsX, groupsY);
+    int samples = 0;  // per pixel, in this batch of passes
+    for (int p = 0; p < perFlush && done + samples < options.spp; ++p) {
+      const int count = std::min(perPass, options.spp - done - samples);
+      dispatch(options.firstSample + uint32_t(done + samples), uint32_t(count), groupsX, groupsY);
+      samples += count;
+    }
     cmd.writeTimestamp(S::eBottomOfPipe, *queries, 1);
     cmd.copyBuffer(*accum.buffer, *readback.buffer, vk::BufferCopy(0, 0, accumSize));
     cmd.copyBuffer(*counters.buffer, *readback.buffer,
@@ -167,7 +172,7 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
     const auto* px = static_cast<const AccumPixel*>(readback.mapped);
     for (size_t i = 0; i < pixels; ++i) {
       film.sum[i] += glm::dvec3(px[i].sum);
-      film.sampleCount[i] += uint64_t(passes) - px[i].invalid;
+      film.sampleCount[i] += uint64_t(samples) - px[i].invalid;
       film.invalidCount[i] += px[i].invalid;
     }
     DeviceCounters c;
@@ -175,7 +180,7 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
     stats.rays += uint64_t(c.raysHigh) << 32 | c.raysLow;
     stats.truncatedSamples += c.truncated;
     stats.maxLoopIterations = std::max(stats.maxLoopIterations, c.maxLoopIterations);
-    done += passes;
+    done += samples;
     if (options.progress) options.progress(double(done) / double(options.spp));
   }
   stats.invalidSamples = film.totalInvalid();

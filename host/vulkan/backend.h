@@ -1,5 +1,6 @@
 // The Vulkan backend: uploads the flat scene arrays and runs shaders/pathtrace.comp in
-// passes of one sample per pixel, accumulating on the device and folding into the host film.
+// passes (dispatches) of one or more samples per pixel, accumulating on the device and folding
+// into the host film's double-precision sums.
 #pragma once
 
 #include <functional>
@@ -14,6 +15,7 @@ struct VulkanRenderOptions {
   ContextOptions context;
   uint32_t firstSample = 0;
   int spp = 1;
+  int samplesPerPass = 1;   // samples per pixel in one dispatch (see --samples-per-pass)
   int passesPerFlush = 16;  // passes accumulated in float on the device before a fold
   bool specialize = true;   // false: every effect compiled in (to measure what it saves)
   int debugPixelX = -1, debugPixelY = -1;  // print this pixel's paths (needs debugPrintf)
