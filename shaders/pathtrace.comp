@@ -21,6 +21,7 @@ layout(constant_id = PT_SPEC_BSDF_EMISSION) const bool kBsdfEmission = true;
 layout(constant_id = PT_SPEC_MIS) const bool kMis = true;
 layout(constant_id = PT_SPEC_RR) const bool kRussianRoulette = true;
 layout(constant_id = PT_SPEC_WATERTIGHT) const bool kWatertight = true;
+layout(constant_id = PT_SPEC_SOBOL) const bool kSobol = true;
 
 layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer {
   RenderParams params;
@@ -58,6 +59,8 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 
 // Watertight unless switched off by specialization or, unspecialized, by the parameters.
 #define PT_WATERTIGHT (kWatertight && params.fastIntersection == 0u)
+// The sampler, likewise: Owen-scrambled Sobol points or independent hashes.
+#define PT_SOBOL (kSobol && params.samplerType == kSamplerSobol)
 #include "bvh.glsl"
 
 float maxComponent(vec3 v) {
@@ -80,10 +83,11 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
   bool misOn = kMis && params.strategy == kStrategyMis;
   bool bsdfEmissionOn = kBsdfEmission && params.strategy != kStrategyNee;
   bool rouletteOn = kRussianRoulette && params.russianRoulette != 0u;
+  bool sobol = PT_SOBOL;  // else independent random numbers
   // Primary ray through a uniformly jittered point of the pixel (box filter of width 1).
   vec3 origin = params.camera.position;
-  vec3 direction =
-      cameraDirection(params.camera, vec2(pixel) + random2(pixel, sampleIndex, kDimPixel, seed));
+  vec3 direction = cameraDirection(
+      params.camera, vec2(pixel) + random2(sobol, pixel, sampleIndex, kDimPixel, seed));
   vec3 L = vec3(0.0);     // radiance gathered so far
   vec3 beta = vec3(1.0);  // path throughput
   // The camera ray counts as specular: emission it finds is taken at full weight.
@@ -157,13 +161,13 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
       // Sample direct illumination from an emitter (next-event estimation).
       if (neeOn && material.reflectance != vec3(0.0)) {
         // Pick an emitter from the alias table, then a uniform point on its triangle.
-        vec2 uChoose = random2(pixel, sampleIndex, dim + kDimLightChoose, seed);
+        vec2 uChoose = random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed);
         uint slot = min(uint(uChoose.x * float(params.emitterCount)), params.emitterCount - 1u);
         Emitter chosen = emitters[slot];
         Emitter emitter = emitters[uChoose.y < chosen.aliasThreshold ? slot : chosen.alias];
         Triangle light = triangles[emitter.triangle];
-        vec2 b =
-            sampleTriangleBarycentrics(random2(pixel, sampleIndex, dim + kDimLightPoint, seed));
+        vec2 b = sampleTriangleBarycentrics(
+            random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed));
         vec3 lightPoint = (1.0 - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
         vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
         float lightArea = 0.5 * length(lightCross);
@@ -198,8 +202,8 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
         }
       }
       // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
-      wi = localToWorld(sampleCosineHemisphere(random2(pixel, sampleIndex, dim + kDimBsdf, seed)),
-                        n);
+      wi = localToWorld(
+          sampleCosineHemisphere(random2(sobol, pixel, sampleIndex, dim + kDimBsdf, seed)), n);
       bsdfPdf = dot(wi, n) * kInvPi;
       if (!(bsdfPdf > 0.0)) {  // direction in the tangent plane: zero contribution
         pathEnded = true;
@@ -216,7 +220,7 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
     // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
     if (rouletteOn && depth >= params.rrStartDepth) {
       float q = max(0.0, 1.0 - maxComponent(beta));
-      if (random1(pixel, sampleIndex, dim + kDimRoulette, seed) < q) {
+      if (random1(sobol, pixel, sampleIndex, dim + kDimRoulette, seed) < q) {
         pathEnded = true;
         break;
       }

@@ -32,17 +32,69 @@ PT_INLINE uvec4 pcg4d(uvec4 v) {
   return v;
 }
 
-// Two uniform numbers in [0, 1) for (pixel, sample, dimension, seed). The top 24 bits of a
-// hash word convert to float exactly, so both sides get the same bits. The seed is spread
-// by an odd constant (the golden ratio in 32-bit fixed point) so that neighbouring seeds do
-// not share dimensions.
-PT_INLINE vec2 random2(uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
+// Two uniform numbers in [0, 1) for (pixel, sample, dimension, seed), independent of every
+// other pair. The top 24 bits of a hash word convert to float exactly, so both sides get the
+// same bits. The seed is spread by an odd constant (the golden ratio in 32-bit fixed point)
+// so that neighbouring seeds do not share dimensions.
+PT_INLINE vec2 independentRandom2(uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
   uvec4 h = pcg4d(uvec4(pixel.x, pixel.y, sampleIndex, dimension + seed * 0x9E3779B9u));
   return vec2(float(h.x >> 8u), float(h.y >> 8u)) * (1.0f / 16777216.0f);
 }
 
-PT_INLINE float random1(uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
-  return random2(pixel, sampleIndex, dimension, seed).x;
+// ---- Low-discrepancy numbers: Owen-scrambled Sobol points ------------------------------
+// Each dimension (a pair of numbers) of a pixel takes the first two dimensions of the Sobol
+// sequence, a (0,2)-sequence: any 2^k consecutive points from an aligned start fill every
+// elementary interval of area 2^-k once. Following Burley ("Practical Hash-based Owen
+// Scrambling", JCGT 2020), the points are Owen-scrambled by a hash, so that the pixel's
+// error is unbiased and decorrelated from its neighbours', and their order is shuffled per
+// pixel and dimension (a nested scramble of the index keeps aligned power-of-two blocks
+// together, so the first 2^k samples are still such a net), which decorrelates the
+// dimensions of one path from each other. All of it is loop-free 32-bit integer arithmetic.
+
+// Sobol's second dimension: bit 31 - m of the result is the XOR of the index bits k whose
+// binomial coefficient C(k, m) is odd, that is (Lucas) the bits k that contain m as a
+// submask. Five shift-XOR steps sum every superset; the reversal puts bit m at 31 - m.
+PT_INLINE uint sobolSecondDimension(uint index) {
+  uint y = index;
+  y ^= (y >> 1u) & 0x55555555u;
+  y ^= (y >> 2u) & 0x33333333u;
+  y ^= (y >> 4u) & 0x0F0F0F0Fu;
+  y ^= (y >> 8u) & 0x00FF00FFu;
+  y ^= (y >> 16u) & 0x0000FFFFu;
+  return bitfieldReverse(y);
+}
+
+// Nested uniform scramble of the bits of x, most significant first: each bit is flipped by
+// a hash of the seed and of the bits above it. The multiply-XOR steps (Laine and Karras
+// 2011, with their constants) let each bit depend only on lower bits, hence the reversals.
+PT_INLINE uint nestedUniformScramble(uint x, uint seed) {
+  x = bitfieldReverse(x);
+  x += seed;
+  x ^= x * 0x6C50B47Cu;
+  x ^= x * 0xB82F1E52u;
+  x ^= x * 0xC7AFE638u;
+  x ^= x * 0x8D22F6E6u;
+  return bitfieldReverse(x);
+}
+
+PT_INLINE vec2 sobolRandom2(uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
+  // Per pixel and dimension: a shuffle of the sample order and a scramble per coordinate.
+  uvec4 h = pcg4d(uvec4(pixel.x, pixel.y, dimension, seed * 0x9E3779B9u + 0x7F4A7C15u));
+  uint i = nestedUniformScramble(sampleIndex, h.x);
+  uint x = nestedUniformScramble(bitfieldReverse(i), h.y);  // Sobol's first dimension
+  uint y = nestedUniformScramble(sobolSecondDimension(i), h.z);
+  return vec2(float(x >> 8u), float(y >> 8u)) * (1.0f / 16777216.0f);
+}
+
+// The integrators' source of random numbers: two numbers in [0, 1) for one dimension of one
+// path sample, from the chosen sampler (kSamplerIndependent or kSamplerSobol).
+PT_INLINE vec2 random2(bool sobol, uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
+  return sobol ? sobolRandom2(pixel, sampleIndex, dimension, seed)
+               : independentRandom2(pixel, sampleIndex, dimension, seed);
+}
+
+PT_INLINE float random1(bool sobol, uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
+  return random2(sobol, pixel, sampleIndex, dimension, seed).x;
 }
 
 // ---- Directions and points -------------------------------------------------------------

@@ -89,6 +89,10 @@ PT_CONST uint kStrategyMis = 0u;   // light sampling + BSDF sampling, power heur
 PT_CONST uint kStrategyNee = 1u;   // light sampling only (emission hit by BSDF rays ignored)
 PT_CONST uint kStrategyBsdf = 2u;  // BSDF sampling only (no shadow rays)
 
+// Where the integrators' random numbers come from (sampling.h).
+PT_CONST uint kSamplerIndependent = 0u;  // a hash per (pixel, sample, dimension): independent
+PT_CONST uint kSamplerSobol = 1u;        // Owen-scrambled Sobol points per dimension
+
 struct RenderParams {
   Camera camera;          // 64 bytes
   uint maxDepth;          //  4 bytes: maximum number of scattering events on a path
@@ -98,7 +102,7 @@ struct RenderParams {
   uint strategy;          //  4 bytes: kStrategyMis, kStrategyNee or kStrategyBsdf
   uint russianRoulette;   // 4 bytes: 0 or 1
   uint fastIntersection;  // 4 bytes: 1: Moller-Trumbore (not watertight), 0: watertight
-  uint reserved;          //  4 bytes: zero (std430 rounds the struct to 16 bytes)
+  uint samplerType;       //  4 bytes: kSamplerIndependent or kSamplerSobol
 };                        // 96 bytes
 
 // ---- Compute pipeline interface (Vulkan backend) ----------------------------------------
@@ -121,6 +125,7 @@ struct RenderParams {
 #define PT_SPEC_MIS 4            // bool: weigh the two with the power heuristic
 #define PT_SPEC_RR 5             // bool: Russian roulette
 #define PT_SPEC_WATERTIGHT 6     // bool: watertight intersection (false: Moller-Trumbore)
+#define PT_SPEC_SOBOL 7          // bool: Owen-scrambled Sobol numbers (false: independent)
 
 PT_CONST uint kWorkgroupSize = 8u;  // workgroups of 8 x 8 pixels
 

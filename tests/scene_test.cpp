@@ -169,6 +169,7 @@ TEST(SceneLoad, DefaultsWhenCameraAndIntegratorAreMissing) {
   EXPECT_EQ(scene.integrator.spp, integrator.spp);
   EXPECT_EQ(scene.integrator.maxDepth, integrator.maxDepth);
   EXPECT_EQ(scene.integrator.strategy, integrator.strategy);
+  EXPECT_EQ(scene.integrator.sampler, integrator.sampler);
   EXPECT_EQ(scene.integrator.russianRoulette, integrator.russianRoulette);
   EXPECT_EQ(scene.materials[0].reflectance, glm::vec3(0.8f));  // diffuse default
   EXPECT_EQ(scene.triangles.size(), 2u);
@@ -179,12 +180,14 @@ TEST(SceneLoad, IntegratorEdgeValues) {
   const Scene scene = loadScene(dir.write(
       "scene.json", sceneJson(kWhite, kUnitQuad,
                               R"("integrator": {"spp": 64.0, "maxDepth": 0, "seed": 4294967295,
-                                  "rrStartDepth": 1, "strategy": "bsdf"})")));
+                                  "rrStartDepth": 1, "strategy": "bsdf",
+                                  "sampler": "independent"})")));
   EXPECT_EQ(scene.integrator.spp, 64);  // integral floats are accepted
   EXPECT_EQ(scene.integrator.maxDepth, 0);
   EXPECT_EQ(scene.integrator.seed, 4294967295u);
   EXPECT_EQ(scene.integrator.rrStartDepth, 1);
   EXPECT_EQ(scene.integrator.strategy, kStrategyBsdf);
+  EXPECT_EQ(scene.integrator.sampler, kSamplerIndependent);
 }
 
 TEST(SceneLoad, MirroringTransformKeepsVertexOrder) {
@@ -384,6 +387,9 @@ TEST(SceneIntegrator, BadIntegratorValues) {
                   "integrator.russianRoulette: expected true or false, got a number");
   EXPECT_CONTAINS(withIntegrator(R"({"strategy": "nie"})"),
                   "integrator.strategy: unknown strategy 'nie' (did you mean 'nee'?)");
+  EXPECT_CONTAINS(
+      withIntegrator(R"({"sampler": "halton"})"),
+      "integrator.sampler: unknown sampler 'halton' (expected 'independent' or 'sobol')");
   EXPECT_CONTAINS(withIntegrator(R"({"strategy": "path"})"),
                   "integrator.strategy: unknown strategy 'path' (expected 'mis', 'nee' or 'bsdf')");
   EXPECT_CONTAINS(withIntegrator(R"({"samples": 4})"), "integrator.samples: unknown key");

@@ -42,6 +42,20 @@ TEST(Vulkan, FastIntersectionMatchesCpuReference) {
   expectAgreement(renderBoth(data, 4, /*specialize=*/false));
 }
 
+TEST(Vulkan, BothSamplersMatchCpuReference) {
+  // Independent and Owen-scrambled Sobol numbers are the same on both backends, with the
+  // sampler specialised and decided at run time.
+  for (uint sampler : {kSamplerIndependent, kSamplerSobol}) {
+    SCOPED_TRACE("sampler " + std::to_string(sampler));
+    RenderSettings settings{.width = 48, .height = 48};
+    settings.sampler = int(sampler);
+    const SceneData data = prepareScene(loadScene(kConfigs / "cornell-mirror.json"), settings);
+    EXPECT_EQ(data.effects.sobol, sampler == kSamplerSobol);
+    expectAgreement(renderBoth(data, 4));
+    expectAgreement(renderBoth(data, 4, /*specialize=*/false));
+  }
+}
+
 TEST(Vulkan, UnspecializedShaderGivesTheSameImage) {
   // Every effect compiled in and decided at run time must not change the result.
   const SceneData data = prepare("cornell-mirror.json", 32);

@@ -202,6 +202,10 @@ void addOverrideOptions(CLI::App* cmd, SceneOverrides& o) {
                   "Ray/triangle test: watertight (Woop et al.) or fast (Moller-Trumbore, leaks)")
       ->check(CLI::IsMember({"watertight", "fast"}))
       ->capture_default_str();
+  cmd->add_option("--sampler", o.sampler,
+                  "Random numbers: independent (a hash per sample) or sobol (Owen-scrambled "
+                  "Sobol points); default: the scene's")
+      ->check(CLI::IsMember({"independent", "sobol"}));
 }
 
 }  // namespace

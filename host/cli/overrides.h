@@ -17,6 +17,7 @@ struct SceneOverrides {
   std::string roulette;                     // on, off; empty: the scene's
   std::string builder = "lbvh";             // lbvh, sah
   std::string intersection = "watertight";  // watertight, fast
+  std::string sampler;                      // independent, sobol; empty: the scene's
 
   RenderSettings toSettings() const {
     RenderSettings s;
@@ -31,6 +32,8 @@ struct SceneOverrides {
     if (!roulette.empty()) s.russianRoulette = roulette == "on" ? 1 : 0;
     s.builder = builder == "sah" ? BvhBuilder::kBinnedSah : BvhBuilder::kLbvh;
     s.fastIntersection = intersection == "fast";
+    if (sampler == "independent") s.sampler = int(kSamplerIndependent);
+    if (sampler == "sobol") s.sampler = int(kSamplerSobol);
     return s;
   }
 };

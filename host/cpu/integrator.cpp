@@ -37,6 +37,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
   const RenderParams& params = scene.params;
   const Bvh& bvh = scene.bvh;
   const uint seed = params.seed;
+  const bool sobol = params.samplerType == kSamplerSobol;  // else independent random numbers
   const bool misOn = params.strategy == kStrategyMis;
   const bool neeOn = params.strategy != kStrategyBsdf && params.emitterCount > 0;
   const bool bsdfEmissionOn = params.strategy != kStrategyNee;
@@ -44,7 +45,8 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
       params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
 
   // Primary ray through a uniformly jittered point of the pixel (box filter of width 1).
-  Ray ray = cameraRay(params.camera, vec2(pixel) + random2(pixel, sampleIndex, kDimPixel, seed));
+  Ray ray =
+      cameraRay(params.camera, vec2(pixel) + random2(sobol, pixel, sampleIndex, kDimPixel, seed));
   vec3 L(0.0f);     // radiance gathered so far
   vec3 beta(1.0f);  // path throughput
   // The camera ray counts as specular: emission it finds is taken at full weight.
@@ -111,15 +113,15 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
       // Sample direct illumination from an emitter (next-event estimation).
       if (neeOn && material.reflectance != vec3(0.0f)) {
         // Pick an emitter from the alias table, then a uniform point on its triangle.
-        const vec2 uChoose = random2(pixel, sampleIndex, dim + kDimLightChoose, seed);
+        const vec2 uChoose = random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed);
         const uint slot =
             std::min(uint(uChoose.x * float(params.emitterCount)), params.emitterCount - 1u);
         const Emitter& chosen = scene.emitters[slot];
         const Emitter& emitter =
             uChoose.y < chosen.aliasThreshold ? chosen : scene.emitters[chosen.alias];
         const Triangle& light = bvh.triangles[emitter.triangle];
-        const vec2 b =
-            sampleTriangleBarycentrics(random2(pixel, sampleIndex, dim + kDimLightPoint, seed));
+        const vec2 b = sampleTriangleBarycentrics(
+            random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed));
         const vec3 lightPoint = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
         const vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
         const float lightArea = 0.5f * length(lightCross);
@@ -151,8 +153,8 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
         }
       }
       // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
-      wi = localToWorld(sampleCosineHemisphere(random2(pixel, sampleIndex, dim + kDimBsdf, seed)),
-                        n);
+      wi = localToWorld(
+          sampleCosineHemisphere(random2(sobol, pixel, sampleIndex, dim + kDimBsdf, seed)), n);
       bsdfPdf = dot(wi, n) * kInvPi;
       if (!(bsdfPdf > 0.0f)) break;  // direction in the tangent plane: zero contribution
       beta *= material.reflectance;
@@ -163,7 +165,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
     if (params.russianRoulette != 0u && depth >= params.rrStartDepth) {
       const float q = std::max(0.0f, 1.0f - maxComponent(beta));
-      if (random1(pixel, sampleIndex, dim + kDimRoulette, seed) < q) break;
+      if (random1(sobol, pixel, sampleIndex, dim + kDimRoulette, seed) < q) break;
       beta /= 1.0f - q;
     }
 

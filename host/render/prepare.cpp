@@ -20,6 +20,7 @@ std::string EffectSet::toString() const {
   add(mis, "mis");
   add(russianRoulette, "rr");
   add(!watertight, "fast-isect");
+  add(sobol, "sobol");
   return s.empty() ? "none" : s;
 }
 
@@ -127,6 +128,7 @@ SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
   p.seed = settings.seed >= 0 ? uint32_t(settings.seed) : integ.seed;
   p.strategy = settings.strategy >= 0 ? uint32_t(settings.strategy) : integ.strategy;
   p.fastIntersection = settings.fastIntersection ? 1u : 0u;
+  p.samplerType = settings.sampler >= 0 ? uint32_t(settings.sampler) : integ.sampler;
   p.russianRoulette = settings.russianRoulette >= 0 ? uint32_t(settings.russianRoulette)
                                                     : (integ.russianRoulette ? 1u : 0u);
 
@@ -143,6 +145,7 @@ SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
       fx.diffuse && scatters && !data.emitters.empty() && p.strategy != kStrategyBsdf;
   fx.bsdfEmission = !data.emitters.empty() && p.strategy != kStrategyNee;
   fx.watertight = !settings.fastIntersection;
+  fx.sobol = p.samplerType == kSamplerSobol;
   fx.mis = fx.lightSampling && fx.bsdfEmission && p.strategy == kStrategyMis;
   fx.russianRoulette = p.russianRoulette != 0 && scatters && (fx.diffuse || fx.mirror);
   return data;

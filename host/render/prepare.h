@@ -23,6 +23,7 @@ struct RenderSettings {
   bool fastIntersection = false;  // Moller-Trumbore instead of the watertight test
   int strategy = -1;              // kStrategy*, -1: from the scene
   int russianRoulette = -1;       // 0 off, 1 on, -1: from the scene
+  int sampler = -1;               // kSampler*, -1: from the scene
 };
 
 // Which effects the scene calls for; the rest are compiled or switched out.
@@ -34,7 +35,8 @@ struct EffectSet {
   bool mis = false;            // both of the above, weighed by the power heuristic
   bool russianRoulette = false;
   bool watertight = true;        // false: the faster, leaky Moller-Trumbore test
-  std::string toString() const;  // e.g. "diffuse+mirror+nee+mis+rr" (+"fast-isect")
+  bool sobol = false;            // Owen-scrambled Sobol numbers instead of independent ones
+  std::string toString() const;  // e.g. "diffuse+mirror+nee+mis+rr" (+"fast-isect", "sobol")
 };
 
 struct SceneData {

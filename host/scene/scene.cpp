@@ -99,7 +99,8 @@ CameraDesc readCamera(const JsonNode& node) {
 }
 
 IntegratorSettings readIntegrator(const JsonNode& node) {
-  node.checkKeys({"spp", "maxDepth", "seed", "russianRoulette", "rrStartDepth", "strategy"});
+  node.checkKeys(
+      {"spp", "maxDepth", "seed", "russianRoulette", "rrStartDepth", "strategy", "sampler"});
   IntegratorSettings s;
   if (auto n = node.find("spp")) s.spp = static_cast<int>(n->integer(1, kIntMax));
   if (auto n = node.find("maxDepth")) s.maxDepth = static_cast<int>(n->integer(0, kIntMax));
@@ -112,6 +113,11 @@ IntegratorSettings readIntegrator(const JsonNode& node) {
     static constexpr std::array<Choice<uint>, 3> kStrategies{
         {{"mis", kStrategyMis}, {"nee", kStrategyNee}, {"bsdf", kStrategyBsdf}}};
     s.strategy = readChoice(*n, kStrategies, "strategy");
+  }
+  if (auto n = node.find("sampler")) {
+    static constexpr std::array<Choice<uint>, 2> kSamplers{
+        {{"independent", kSamplerIndependent}, {"sobol", kSamplerSobol}}};
+    s.sampler = readChoice(*n, kSamplers, "sampler");
   }
   return s;
 }

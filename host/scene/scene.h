@@ -28,6 +28,7 @@ struct IntegratorSettings {
   bool russianRoulette = true;
   int rrStartDepth = 3;  // Russian roulette from this many scattering events on
   uint strategy = kStrategyMis;
+  uint sampler = kSamplerSobol;  // see docs/accuracy.md for what it buys
 };
 
 struct Scene {

@@ -17,7 +17,7 @@ namespace {
 
 // The effect set as specialization constants, in PT_SPEC_* id order.
 struct SpecData {
-  vk::Bool32 values[7];
+  vk::Bool32 values[8];
 };
 
 }  // namespace
@@ -71,12 +71,12 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   const bool all = !options.specialize;
   const SpecData spec{{all || fx.diffuse, all || fx.mirror, all || fx.lightSampling,
                        all || fx.bsdfEmission, all || fx.mis, all || fx.russianRoulette,
-                       all || fx.watertight}};
+                       all || fx.watertight, all || fx.sobol}};
   static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
                 PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
-                PT_SPEC_WATERTIGHT == 6);
+                PT_SPEC_WATERTIGHT == 6 && PT_SPEC_SOBOL == 7);
   std::vector<vk::SpecializationMapEntry> entries;
-  for (uint32_t id = 0; id < 7; ++id) {
+  for (uint32_t id = 0; id < 8; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(vk::Bool32)), sizeof(vk::Bool32));
   }
   const vk::SpecializationInfo specInfo(entries, vk::ArrayProxyNoTemporaries<const SpecData>(spec));
