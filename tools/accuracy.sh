@@ -6,6 +6,7 @@
 # Environment:
 #   REF_SPP  reference samples per pixel (default 32 x MAX_SPP)
 #   TARGET   relMSE whose time to reach is tabulated (default 0.01)
+#   RUNS     rounds of every configuration; times are the median over rounds (default 3)
 #   THREADS  CPU threads, and LP_NUM_THREADS for lavapipe (default: all cores)
 #   BUILD    build directory (default build)
 #   REUSE_REF=1 keeps a reference already rendered with the same size, spp and seed
@@ -18,6 +19,7 @@ size=${1:-64}
 max_spp=${2:-256}
 ref_spp=${REF_SPP:-$((32 * max_spp))}
 target=${TARGET:-0.01}
+runs=${RUNS:-3}
 threads=${THREADS:-$(nproc)}
 build=${BUILD:-build}
 ref_seed=1000003  # the studied runs use the scenes' own seed, 0
@@ -64,8 +66,9 @@ if [[ ${REPORT_ONLY:-0} == 1 ]]; then
 else
   rm -f "$out"/csv/*.csv "$out"/problems.txt
   started=$SECONDS
+  reference() { echo "$out/$1-ref-${size}px-${ref_spp}spp-seed$ref_seed.exr"; }
   for scene in "${scenes[@]}"; do
-    ref=$out/$scene-ref-${size}px-${ref_spp}spp-seed$ref_seed.exr
+    ref=$(reference "$scene")
     if [[ ${REUSE_REF:-0} == 1 && -f $ref ]]; then
       echo "== $scene: reusing $ref"
     else
@@ -73,28 +76,35 @@ else
       "$pt" render "configs/$scene.json" --backend cpu --threads "$threads" --width "$size" \
         --height "$size" --spp "$ref_spp" --seed "$ref_seed" --out "$ref" 2>/dev/null
     fi
-    for backend in cpu vulkan; do
-      labels=$cpu_labels
-      [[ $backend == vulkan ]] && labels=$vulkan_labels
-      for label in $labels; do
-        name=$scene.$backend.$label
-        # shellcheck disable=SC2086  # flags are words
-        if "$pt" converge "configs/$scene.json" --backend "$backend" --threads "$threads" \
-          --width "$size" --height "$size" --max-spp "$max_spp" --reference "$ref" \
-          --label "$label" --csv "$out/csv/$name.csv" ${flags[$label]} >"$out/logs/$name.txt" \
-          2>"$out/logs/$name.err"; then
-          status=0
-        else
-          status=$?
-        fi
-        # Status 1: some samples were NaN/Inf or cut short; the rows are kept and flagged.
-        if ((status == 1)); then
-          echo "$name: $(tail -1 "$out/logs/$name.err")" >>"$out/problems.txt"
-        elif ((status != 0)); then
-          cat "$out/logs/$name.err" >&2
-          exit "$status"
-        fi
-        echo "$name: $(tail -1 "$out/logs/$name.txt")  (elapsed ${SECONDS}s)"
+  done
+  # Every configuration once per round, so that a slow spell of the machine hits one round
+  # of every configuration rather than every round of one.
+  for ((run = 1; run <= runs; ++run)); do
+    for scene in "${scenes[@]}"; do
+      ref=$(reference "$scene")
+      for backend in cpu vulkan; do
+        labels=$cpu_labels
+        [[ $backend == vulkan ]] && labels=$vulkan_labels
+        for label in $labels; do
+          name=$scene.$backend.$label.run$run
+          # shellcheck disable=SC2086  # flags are words
+          if "$pt" converge "configs/$scene.json" --backend "$backend" --threads "$threads" \
+            --width "$size" --height "$size" --max-spp "$max_spp" --reference "$ref" \
+            --label "$label" --csv "$out/csv/$name.csv" ${flags[$label]} \
+            >"$out/logs/$name.txt" 2>"$out/logs/$name.err"; then
+            status=0
+          else
+            status=$?
+          fi
+          # Status 1: some samples were NaN/Inf or cut short; the rows are kept and flagged.
+          if ((status == 1)); then
+            echo "$name: $(tail -1 "$out/logs/$name.err")" >>"$out/problems.txt"
+          elif ((status != 0)); then
+            cat "$out/logs/$name.err" >&2
+            exit "$status"
+          fi
+          echo "$name: $(tail -1 "$out/logs/$name.txt")  (elapsed ${SECONDS}s)"
+        done
       done
     done
   done
@@ -115,15 +125,30 @@ else
   cpu_model=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
   vk_device=$("$pt" devices 2>/dev/null | head -1 | sed 's/^[0-9]*: //') || vk_device="(none)"
   run_date=$(date -u +%Y-%m-%d)
-  declare -p size max_spp ref_spp threads elapsed cpu_model vk_device run_date >"$run_info"
+  declare -p size max_spp ref_spp runs threads elapsed cpu_model vk_device run_date >"$run_info"
 fi
 rm -f "$out"/dat/*.dat "$out"/dat/*.guide "$plots"/accuracy-*.png
 
-# ---- Merge, split per curve for gnuplot ------------------------------------------------------
+# ---- Merge the rounds (median seconds and Mrays/s per level), split per curve for gnuplot ----
+# The errors do not depend on the round: the same sample indices give the same image.
 merged=$out/accuracy.csv
 {
   echo "label,backend,scene,width,height,spp,seconds,rmse,relmse,mrays_per_s"
-  for f in "$out"/csv/*.csv; do tail -n +2 "$f"; done
+  for f in "$out"/csv/*.csv; do tail -n +2 "$f"; done |
+    sort -t, -k1,1 -k2,2 -k3,3 -k4,4n -k5,5n -k6,6n |
+    awk -F, -v OFS=, '
+      function median(list,   v, n, i, j, x) {
+        n = split(list, v, " ")
+        for (i = 2; i <= n; ++i) for (j = i; j > 1 && v[j - 1] + 0 > v[j] + 0; --j) {
+          x = v[j]; v[j] = v[j - 1]; v[j - 1] = x
+        }
+        return n % 2 ? v[(n + 1) / 2] : (v[n / 2] + v[n / 2 + 1]) / 2
+      }
+      function flush() { if (key != "") print key, median(secs), rest, median(mrays) }
+      { k = $1 OFS $2 OFS $3 OFS $4 OFS $5 OFS $6
+        if (k != key) { flush(); key = k; secs = ""; mrays = "" }
+        secs = secs " " $7; mrays = mrays " " $10; rest = $8 OFS $9 }
+      END { flush() }'
 } >"$merged"
 awk -F, -v dir="$out/dat" 'NR > 1 {
   f = dir "/" $3 "." $2 "." $1 ".dat"; print $6, $7, $9 > f }' "$merged"
@@ -251,9 +276,9 @@ below comes from that run.
 - Image ${size}x${size}; \`pt converge\` levels 1, 2, 4, … $max_spp spp; references rendered on
   the CPU at $ref_spp spp with seed $ref_seed (the studied runs use the scenes' seed 0).
 - Rendering took $((elapsed / 60)) min $((elapsed % 60)) s of wall time, one render at a time.
-- Each configuration ran once, so its times carry whatever else the machine was doing (see
-  the notes on this run); the errors (relMSE at a given spp) are deterministic and do not
-  depend on the load.
+- Every configuration ran $runs times, in $runs rounds of all of them; the times and Mrays/s
+  are the medians over the rounds. The errors (relMSE at a given spp) are deterministic and
+  do not depend on the round or on the load.
 
 ## How to rerun
 
@@ -262,11 +287,11 @@ tools/accuracy.sh [SIZE] [MAX_SPP]     # e.g. tools/accuracy.sh $size $max_spp
 \`\`\`
 
 It installs packages and builds like the other tools, renders the references into
-\`out/accuracy/\`, runs \`pt converge\` once per configuration and backend, one render at a
+\`out/accuracy/\`, runs \`pt converge\` RUNS times per configuration and backend, one render at a
 time, merges the rows into \`out/accuracy/accuracy.csv\`, draws \`docs/plots/accuracy-*.png\`
 with gnuplot and rewrites this file (the notes block at the end is kept). \`REF_SPP\`,
-\`TARGET\`, \`THREADS\` and \`BUILD\` override the defaults (32 × MAX_SPP, 0.01, all cores,
-\`build\`); \`REPORT_ONLY=1\` redraws the plots and this file from the last run's CSVs without
+\`TARGET\`, \`RUNS\`, \`THREADS\` and \`BUILD\` override the defaults (32 × MAX_SPP, 0.01, 3,
+all cores, \`build\`); \`REPORT_ONLY=1\` redraws the plots and this file from the last run's CSVs without
 rendering. One configuration by hand:
 
 \`\`\`sh
