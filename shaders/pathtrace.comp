@@ -20,8 +20,8 @@ layout(constant_id = PT_SPEC_NEE) const bool kNee = true;
 layout(constant_id = PT_SPEC_BSDF_EMISSION) const bool kBsdfEmission = true;
 layout(constant_id = PT_SPEC_MIS) const bool kMis = true;
 layout(constant_id = PT_SPEC_RR) const bool kRussianRoulette = true;
-layout(constant_id = PT_SPEC_WATERTIGHT) const bool kWatertight = true;
-layout(constant_id = PT_SPEC_SOBOL) const bool kSobol = true;
+layout(constant_id = PT_SPEC_INTERSECTION) const uint kIntersection = kSpecAtRunTime;
+layout(constant_id = PT_SPEC_SAMPLER) const uint kSampler = kSpecAtRunTime;
 
 layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer {
   RenderParams params;
@@ -58,9 +58,11 @@ uint gRays = 0u;
 bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 
 // Watertight unless switched off by specialization or, unspecialized, by the parameters.
-#define PT_WATERTIGHT (kWatertight && params.fastIntersection == 0u)
+#define PT_WATERTIGHT \
+  (kIntersection == kSpecAtRunTime ? params.fastIntersection == 0u : kIntersection == 0u)
 // The sampler, likewise: Owen-scrambled Sobol points or independent hashes.
-#define PT_SOBOL (kSobol && params.samplerType == kSamplerSobol)
+#define PT_SOBOL \
+  (kSampler == kSpecAtRunTime ? params.samplerType == kSamplerSobol : kSampler == kSamplerSobol)
 #include "bvh.glsl"
 
 float maxComponent(vec3 v) {

@@ -124,8 +124,12 @@ struct RenderParams {
 #define PT_SPEC_BSDF_EMISSION 3  // bool: count emission reached by BSDF-sampled rays
 #define PT_SPEC_MIS 4            // bool: weigh the two with the power heuristic
 #define PT_SPEC_RR 5             // bool: Russian roulette
-#define PT_SPEC_WATERTIGHT 6     // bool: watertight intersection (false: Moller-Trumbore)
-#define PT_SPEC_SOBOL 7          // bool: Owen-scrambled Sobol numbers (false: independent)
+// Two choices between alternatives: the value of the parameter the scene chose, so that only
+// that alternative is compiled, or kSpecAtRunTime to compile both and read RenderParams.
+#define PT_SPEC_INTERSECTION 6  // uint: RenderParams::fastIntersection (0 watertight, 1 fast)
+#define PT_SPEC_SAMPLER 7       // uint: RenderParams::samplerType (independent or Sobol)
+#define PT_SPEC_COUNT 8
+PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 PT_CONST uint kWorkgroupSize = 8u;  // workgroups of 8 x 8 pixels
 

@@ -15,9 +15,10 @@
 namespace pt {
 namespace {
 
-// The effect set as specialization constants, in PT_SPEC_* id order.
+// The effect set as specialization constants, in PT_SPEC_* id order: booleans (VkBool32)
+// for the effects, the chosen value (or kSpecAtRunTime) for the two choices.
 struct SpecData {
-  vk::Bool32 values[8];
+  uint32_t values[PT_SPEC_COUNT];
 };
 
 }  // namespace
@@ -69,15 +70,17 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   // ---- Pipeline, specialised to the scene's effect set --------------------------------------
   const EffectSet& fx = scene.effects;
   const bool all = !options.specialize;
+  const RenderParams& params = scene.params;
   const SpecData spec{{all || fx.diffuse, all || fx.mirror, all || fx.lightSampling,
                        all || fx.bsdfEmission, all || fx.mis, all || fx.russianRoulette,
-                       all || fx.watertight, all || fx.sobol}};
+                       all ? kSpecAtRunTime : params.fastIntersection,
+                       all ? kSpecAtRunTime : params.samplerType}};
   static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
                 PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
-                PT_SPEC_WATERTIGHT == 6 && PT_SPEC_SOBOL == 7);
+                PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_COUNT == 8);
   std::vector<vk::SpecializationMapEntry> entries;
-  for (uint32_t id = 0; id < 8; ++id) {
-    entries.emplace_back(id, uint32_t(id * sizeof(vk::Bool32)), sizeof(vk::Bool32));
+  for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
+    entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));
   }
   const vk::SpecializationInfo specInfo(entries, vk::ArrayProxyNoTemporaries<const SpecData>(spec));
   std::vector<const Buffer*> bound;
