@@ -31,11 +31,17 @@ inline std::vector<Triangle> loadBunny() {
   return loadScene(dir / "bunny.json").triangles;
 }
 
+// Vertices are matched by exact position: a closed mesh shares them bit for bit.
+using PositionKey = std::tuple<float, float, float>;
+inline PositionKey positionKey(vec3 v) {
+  return PositionKey(v.x, v.y, v.z);
+}
+
 // How many edges are not shared by exactly two triangles that traverse them in opposite
 // directions (0 for a closed, consistently oriented mesh). Vertices are matched by position.
 inline size_t openOrMisorientedEdges(const std::vector<Triangle>& tris) {
-  auto key = [](vec3 v) { return std::tuple(v.x, v.y, v.z); };
-  std::map<std::pair<std::tuple<float, float, float>, std::tuple<float, float, float>>, int> use;
+  const auto key = positionKey;
+  std::map<std::pair<PositionKey, PositionKey>, int> use;
   for (const Triangle& t : tris) {
     const vec3 v[3] = {t.v0, t.v1, t.v2};
     for (int i = 0; i < 3; ++i) ++use[{key(v[i]), key(v[(i + 1) % 3])}];
@@ -99,10 +105,9 @@ inline std::vector<vec3> interiorPoints(const Bvh& bvh, int gridSize, size_t max
 // to hit the far side.)
 inline std::vector<RayQuery> aimedRays(const std::vector<Triangle>& tris,
                                        const std::vector<vec3>& origins) {
-  using Key = std::tuple<float, float, float>;
-  auto key = [](vec3 v) { return Key(v.x, v.y, v.z); };
-  std::map<Key, std::vector<uint32_t>> aroundVertex;
-  std::map<std::pair<Key, Key>, std::vector<uint32_t>> aroundEdge;  // ordered endpoints
+  const auto key = positionKey;
+  std::map<PositionKey, std::vector<uint32_t>> aroundVertex;
+  std::map<std::pair<PositionKey, PositionKey>, std::vector<uint32_t>> aroundEdge;  // sorted ends
   for (uint32_t i = 0; i < tris.size(); ++i) {
     const vec3 v[3] = {tris[i].v0, tris[i].v1, tris[i].v2};
     for (int k = 0; k < 3; ++k) {
