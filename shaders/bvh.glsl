@@ -1,15 +1,10 @@
 // GLSL ray queries on the flat BVH: watertight ray/triangle intersection (Woop, Benthin and
 // Wald 2013), the slab test with Ize's (2013) widened far distance, and iterative traversal
 // with a fixed stack, near child first, closest-hit and any-hit. The same algorithms as
-// host/bvh/traverse.cpp, written for the GPU. Expects the buffers `nodes` and `triangles`
-// the globals `gLoopIterations` and `gTruncated`, and PT_WATERTIGHT (a boolean expression) to be
-// declared by the including shader.
-
-// Smallest |direction| component used for 1/direction: keeps every slab product finite.
-const float kMinDirection = 1e-30;
-// 1 + 2 gamma(3): Ize 2013's widening of the far distance against rounding.
-const float kFarScale =
-    1.0 + 2.0 * (3.0 * 5.9604644775390625e-8 / (1.0 - 3.0 * 5.9604644775390625e-8));
+// host/bvh/traverse.cpp, written for the GPU; the constants kMinDirection and kFarScale come
+// from sampling.h, shared with it. Expects sampling.h, the buffers `nodes` and `triangles`,
+// the globals `gLoopIterations` and `gTruncated`, and PT_WATERTIGHT (a boolean expression) to
+// be declared by the including shader.
 
 struct RayData {
   vec3 origin;

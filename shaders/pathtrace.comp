@@ -65,16 +65,48 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
   (kSampler == kSpecAtRunTime ? params.samplerType == kSamplerSobol : kSampler == kSamplerSobol)
 #include "bvh.glsl"
 
-float maxComponent(vec3 v) {
-  return max(v.x, max(v.y, v.z));
-}
+// Samples direct illumination at diffuse vertex p with shading normal n (next-event
+// estimation, pbrt's SampleLd): picks an emitter from the alias table with uChoose, a uniform
+// point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
+// contribution to L, beta * f * Le * cos / pdf, weighted by the power heuristic against BSDF
+// sampling when misOn; zero when the point faces away or is occluded.
+vec3 sampleDirectLight(vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f, vec2 uChoose,
+                       vec2 uLight, bool misOn, uint depth) {
+  // Pick an emitter from the alias table, then a uniform point on its triangle.
+  uint slot = aliasTableSlot(uChoose.x, params.emitterCount);
+  Emitter emitter = emitters[aliasTablePick(slot, emitters[slot], uChoose.y)];
+  Triangle light = triangles[emitter.triangle];
+  vec2 b = sampleTriangleBarycentrics(uLight);
+  vec3 lightPoint = (1.0 - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
+  vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
+  float lightArea = 0.5 * length(lightCross);
+  vec3 lightNormal = normalize(lightCross);
 
-// Primary ray through film point (x, y), row 0 at the top.
-vec3 cameraDirection(Camera cam, vec2 filmPoint) {
-  float u = 2.0 * filmPoint.x / float(cam.width) - 1.0;
-  float v = 1.0 - 2.0 * filmPoint.y / float(cam.height);
-  return normalize(cam.forward + (u * cam.tanHalfFovY * cam.aspect) * cam.right +
-                   (v * cam.tanHalfFovY) * cam.up);
+  vec3 toLight = lightPoint - p;
+  float dist2 = dot(toLight, toLight);
+  vec3 wl = toLight / sqrt(dist2);
+  float cosLight = -dot(lightNormal, wl);  // > 0: we see the emitting side
+  float cosSurface = dot(n, wl);
+  if (!(cosLight > 0.0 && cosSurface > 0.0)) return vec3(0.0);
+
+  // Shadow ray between the two offset points; t in [0, 1) spans the segment.
+  vec3 from = offsetRayOrigin(p, n, magnitude);
+  vec3 to =
+      offsetRayOrigin(lightPoint, lightNormal, triangleMagnitude(light.v0, light.v1, light.v2));
+  gRays++;
+  HitData blocker;
+  if (traceRay(from, to - from, 1.0, /*anyHit=*/true, blocker)) return vec3(0.0);
+
+  float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
+  float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0;
+  vec3 Le = materials[light.material].emission;
+#ifdef PT_DEBUG_PRINTF
+  if (gDebug) {
+    debugPrintfEXT("gpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g",
+                   depth, emitter.triangle, light.primitive, lightPdf, weight);
+  }
+#endif
+  return beta * f * Le * (cosSurface * weight / lightPdf);
 }
 
 vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
@@ -162,46 +194,10 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
       vec3 f = material.reflectance * kInvPi;
       // Sample direct illumination from an emitter (next-event estimation).
       if (neeOn && material.reflectance != vec3(0.0)) {
-        // Pick an emitter from the alias table, then a uniform point on its triangle.
-        vec2 uChoose = random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed);
-        uint slot = min(uint(uChoose.x * float(params.emitterCount)), params.emitterCount - 1u);
-        Emitter chosen = emitters[slot];
-        Emitter emitter = emitters[uChoose.y < chosen.aliasThreshold ? slot : chosen.alias];
-        Triangle light = triangles[emitter.triangle];
-        vec2 b = sampleTriangleBarycentrics(
-            random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed));
-        vec3 lightPoint = (1.0 - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
-        vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
-        float lightArea = 0.5 * length(lightCross);
-        vec3 lightNormal = normalize(lightCross);
-
-        vec3 toLight = lightPoint - p;
-        float dist2 = dot(toLight, toLight);
-        vec3 wl = toLight / sqrt(dist2);
-        float cosLight = -dot(lightNormal, wl);  // > 0: we see the emitting side
-        float cosSurface = dot(n, wl);
-        if (cosLight > 0.0 && cosSurface > 0.0) {
-          // Shadow ray between the two offset points; t in [0, 1) spans the segment.
-          vec3 from = offsetRayOrigin(p, n, magnitude);
-          vec3 to = offsetRayOrigin(lightPoint, lightNormal,
-                                    triangleMagnitude(light.v0, light.v1, light.v2));
-          gRays++;
-          HitData blocker;
-          bool occluded = traceRay(from, to - from, 1.0, /*anyHit=*/true, blocker);
-          if (!occluded) {
-            float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
-            float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0;
-            vec3 Le = materials[light.material].emission;
-            L += beta * f * Le * (cosSurface * weight / lightPdf);
-#ifdef PT_DEBUG_PRINTF
-            if (gDebug) {
-              debugPrintfEXT(
-                  "gpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g",
-                  depth, emitter.triangle, light.primitive, lightPdf, weight);
-            }
-#endif
-          }
-        }
+        L += sampleDirectLight(p, n, magnitude, beta, f,
+                               random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
+                               random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
+                               misOn, depth);
       }
       // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
       wi = localToWorld(

@@ -5,6 +5,7 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared_types.h"
+#include "sampling.h"
 
 layout(local_size_x = kRaycastWorkgroupSize) in;
 

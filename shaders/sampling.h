@@ -146,12 +146,48 @@ PT_INLINE vec2 sampleTriangleBarycentrics(vec2 u) {
   return vec2(su * (1.0f - u.y), su * u.y);
 }
 
+// Choosing an emitter from the alias table (struct Emitter, shared_types.h) with two uniform
+// numbers: u.x picks one of `count` slots uniformly, u.y keeps the slot with probability
+// aliasThreshold and otherwise takes its alias. Returns the chosen emitter's index.
+PT_INLINE uint aliasTableSlot(float u, uint count) {
+  return min(uint(u * float(count)), count - 1u);
+}
+PT_INLINE uint aliasTablePick(uint slot, Emitter entry, float u) {
+  return u < entry.aliasThreshold ? slot : entry.alias;
+}
+
 // Power heuristic with beta = 2 (Veach 1997) for the sample of the strategy with pdf a.
 PT_INLINE float powerHeuristic(float a, float b) {
   float a2 = a * a;
   float b2 = b * b;
   return a2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
 }
+
+// ---- Rays ------------------------------------------------------------------------------
+
+// Largest component (path throughput tests, Russian roulette).
+PT_INLINE float maxComponent(vec3 v) {
+  return max(v.x, max(v.y, v.z));
+}
+
+// Unit direction of the primary ray through film point (x, y) in [0, width) x [0, height),
+// row 0 at the top (see struct Camera).
+PT_INLINE vec3 cameraDirection(Camera cam, vec2 filmPoint) {
+  float u = 2.0f * filmPoint.x / float(cam.width) - 1.0f;
+  float v = 1.0f - 2.0f * filmPoint.y / float(cam.height);
+  return normalize(cam.forward + (u * cam.tanHalfFovY * cam.aspect) * cam.right +
+                   (v * cam.tanHalfFovY) * cam.up);
+}
+
+// Traversal constants of both BVH traversals (host/bvh/traverse.cpp, shaders/bvh.glsl).
+// Smallest |direction| component used for 1/direction: keeps 1/d finite, so the slab
+// products (lo - o) * (1/d) are never 0 * inf = NaN, and a ray lying in a box's face plane
+// counts as inside that slab. Components this small only arise as exact zeros in practice.
+PT_CONST float kMinDirection = 1e-30f;
+// gamma(3) of Pharr et al. (a 3-ulp relative error bound, 2^-24 the unit roundoff); Ize 2013
+// widens the slab test's far distance by 1 + 2 gamma(3) so that rounding never loses a hit.
+PT_CONST float kGamma3 = 3.0f * 5.9604644775390625e-8f / (1.0f - 3.0f * 5.9604644775390625e-8f);
+PT_CONST float kFarScale = 1.0f + 2.0f * kGamma3;
 
 // ---- Ray origins -----------------------------------------------------------------------
 

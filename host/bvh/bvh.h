@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/named_values.h"
 #include "common/shared.h"
 
 namespace pt {
@@ -15,6 +16,11 @@ enum class BvhBuilder {
   kLbvh,       // Morton order, split at the highest differing bit: fast to build
   kBinnedSah,  // top-down, 16 bins per node on the widest centroid axis, surface-area cost
 };
+
+inline constexpr NameTable<BvhBuilder, 2> kBuilderNames{{
+    {"lbvh", BvhBuilder::kLbvh, "Morton order, fast to build"},
+    {"sah", BvhBuilder::kBinnedSah, "binned SAH, slower to build, faster to trace"},
+}};
 
 struct BvhBuildOptions {
   int maxLeafSize = 4;  // a range of at most this many triangles becomes a leaf (>= 1)

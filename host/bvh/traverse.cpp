@@ -7,15 +7,7 @@
 namespace pt {
 namespace {
 
-// Smallest |direction| component used for 1/direction: keeps 1/d finite, so the slab
-// products (lo - o) * (1/d) are never 0 * inf = NaN, and a ray lying in a box's face plane
-// counts as inside that slab. Components this small only arise as exact zeros in practice.
-constexpr float kMinDirection = 1e-30f;
-
-// gamma(3) of Pharr et al. (3 ulp relative error bound); Ize 2013 widens the far distance
-// by 1 + 2 gamma(3) so that rounding in the slab test never loses a hit.
-constexpr float kGamma3 = 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
-constexpr float kFarScale = 1.0f + 2.0f * kGamma3;
+// kMinDirection and kFarScale come from shaders/sampling.h, shared with the shader.
 
 float safeInverse(float d) {
   return 1.0f / (std::fabs(d) < kMinDirection ? std::copysign(kMinDirection, d) : d);

@@ -1,93 +1,17 @@
-// `pt converge`; see converge.h.
+// `pt converge`: the command line around host/converge; see cli/converge.h.
 #include "cli/converge.h"
 
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "common/check.h"
-#include "cpu/integrator.h"
+#include "cli/progress.h"
+#include "converge/converge.h"
 #include "scene/scene.h"
-#include "vulkan/backend.h"
 
 namespace pt {
-namespace {
-
-// The reference must have the render's resolution and hold finite values only (diffImages
-// would leave non-finite pixels out of the error, hiding a broken reference).
-void checkReference(const Image& reference, const Camera& camera) {
-  if (reference.width != int(camera.width) || reference.height != int(camera.height)) {
-    throw InputError("reference is " + std::to_string(reference.width) + "x" +
-                     std::to_string(reference.height) + " but the render is " +
-                     std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                     " (render the reference at the same --width and --height)");
-  }
-  for (const glm::vec3& p : reference.pixels) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      throw InputError("reference has NaN or infinite pixels");
-    }
-  }
-}
-
-}  // namespace
-
-std::vector<int> convergenceLevels(int maxSpp) {
-  if (maxSpp < 1) throw InputError("--max-spp must be at least 1");
-  std::vector<int> levels;
-  for (int spp = 1; spp < maxSpp; spp *= 2) levels.push_back(spp);
-  levels.push_back(maxSpp);
-  return levels;
-}
-
-std::vector<ConvergeRow> runConvergence(const SceneData& scene, const Image& reference,
-                                        const ConvergeOptions& options) {
-  const Camera& cam = scene.params.camera;
-  checkReference(reference, cam);
-  Film film(int(cam.width), int(cam.height));
-  std::vector<ConvergeRow> rows;
-  double seconds = 0.0;
-  uint64_t rays = 0, truncated = 0;
-  int done = 0;  // samples per pixel already in the film: indices [0, done)
-  for (const int spp : convergenceLevels(options.maxSpp)) {
-    // Add the sample indices [done, spp); only the render itself is timed.
-    if (options.backend == "cpu") {
-      CpuRenderOptions o;
-      o.threads = options.threads;
-      o.firstSample = uint32_t(done);
-      o.spp = spp - done;
-      const RenderStats s = renderCpu(scene, o, film);
-      seconds += s.seconds;
-      rays += s.rays;
-    } else {
-      // A fresh context per level: set-up and shader compilation are outside deviceSeconds.
-      VulkanRenderOptions o;
-      o.context.device = options.device;
-      o.firstSample = uint32_t(done);
-      o.spp = spp - done;
-      o.specialize = options.specialize;
-      const VulkanRenderStats s = renderVulkan(scene, o, film);
-      seconds += s.deviceSeconds;
-      rays += s.rays;
-      truncated += s.truncatedSamples;
-    }
-    done = spp;
-
-    const DiffStats d = diffImages(film.resolve(), reference, /*threshold=*/1e-3);
-    ConvergeRow row;
-    row.spp = spp;
-    row.seconds = seconds;
-    row.rmse = d.rmse;
-    row.relMse = d.relMse;
-    row.mraysPerSecond = seconds > 0.0 ? double(rays) / seconds * 1e-6 : 0.0;
-    row.invalidSamples = film.totalInvalid();
-    row.truncatedSamples = truncated;
-    rows.push_back(row);
-    if (options.onRow) options.onRow(row);
-  }
-  return rows;
-}
 
 int runConvergeCommand(const ConvergeArgs& args) {
   // Everything the user gave is checked before any time is spent rendering.
@@ -98,9 +22,7 @@ int runConvergeCommand(const ConvergeArgs& args) {
   if (args.noSpecialize && args.backend != "vulkan") {
     throw InputError("--no-specialize applies to the Vulkan backend only");
   }
-  std::string refExt = std::filesystem::path(args.reference).extension().string();
-  for (char& ch : refExt) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-  if (refExt != ".exr" && refExt != ".pfm") {
+  if (imageFormatOf(args.reference) == ImageFormat::kPng) {
     throw InputError(args.reference + ": the reference must be a float image (.exr or .pfm)");
   }
   const Scene scene = loadScene(args.scene);
@@ -148,9 +70,7 @@ int runConvergeCommand(const ConvergeArgs& args) {
 
   const ConvergeRow& last = rows.back();
   if (last.invalidSamples > 0) {
-    std::fprintf(stderr, "error: %llu samples were NaN or Inf%s; they were left out of the image\n",
-                 (unsigned long long)last.invalidSamples,
-                 last.truncatedSamples ? " or cut short by the shader's loop budget" : "");
+    printInvalidSamples(last.invalidSamples, last.truncatedSamples);
     return kExitFailure;
   }
   return kExitOk;

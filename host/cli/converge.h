@@ -1,47 +1,12 @@
-// `pt converge`: what accuracy costs in time. Renders progressively at 1, 2, 4, ... N samples
-// per pixel, each level adding the sample indices [k, 2k) to the film that holds [0, k), and
-// after each level compares the image with a reference (RMSE, relMSE) against the cumulative
-// render time. tools/accuracy.sh drives it; docs/accuracy.md shows the results.
+// `pt converge`: the command line around host/converge (error against time as samples
+// double), writing a CSV that tools/accuracy.sh turns into docs/accuracy.md.
 #pragma once
 
-#include <cstdint>
-#include <functional>
 #include <string>
-#include <vector>
 
-#include "image/image.h"
 #include "cli/overrides.h"
-#include "render/prepare.h"
 
 namespace pt {
-
-// One level of a convergence run.
-struct ConvergeRow {
-  int spp = 0;                    // samples per pixel so far
-  double seconds = 0.0;           // cumulative render time (CPU: wall; Vulkan: device timestamps)
-  double rmse = 0.0;              // of the resolved film against the reference
-  double relMse = 0.0;            // ditto, squared error over reference^2 + 0.01
-  double mraysPerSecond = 0.0;    // cumulative rays / cumulative seconds, in millions
-  uint64_t invalidSamples = 0;    // NaN/Inf samples so far (left out of the film)
-  uint64_t truncatedSamples = 0;  // Vulkan: paths cut short by the shader's loop budget
-};
-
-struct ConvergeOptions {
-  std::string backend = "vulkan";  // "vulkan" or "cpu"
-  std::string device;              // Vulkan device: index or part of the name
-  int maxSpp = 256;                // levels 1, 2, 4, ... up to and including maxSpp
-  int threads = 0;                 // CPU threads, 0: all
-  bool specialize = true;          // Vulkan: false compiles every effect into the shader
-  std::function<void(const ConvergeRow&)> onRow;  // called as each level finishes
-};
-
-// The spp of each level: powers of two below maxSpp, then maxSpp itself (maxSpp >= 1).
-std::vector<int> convergenceLevels(int maxSpp);
-
-// Runs the levels on `scene`, comparing each resolved film with `reference`. Throws
-// InputError when the reference's size differs from the camera's or it has NaN/Inf pixels.
-std::vector<ConvergeRow> runConvergence(const SceneData& scene, const Image& reference,
-                                        const ConvergeOptions& options);
 
 // The command line's arguments; empty strings and negative numbers mean "the scene's".
 struct ConvergeArgs {
@@ -52,7 +17,7 @@ struct ConvergeArgs {
   bool noSpecialize = false;
 };
 
-// `pt converge`: loads the scene and the reference, runs the levels, writes the CSV (header
+// Loads the scene and the reference, runs the levels, writes the CSV (header
 // `label,backend,scene,width,height,spp,seconds,rmse,relmse,mrays_per_s`, one row per level,
 // flushed as it comes) and prints a table. Returns the exit status (1 if samples were
 // invalid); throws InputError for bad input.

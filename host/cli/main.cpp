@@ -1,11 +1,10 @@
 // The `pt` command line: render a scene, compare two images. Input errors print one line
 // and exit with kExitInputError; see `pt --help` and README.md.
-#include <cctype>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
-#include <thread>
+#include <system_error>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -14,11 +13,14 @@
 #include "cli/overrides.h"
 #include "cli/progress.h"
 #include "common/check.h"
+#include "common/named_values.h"
 #include "cpu/integrator.h"
 #include "image/image.h"
 #include "render/prepare.h"
+#include "render/render_options.h"
 #include "scene/scene.h"
 #include "vulkan/backend.h"
+#include "vulkan/device_info.h"
 
 namespace pt {
 namespace {
@@ -31,7 +33,8 @@ struct RenderArgs {
   bool noSpecialize = false;
   std::string debugPixel;  // "X,Y"
   SceneOverrides overrides;
-  int spp = 0, threads = 0;
+  std::optional<int> spp;
+  int threads = 0;
   int samplesPerPass = 1;
   std::vector<std::string> outputs;
 };
@@ -51,19 +54,14 @@ int runRender(const RenderArgs& args) {
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
   RenderSettings settings = args.overrides.toSettings();
-  settings.spp = args.spp;
+  settings.spp = args.spp;  // unset: the scene's
   const SceneData data = prepareScene(scene, settings);
 
   std::vector<std::filesystem::path> outputs(args.outputs.begin(), args.outputs.end());
   if (outputs.empty()) outputs.push_back(std::filesystem::path(args.scene).stem() += ".png");
   // Check every output before spending time on the render.
   for (const auto& path : outputs) {
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (ext != ".png" && ext != ".exr" && ext != ".pfm") {
-      throw InputError(path.string() + ": unknown image format '" + ext +
-                       "' (use .png, .exr or .pfm)");
-    }
+    imageFormatOf(path);
     const auto dir = path.parent_path();
     if (!dir.empty() && !std::filesystem::is_directory(dir)) {
       throw InputError(path.string() + ": directory '" + dir.string() + "' does not exist");
@@ -87,18 +85,18 @@ int runRender(const RenderArgs& args) {
   }
   Film film(int(cam.width), int(cam.height));
   Progress progress("rendering");
-  RenderStats stats;
+  RenderStats stats;  // what both backends report
   std::string backendInfo;
   std::string effects = data.effects.toString();
-  uint64_t truncated = 0;
   uint32_t validationErrors = 0;
   if (args.backend == "cpu") {
     CpuRenderOptions options;
     options.threads = args.threads;
     options.spp = data.spp;
     options.progress = [&progress](double f) { progress.update(f); };
-    stats = renderCpu(data, options, film);
-    backendInfo = "backend=cpu threads=" + std::to_string(stats.threads);
+    const CpuRenderStats cpu = renderCpu(data, options, film);
+    stats = cpu;
+    backendInfo = "backend=cpu threads=" + std::to_string(cpu.threads);
   } else {
     VulkanRenderOptions options;
     options.context.device = args.device;
@@ -112,15 +110,13 @@ int runRender(const RenderArgs& args) {
     options.debugPixelX = debugX;
     options.debugPixelY = debugY;
     options.progress = [&progress](double f) { progress.update(f); };
-    const VulkanRenderStats v = renderVulkan(data, options, film);
-    stats = v;
+    const VulkanRenderStats gpu = renderVulkan(data, options, film);
+    stats = gpu;
+    validationErrors = gpu.validationErrors;
     // Throughput from the device's timestamps; wall time also counts set-up and upload.
-    stats.seconds = v.deviceSeconds;
-    truncated = v.truncatedSamples;
-    validationErrors = v.validationErrors;
-    backendInfo = "backend=vulkan device=\"" + v.device +
-                  "\" wall_seconds=" + std::to_string(v.seconds) +
-                  " max_loop_iterations=" + std::to_string(v.maxLoopIterations);
+    backendInfo = "backend=vulkan device=\"" + gpu.device +
+                  "\" wall_seconds=" + std::to_string(gpu.wallSeconds) +
+                  " max_loop_iterations=" + std::to_string(gpu.maxLoopIterations);
     if (args.noSpecialize) effects = "all(unspecialized)";
   }
   progress.finish();
@@ -136,9 +132,7 @@ int runRender(const RenderArgs& args) {
       data.bvh.buildSeconds, (unsigned long long)stats.invalidSamples);
   int status = kExitOk;
   if (stats.invalidSamples > 0) {
-    std::fprintf(stderr, "error: %llu samples were NaN or Inf%s; they were left out of the image\n",
-                 (unsigned long long)stats.invalidSamples,
-                 truncated ? " or cut short by lavapipe's loop-iteration cap" : "");
+    printInvalidSamples(stats.invalidSamples, stats.truncatedSamples);
     status = kExitFailure;
   }
   if (validationErrors > 0) {
@@ -149,7 +143,7 @@ int runRender(const RenderArgs& args) {
 }
 
 int runDevices() {
-  const std::vector<DeviceInfo> devices = VulkanContext::listDevices();
+  const std::vector<DeviceInfo> devices = listVulkanDevices();
   if (devices.empty()) throw NoDeviceError("no Vulkan device found");
   for (const DeviceInfo& d : devices) {
     std::printf("%u: %s (%s; %s)%s%s\n", d.index, d.name.c_str(), d.type.c_str(), d.driver.c_str(),
@@ -189,23 +183,21 @@ void addOverrideOptions(CLI::App* cmd, SceneOverrides& o) {
   cmd->add_option("--leaf-size", o.leafSize, "Maximum triangles per BVH leaf")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
-  cmd->add_option(
-         "--strategy", o.strategy,
-         "Direct light: mis (default), nee (light sampling only), bsdf (no light sampling)")
-      ->check(CLI::IsMember({"mis", "nee", "bsdf"}));
-  cmd->add_option("--rr", o.roulette, "Russian roulette on or off (default: the scene's)")
-      ->check(CLI::IsMember({"on", "off"}));
-  cmd->add_option("--builder", o.builder, "BVH builder: lbvh (Morton, fast) or sah (binned SAH)")
-      ->check(CLI::IsMember({"lbvh", "sah"}))
+  cmd->add_option("--strategy", o.strategy,
+                  "Direct light: " + describeNames(kStrategyNames) + "; default: the scene's")
+      ->check(CLI::IsMember(namesOf(kStrategyNames)));
+  cmd->add_option("--rr", o.roulette, "Russian roulette: on or off; default: the scene's")
+      ->check(CLI::IsMember(namesOf(kRouletteNames)));
+  cmd->add_option("--builder", o.builder, "BVH builder: " + describeNames(kBuilderNames))
+      ->check(CLI::IsMember(namesOf(kBuilderNames)))
       ->capture_default_str();
   cmd->add_option("--intersection", o.intersection,
-                  "Ray/triangle test: watertight (Woop et al.) or fast (Moller-Trumbore, leaks)")
-      ->check(CLI::IsMember({"watertight", "fast"}))
+                  "Ray/triangle test: " + describeNames(kIntersectionNames))
+      ->check(CLI::IsMember(namesOf(kIntersectionNames)))
       ->capture_default_str();
   cmd->add_option("--sampler", o.sampler,
-                  "Random numbers: independent (a hash per sample) or sobol (Owen-scrambled "
-                  "Sobol points); default: the scene's")
-      ->check(CLI::IsMember({"independent", "sobol"}));
+                  "Random numbers: " + describeNames(kSamplerNames) + "; default: the scene's")
+      ->check(CLI::IsMember(namesOf(kSamplerNames)));
 }
 
 }  // namespace
@@ -257,7 +249,7 @@ int main(int argc, char** argv) {
                    "The images agree when at most this fraction of pixels differ")
       ->capture_default_str();
 
-  // ---- converge: error against a reference as samples double (host/cli/converge.h) ----
+  // ---- converge: error against a reference as samples double (host/converge) ----
   ConvergeArgs c;
   CLI::App* converge = app.add_subcommand(
       "converge",
@@ -279,7 +271,6 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   addOverrideOptions(converge, c.overrides);
   converge->add_flag("--no-specialize", c.noSpecialize, "Vulkan: compile every effect in");
-  // ---- end converge ----
 
   CLI::App* devices = app.add_subcommand("devices", "List Vulkan devices");
 
@@ -296,15 +287,17 @@ int main(int argc, char** argv) {
     if (*render) return runRender(r);
     if (*diff) return runDiff(d);
     if (*devices) return runDevices();
-    if (*converge) return runConvergeCommand(c);  // converge
+    if (*converge) return runConvergeCommand(c);
   } catch (const InputError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitInputError;
   } catch (const NoDeviceError& e) {
     std::fprintf(stderr, "pt: no usable Vulkan device: %s\n", e.what());
     return kExitNoDevice;
-  } catch (const vk::SystemError& e) {
-    std::fprintf(stderr, "pt: Vulkan error: %s\n", e.what());
+  } catch (const std::system_error& e) {
+    // Vulkan-Hpp's errors are system errors in the "vk::Result" category.
+    const bool vulkan = std::string_view(e.code().category().name()) == "vk::Result";
+    std::fprintf(stderr, "pt: %s error: %s\n", vulkan ? "Vulkan" : "system", e.what());
     return kExitInternal;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pt: error: %s\n", e.what());

@@ -1,24 +1,26 @@
 // Command-line overrides of a scene's camera and integrator settings, shared by `render` and
-// `converge` (their options are registered once, in main.cpp).
+// `converge`: registered once (addOverrideOptions in main.cpp), turned into RenderSettings here.
+// Choice names come from the option tables (common/named_values.h, bvh/bvh.h).
 #pragma once
 
+#include <optional>
 #include <string>
 
+#include "common/named_values.h"
 #include "render/prepare.h"
 
 namespace pt {
 
 struct SceneOverrides {
-  int width = 0, height = 0;  // 0: the scene's
-  int maxDepth = -1;          // -1: the scene's
+  std::optional<int> width, height, maxDepth;  // unset: the scene's
+  std::optional<uint32_t> seed;
   int leafSize = 4;
-  long long seed = -1;                      // -1: the scene's
-  std::string strategy;                     // mis, nee, bsdf; empty: the scene's
-  std::string roulette;                     // on, off; empty: the scene's
-  std::string builder = "lbvh";             // lbvh, sah
-  std::string intersection = "watertight";  // watertight, fast
-  std::string sampler;                      // independent, sobol; empty: the scene's
+  // Names from the tables; empty: the scene's (strategy, roulette, sampler) or the default.
+  std::string strategy, roulette, sampler;
+  std::string builder{nameOf(kBuilderNames, BvhBuilder::kLbvh)};
+  std::string intersection{nameOf(kIntersectionNames, false)};
 
+  // The names were validated against the same tables when the command line was parsed.
   RenderSettings toSettings() const {
     RenderSettings s;
     s.width = width;
@@ -26,14 +28,11 @@ struct SceneOverrides {
     s.seed = seed;
     s.maxDepth = maxDepth;
     s.maxLeafSize = leafSize;
-    if (strategy == "mis") s.strategy = int(kStrategyMis);
-    if (strategy == "nee") s.strategy = int(kStrategyNee);
-    if (strategy == "bsdf") s.strategy = int(kStrategyBsdf);
-    if (!roulette.empty()) s.russianRoulette = roulette == "on" ? 1 : 0;
-    s.builder = builder == "sah" ? BvhBuilder::kBinnedSah : BvhBuilder::kLbvh;
-    s.fastIntersection = intersection == "fast";
-    if (sampler == "independent") s.sampler = int(kSamplerIndependent);
-    if (sampler == "sobol") s.sampler = int(kSamplerSobol);
+    s.strategy = valueNamed(kStrategyNames, strategy);
+    s.russianRoulette = valueNamed(kRouletteNames, roulette);
+    s.sampler = valueNamed(kSamplerNames, sampler);
+    s.builder = valueNamed(kBuilderNames, builder).value_or(BvhBuilder::kLbvh);
+    s.fastIntersection = valueNamed(kIntersectionNames, intersection).value_or(false);
     return s;
   }
 };

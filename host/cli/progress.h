@@ -1,8 +1,10 @@
-// Progress on stderr for long renders: a live bar on a terminal, a line every few seconds
-// otherwise (logs, CI). Silent for work that finishes within a second.
+// What the command line reports on stderr while and after rendering: progress for long
+// renders (a live bar on a terminal, a line every few seconds otherwise; silent for work that
+// finishes within a second) and the one message for samples left out of an image.
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -56,5 +58,13 @@ class Progress {
   bool shown_ = false;
   bool printedFinal_ = false;
 };
+
+// Samples that were NaN/Inf or cut short (`truncated` of them) are never added to the image;
+// the command then exits with kExitFailure.
+inline void printInvalidSamples(uint64_t invalid, uint64_t truncated) {
+  std::fprintf(stderr, "error: %llu samples were NaN or Inf%s; they were left out of the image\n",
+               (unsigned long long)invalid,
+               truncated > 0 ? " or cut short by lavapipe's loop-iteration cap" : "");
+}
 
 }  // namespace pt

@@ -4,8 +4,8 @@
 
 #include <cstddef>
 
-#include "../../shaders/shared_types.h"
-#include "../../shaders/sampling.h"
+#include "shared_types.h"
+#include "sampling.h"
 
 namespace pt {
 

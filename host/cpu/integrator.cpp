@@ -18,18 +18,52 @@
 namespace pt {
 namespace {
 
-float maxComponent(vec3 v) {
-  return std::max(v.x, std::max(v.y, v.z));
+// Samples direct illumination at diffuse vertex p with shading normal n (next-event
+// estimation, pbrt's SampleLd): picks an emitter from the alias table with uChoose, a uniform
+// point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
+// contribution to L, beta * f * Le * cos / pdf, weighted by the power heuristic against BSDF
+// sampling when misOn; zero when the point faces away or is occluded.
+vec3 sampleDirectLight(const SceneData& scene, vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f,
+                       vec2 uChoose, vec2 uLight, bool misOn, Intersection test, uint64_t& rays,
+                       bool debugPrint, uint depth) {
+  // Pick an emitter from the alias table, then a uniform point on its triangle.
+  const uint slot = aliasTableSlot(uChoose.x, scene.params.emitterCount);
+  const Emitter& emitter = scene.emitters[aliasTablePick(slot, scene.emitters[slot], uChoose.y)];
+  const Triangle& light = scene.bvh.triangles[emitter.triangle];
+  const vec2 b = sampleTriangleBarycentrics(uLight);
+  const vec3 lightPoint = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
+  const vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
+  const float lightArea = 0.5f * length(lightCross);
+  const vec3 lightNormal = normalize(lightCross);
+
+  const vec3 toLight = lightPoint - p;
+  const float dist2 = dot(toLight, toLight);
+  const vec3 wl = toLight / std::sqrt(dist2);
+  const float cosLight = -dot(lightNormal, wl);  // > 0: we see the emitting side
+  const float cosSurface = dot(n, wl);
+  if (!(cosLight > 0.0f && cosSurface > 0.0f)) return vec3(0.0f);
+
+  // Shadow ray between the two offset points; t in [0, 1) spans the segment.
+  const vec3 from = offsetRayOrigin(p, n, magnitude);
+  const vec3 to =
+      offsetRayOrigin(lightPoint, lightNormal, triangleMagnitude(light.v0, light.v1, light.v2));
+  ++rays;
+  if (anyHit(scene.bvh, Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
+
+  const float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
+  const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
+  const vec3 Le = scene.materials[light.material].emission;
+  if (debugPrint) {
+    std::fprintf(stderr, "cpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g\n",
+                 depth, emitter.triangle, light.primitive, lightPdf, weight);
+  }
+  return beta * f * Le * (cosSurface * weight / lightPdf);
 }
 
 }  // namespace
 
 Ray cameraRay(const Camera& cam, vec2 filmPoint) {
-  const float u = 2.0f * filmPoint.x / float(cam.width) - 1.0f;
-  const float v = 1.0f - 2.0f * filmPoint.y / float(cam.height);
-  const vec3 d =
-      cam.forward + (u * cam.tanHalfFovY * cam.aspect) * cam.right + (v * cam.tanHalfFovY) * cam.up;
-  return Ray{cam.position, normalize(d)};
+  return Ray{cam.position, cameraDirection(cam, filmPoint)};
 }
 
 vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
@@ -112,45 +146,10 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
       const vec3 f = material.reflectance * kInvPi;
       // Sample direct illumination from an emitter (next-event estimation).
       if (neeOn && material.reflectance != vec3(0.0f)) {
-        // Pick an emitter from the alias table, then a uniform point on its triangle.
-        const vec2 uChoose = random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed);
-        const uint slot =
-            std::min(uint(uChoose.x * float(params.emitterCount)), params.emitterCount - 1u);
-        const Emitter& chosen = scene.emitters[slot];
-        const Emitter& emitter =
-            uChoose.y < chosen.aliasThreshold ? chosen : scene.emitters[chosen.alias];
-        const Triangle& light = bvh.triangles[emitter.triangle];
-        const vec2 b = sampleTriangleBarycentrics(
-            random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed));
-        const vec3 lightPoint = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
-        const vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
-        const float lightArea = 0.5f * length(lightCross);
-        const vec3 lightNormal = normalize(lightCross);
-
-        const vec3 toLight = lightPoint - p;
-        const float dist2 = dot(toLight, toLight);
-        const vec3 wl = toLight / std::sqrt(dist2);
-        const float cosLight = -dot(lightNormal, wl);  // > 0: we see the emitting side
-        const float cosSurface = dot(n, wl);
-        if (cosLight > 0.0f && cosSurface > 0.0f) {
-          // Shadow ray between the two offset points; t in [0, 1) spans the segment.
-          const vec3 from = offsetRayOrigin(p, n, magnitude);
-          const vec3 to = offsetRayOrigin(lightPoint, lightNormal,
-                                          triangleMagnitude(light.v0, light.v1, light.v2));
-          ++rays;
-          if (!anyHit(bvh, Ray{from, to - from}, 1.0f, test)) {
-            const float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
-            const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
-            const vec3 Le = scene.materials[light.material].emission;
-            L += beta * f * Le * (cosSurface * weight / lightPdf);
-            if (debugPrint) {
-              std::fprintf(stderr,
-                           "cpu depth %u: light sample on triangle %u (primitive %u) pdf=%g "
-                           "weight=%g\n",
-                           depth, emitter.triangle, light.primitive, lightPdf, weight);
-            }
-          }
-        }
+        L += sampleDirectLight(scene, p, n, magnitude, beta, f,
+                               random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
+                               random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
+                               misOn, test, rays, debugPrint, depth);
       }
       // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
       wi = localToWorld(
@@ -178,11 +177,11 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
   return L;
 }
 
-RenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film) {
+CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film) {
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
   const auto start = std::chrono::steady_clock::now();
-  RenderStats stats;
+  CpuRenderStats stats;
   stats.threads = options.threads > 0 ? options.threads
                                       : int(std::max(1u, std::thread::hardware_concurrency()));
 
@@ -228,6 +227,7 @@ RenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, F
   stats.rays = totalRays;
   stats.invalidSamples = film.totalInvalid();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats.wallSeconds = stats.seconds;
   return stats;
 }
 

@@ -4,27 +4,20 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 
 #include "bvh/traverse.h"
 #include "image/image.h"
 #include "render/prepare.h"
+#include "render/render_options.h"
 
 namespace pt {
 
-struct CpuRenderOptions {
-  int threads = 0;           // 0: all hardware threads
-  uint32_t firstSample = 0;  // sample indices [firstSample, firstSample + spp) are taken
-  int spp = 1;
-  // Called now and then from one thread with the fraction of work done, in [0, 1].
-  std::function<void(double)> progress;
+struct CpuRenderOptions : RenderOptions {
+  int threads = 0;  // 0: all hardware threads
 };
 
-struct RenderStats {
-  double seconds = 0.0;
-  uint64_t rays = 0;            // every ray traced: camera, bounce and shadow rays
-  uint64_t invalidSamples = 0;  // samples whose radiance was NaN or Inf (not accumulated)
-  int threads = 0;
+struct CpuRenderStats : RenderStats {
+  int threads = 0;  // threads used
 };
 
 // Camera ray through film point (x, y) in [0, width) x [0, height), row 0 at the top.
@@ -37,6 +30,6 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
                     bool debugPrint = false);
 
 // Renders into film (which must have the camera's resolution), adding spp samples per pixel.
-RenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film);
+CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film);
 
 }  // namespace pt

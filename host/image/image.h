@@ -27,6 +27,12 @@ struct Image {
   const glm::vec3& at(int x, int y) const { return pixels[size_t(y) * size_t(width) + size_t(x)]; }
 };
 
+enum class ImageFormat { kExr, kPfm, kPng };
+
+// The format a file name's extension (any case) asks for; InputError "<path>: unknown image
+// file extension ..." for anything else.
+ImageFormat imageFormatOf(const std::filesystem::path& path);
+
 // Writes by file extension: .exr (32-bit float RGB, scene-linear), .pfm (little-endian
 // float RGB, rows bottom-to-top as PFM requires), .png (8-bit sRGB-encoded, clamped to
 // [0, 1]). Writes to a temporary file beside the target and renames it, so an interrupted
@@ -91,6 +97,14 @@ struct Film {
     } else {
       ++invalidCount[i];
     }
+  }
+
+  // Adds a batch of pixel i's samples (row-major index), summed elsewhere: the sum of its
+  // `valid` finite samples and the number of `invalid` ones (the Vulkan backend's fold).
+  void addSums(size_t i, glm::dvec3 radianceSum, uint64_t valid, uint64_t invalid) {
+    sum[i] += radianceSum;
+    sampleCount[i] += valid;
+    invalidCount[i] += invalid;
   }
 
   void merge(const Film& other);  // sizes must match (PT_CHECK)

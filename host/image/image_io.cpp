@@ -48,19 +48,6 @@ using Bytes = std::vector<unsigned char>;
   throw InputError(path.string() + ": " + what);
 }
 
-enum class Format { kExr, kPfm, kPng };
-
-Format formatOf(const fs::path& path) {
-  std::string ext = path.extension().string();
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".exr") return Format::kExr;
-  if (ext == ".pfm") return Format::kPfm;
-  if (ext == ".png") return Format::kPng;
-  if (ext.empty()) fail(path, "no image file extension (expected .exr, .pfm or .png)");
-  fail(path, "unknown image file extension '" + path.extension().string() +
-                 "' (expected .exr, .pfm or .png)");
-}
-
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }
 };
@@ -469,6 +456,17 @@ float srgbToLinear(float encoded) {
   return float(decodeSrgb(encoded));
 }
 
+ImageFormat imageFormatOf(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".exr") return ImageFormat::kExr;
+  if (ext == ".pfm") return ImageFormat::kPfm;
+  if (ext == ".png") return ImageFormat::kPng;
+  if (ext.empty()) fail(path, "no image file extension (expected .exr, .pfm or .png)");
+  fail(path, "unknown image file extension '" + path.extension().string() +
+                 "' (expected .exr, .pfm or .png)");
+}
+
 uint8_t linearToSrgb8(float linear) {
   if (!(linear > 0.0f)) return 0;  // also NaN
   if (linear >= 1.0f) return 255;
@@ -476,33 +474,33 @@ uint8_t linearToSrgb8(float linear) {
 }
 
 void writeImage(const Image& image, const std::filesystem::path& path) {
-  const Format format = formatOf(path);
+  const ImageFormat format = imageFormatOf(path);
   PT_CHECK(image.width >= 0 && image.height >= 0 &&
                image.pixels.size() == size_t(image.width) * size_t(image.height),
            "image pixel count does not match its size");
   if (image.width == 0 || image.height == 0) fail(path, "cannot write an empty image");
   switch (format) {
-    case Format::kExr:
+    case ImageFormat::kExr:
       writeFileAtomically(path, encodeExr(image, path));
       break;
-    case Format::kPfm:
+    case ImageFormat::kPfm:
       writeFileAtomically(path, encodePfm(image));
       break;
-    case Format::kPng:
+    case ImageFormat::kPng:
       writeFileAtomically(path, encodePng(image, path));
       break;
   }
 }
 
 Image readImage(const std::filesystem::path& path) {
-  const Format format = formatOf(path);
+  const ImageFormat format = imageFormatOf(path);
   const Bytes bytes = readFile(path);
   switch (format) {
-    case Format::kExr:
+    case ImageFormat::kExr:
       return decodeExr(bytes, path);
-    case Format::kPfm:
+    case ImageFormat::kPfm:
       return decodePfm(bytes, path);
-    case Format::kPng:
+    case ImageFormat::kPng:
       return decodePng(bytes, path);
   }
   PT_CHECK(false, "unhandled image format");

@@ -9,7 +9,7 @@ namespace pt {
 
 std::string EffectSet::toString() const {
   std::string s;
-  auto add = [&s](bool on, const char* name) {
+  auto add = [&s](bool on, std::string_view name) {
     if (!on) return;
     if (!s.empty()) s += '+';
     s += name;
@@ -20,7 +20,7 @@ std::string EffectSet::toString() const {
   add(mis, "mis");
   add(russianRoulette, "rr");
   add(!watertight, "fast-isect");
-  add(sobol, "sobol");
+  add(sobol, nameOf(kSamplerNames, kSamplerSobol));
   return s.empty() ? "none" : s;
 }
 
@@ -106,10 +106,10 @@ vec3 recentre(std::vector<Triangle>& triangles, CameraDesc& camera) {
 
 SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
   SceneData data;
-  const int width = settings.width > 0 ? settings.width : scene.camera.width;
-  const int height = settings.height > 0 ? settings.height : scene.camera.height;
+  const int width = settings.width.value_or(scene.camera.width);
+  const int height = settings.height.value_or(scene.camera.height);
   const IntegratorSettings& integ = scene.integrator;
-  data.spp = settings.spp > 0 ? settings.spp : integ.spp;
+  data.spp = settings.spp.value_or(integ.spp);
   data.materials = scene.materials;
 
   std::vector<Triangle> triangles = scene.triangles;
@@ -122,15 +122,14 @@ SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
 
   RenderParams& p = data.params;
   p.camera = makeCamera(camera, width, height);
-  p.maxDepth = uint32_t(settings.maxDepth >= 0 ? settings.maxDepth : integ.maxDepth);
+  p.maxDepth = uint32_t(settings.maxDepth.value_or(integ.maxDepth));
   p.rrStartDepth = uint32_t(integ.rrStartDepth);
   p.emitterCount = uint32_t(data.emitters.size());
-  p.seed = settings.seed >= 0 ? uint32_t(settings.seed) : integ.seed;
-  p.strategy = settings.strategy >= 0 ? uint32_t(settings.strategy) : integ.strategy;
+  p.seed = settings.seed.value_or(integ.seed);
+  p.strategy = settings.strategy.value_or(integ.strategy);
   p.fastIntersection = settings.fastIntersection ? 1u : 0u;
-  p.samplerType = settings.sampler >= 0 ? uint32_t(settings.sampler) : integ.sampler;
-  p.russianRoulette = settings.russianRoulette >= 0 ? uint32_t(settings.russianRoulette)
-                                                    : (integ.russianRoulette ? 1u : 0u);
+  p.samplerType = settings.sampler.value_or(integ.sampler);
+  p.russianRoulette = settings.russianRoulette.value_or(integ.russianRoulette) ? 1u : 0u;
 
   // Effects: which material kinds occur on triangles, and whether light sampling can matter.
   EffectSet& fx = data.effects;

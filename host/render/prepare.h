@@ -4,6 +4,8 @@
 // reference traverses them in place.
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,18 +14,19 @@
 
 namespace pt {
 
-// Command-line overrides of the scene's camera and integrator settings (unset = scene's).
+// Overrides of the scene's camera and integrator settings (unset: the scene's), and the
+// settings the scene file does not hold.
 struct RenderSettings {
-  int width = 0, height = 0;  // 0: from the scene
-  int spp = 0;                // 0: from the scene
-  long long seed = -1;        // -1: from the scene
-  int maxDepth = -1;          // -1: from the scene
+  std::optional<int> width, height;
+  std::optional<int> spp;
+  std::optional<uint32_t> seed;
+  std::optional<int> maxDepth;
+  std::optional<uint> strategy;  // kStrategy*
+  std::optional<bool> russianRoulette;
+  std::optional<uint> sampler;  // kSampler*
   int maxLeafSize = 4;
   BvhBuilder builder = BvhBuilder::kLbvh;
   bool fastIntersection = false;  // Moller-Trumbore instead of the watertight test
-  int strategy = -1;              // kStrategy*, -1: from the scene
-  int russianRoulette = -1;       // 0 off, 1 on, -1: from the scene
-  int sampler = -1;               // kSampler*, -1: from the scene
 };
 
 // Which effects the scene calls for; the rest are compiled or switched out.

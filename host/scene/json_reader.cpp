@@ -1,6 +1,6 @@
 // Strict JSON access for the scene loader: parsing with line/column errors, duplicate-key
 // detection, typed getters that name the field path, and did-you-mean suggestions.
-#include "json_reader.h"
+#include "scene/json_reader.h"
 
 #include <algorithm>
 #include <cctype>
@@ -11,7 +11,7 @@
 #include <limits>
 #include <set>
 
-#include "../common/check.h"
+#include "common/check.h"
 
 namespace pt::scene_detail {
 

@@ -2,7 +2,7 @@
 // tinyobjloader would silently accept or mangle (index 0, out-of-range indices, unparsable
 // or non-finite coordinates, polygons of more than 255 vertices); tinyobjloader then does
 // the actual load and the faces are fan-triangulated here.
-#include "obj_mesh.h"
+#include "scene/obj_mesh.h"
 
 #include <charconv>
 #include <cmath>
@@ -13,7 +13,7 @@
 
 #include <tiny_obj_loader.h>
 
-#include "json_reader.h"
+#include "scene/json_reader.h"
 
 namespace pt::scene_detail {
 

@@ -1,6 +1,6 @@
 // Scene loading: reads the JSON scene description (docs/scene-format.md) into a Scene with
 // a flat triangle list, validating everything and naming the field of any error.
-#include "scene.h"
+#include "scene/scene.h"
 
 #include <array>
 #include <cmath>
@@ -14,9 +14,10 @@
 
 #include <glm/geometric.hpp>
 
-#include "../common/check.h"
-#include "json_reader.h"
-#include "obj_mesh.h"
+#include "common/check.h"
+#include "common/named_values.h"
+#include "scene/json_reader.h"
+#include "scene/obj_mesh.h"
 
 namespace pt {
 
@@ -29,29 +30,16 @@ using Tri = std::array<glm::dvec3, 3>;
 constexpr std::int64_t kMaxResolution = 16384;  // keeps width * height well inside int
 constexpr std::int64_t kIntMax = std::numeric_limits<int>::max();
 
-// Accepted values of an enumerated string field, in documentation order.
-template <typename T>
-struct Choice {
-  std::string_view name;
-  T value;
-};
-
+// The value of an enumerated string field, from the option's name table (named_values.h).
 template <typename T, std::size_t N>
-T readChoice(const JsonNode& node, const std::array<Choice<T>, N>& choices, const char* what) {
+T readChoice(const JsonNode& node, const NameTable<T, N>& table, const char* what) {
   const std::string s = node.string();
+  if (const std::optional<T> value = valueNamed(table, s)) return *value;
   std::vector<std::string_view> names;
-  for (const Choice<T>& c : choices) {
-    if (c.name == s) return c.value;
-    names.push_back(c.name);
-  }
-  std::string expected;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (i > 0) expected += i + 1 == names.size() ? " or " : ", ";
-    expected += "'" + std::string(names[i]) + "'";
-  }
+  for (const NamedValue<T>& entry : table) names.push_back(entry.name);
   const std::string hint = scene_detail::didYouMean(s, names);
   node.fail("unknown " + std::string(what) + " " + singleQuoted(s) +
-            (hint.empty() ? " (expected " + expected + ")" : hint));
+            (hint.empty() ? " (expected " + quotedNames(table) + ")" : hint));
 }
 
 // ---- camera and integrator --------------------------------------------------------------
@@ -109,16 +97,8 @@ IntegratorSettings readIntegrator(const JsonNode& node) {
   if (auto n = node.find("rrStartDepth")) {
     s.rrStartDepth = static_cast<int>(n->integer(1, kIntMax));
   }
-  if (auto n = node.find("strategy")) {
-    static constexpr std::array<Choice<uint>, 3> kStrategies{
-        {{"mis", kStrategyMis}, {"nee", kStrategyNee}, {"bsdf", kStrategyBsdf}}};
-    s.strategy = readChoice(*n, kStrategies, "strategy");
-  }
-  if (auto n = node.find("sampler")) {
-    static constexpr std::array<Choice<uint>, 2> kSamplers{
-        {{"independent", kSamplerIndependent}, {"sobol", kSamplerSobol}}};
-    s.sampler = readChoice(*n, kSamplers, "sampler");
-  }
+  if (auto n = node.find("strategy")) s.strategy = readChoice(*n, kStrategyNames, "strategy");
+  if (auto n = node.find("sampler")) s.sampler = readChoice(*n, kSamplerNames, "sampler");
   return s;
 }
 
@@ -141,8 +121,10 @@ void readMaterials(const JsonNode& node, Scene& scene) {
     Material material{};
     material.type = kMaterialDiffuse;
     if (auto n = m.find("type")) {
-      static constexpr std::array<Choice<uint>, 2> kTypes{
-          {{"diffuse", kMaterialDiffuse}, {"mirror", kMaterialMirror}}};
+      static constexpr NameTable<uint, 2> kTypes{{
+          {"diffuse", kMaterialDiffuse, "Lambertian"},
+          {"mirror", kMaterialMirror, "ideal specular reflection"},
+      }};
       material.type = readChoice(*n, kTypes, "material type");
     }
     material.reflectance = material.type == kMaterialMirror ? glm::vec3(1.0f) : glm::vec3(0.8f);
@@ -358,8 +340,11 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
     const JsonNode shape = node[i];
     shape.expectObject();
     enum class Kind { kQuad, kTriangles, kObj };
-    static constexpr std::array<Choice<Kind>, 3> kKinds{
-        {{"quad", Kind::kQuad}, {"triangles", Kind::kTriangles}, {"obj", Kind::kObj}}};
+    static constexpr NameTable<Kind, 3> kKinds{{
+        {"quad", Kind::kQuad, "a parallelogram"},
+        {"triangles", Kind::kTriangles, "a list of triangles"},
+        {"obj", Kind::kObj, "a Wavefront OBJ mesh"},
+    }};
     const Kind kind = readChoice(shape.require("type"), kKinds, "shape type");
     switch (kind) {
       case Kind::kQuad:

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "../common/shared.h"
+#include "common/shared.h"
 
 namespace pt {
 

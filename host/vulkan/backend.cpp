@@ -1,8 +1,8 @@
 // Vulkan backend; see backend.h. Host code kept small: device-local buffers filled through
 // one staging buffer, one descriptor set, one compute pipeline specialised to the scene's
-// effect set, one command buffer re-recorded per batch of passes.
+// effect set, one command buffer re-recorded per batch of passes. renderVulkan reads as its
+// four stages: upload, pipeline, batches of passes, fold into the film.
 #include "vulkan/backend.h"
-#include "vulkan/resources.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,9 +11,15 @@
 #include "common/check.h"
 #include "pathtrace_debug_spv.h"  // kPathtraceDebugSpv: the same shader with debugPrintfEXT
 #include "pathtrace_spv.h"        // kPathtraceSpv: SPIR-V compiled at build time
+#include "vulkan/context.h"
+#include "vulkan/resources.h"
 
 namespace pt {
 namespace {
+
+using S = vk::PipelineStageFlagBits;
+using A = vk::AccessFlagBits;
+using U = vk::BufferUsageFlagBits;
 
 // The effect set as specialization constants, in PT_SPEC_* id order: booleans (VkBool32)
 // for the effects, the chosen value (or kSpecAtRunTime) for the two choices.
@@ -21,19 +27,24 @@ struct SpecData {
   uint32_t values[PT_SPEC_COUNT];
 };
 
-}  // namespace
+// The device buffers of one render, indexed by PT_BINDING_*, and the host-visible buffer the
+// accumulation and the counters are copied back through.
+struct RenderBuffers {
+  std::vector<Buffer> bound;
+  Buffer readback;
+  vk::DeviceSize accumSize = 0;
 
-VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions& options,
-                               Film& film) {
-  const auto start = std::chrono::steady_clock::now();
+  const Buffer& accum() const { return bound[PT_BINDING_ACCUM]; }
+  const Buffer& counters() const { return bound[PT_BINDING_COUNTERS]; }
+};
+
+// ---- Upload: the flat scene arrays into device-local buffers ---------------------------------
+
+// Creates every buffer the shader binds and records the copies of the scene arrays from
+// `staging` (filled here, kept alive by the caller until the commands have run).
+RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
+                          const vk::raii::CommandBuffer& cmd, Buffer& staging) {
   const Camera& cam = scene.params.camera;
-  PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
-  VulkanContext ctx(options.context);
-  const bool debugPrintf = options.context.debugPrintf;
-
-  // ---- Buffers: the flat scene arrays, the accumulation and the counters -------------------
-  using U = vk::BufferUsageFlagBits;
-  const size_t pixels = size_t(cam.width) * cam.height;
   // An empty emitter table still needs a valid binding: one zeroed entry the shader never reads.
   const std::vector<Emitter> emitters =
       scene.emitters.empty() ? std::vector<Emitter>{Emitter{}} : scene.emitters;
@@ -42,6 +53,7 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
     const void* data;
     vk::DeviceSize size;
   };
+  // In PT_BINDING_* order, followed by the accumulation and the counters.
   const Upload uploads[] = {
       {"parameter", &scene.params, sizeof(RenderParams)},
       {"BVH node", scene.bvh.nodes.data(), scene.bvh.nodes.size() * sizeof(BvhNode)},
@@ -49,25 +61,42 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
       {"material", scene.materials.data(), scene.materials.size() * sizeof(Material)},
       {"emitter", emitters.data(), emitters.size() * sizeof(Emitter)},
   };
-  const vk::DeviceSize accumSize = pixels * sizeof(AccumPixel);
-  checkRange(ctx, "accumulation", accumSize);
-  std::vector<Buffer> buffers;  // indexed by PT_BINDING_*
+  static_assert(PT_BINDING_PARAMS == 0 && PT_BINDING_NODES == 1 && PT_BINDING_TRIANGLES == 2 &&
+                PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 && PT_BINDING_ACCUM == 5 &&
+                PT_BINDING_COUNTERS == 6);
+  static_assert(std::size(uploads) + 2 == PT_BINDING_COUNT, "every binding is a buffer");
+
+  RenderBuffers buffers;
+  buffers.accumSize = vk::DeviceSize(cam.width) * cam.height * sizeof(AccumPixel);
+  checkRange(ctx, "accumulation", buffers.accumSize);
   vk::DeviceSize stagingSize = 0;
   for (const Upload& u : uploads) {
     checkRange(ctx, u.what, u.size);
-    buffers.push_back(makeBuffer(ctx, u.size, U::eStorageBuffer | U::eTransferDst, false));
+    buffers.bound.push_back(makeBuffer(ctx, u.size, U::eStorageBuffer | U::eTransferDst, false));
     stagingSize += u.size;
   }
-  buffers.push_back(
-      makeBuffer(ctx, accumSize, U::eStorageBuffer | U::eTransferSrc | U::eTransferDst, false));
-  buffers.push_back(makeBuffer(ctx, sizeof(DeviceCounters),
-                               U::eStorageBuffer | U::eTransferSrc | U::eTransferDst, false));
-  Buffer& accum = buffers[PT_BINDING_ACCUM];
-  Buffer& counters = buffers[PT_BINDING_COUNTERS];
-  Buffer staging = makeBuffer(ctx, stagingSize, U::eTransferSrc, true);
-  Buffer readback = makeBuffer(ctx, accumSize + sizeof(DeviceCounters), U::eTransferDst, true);
+  const auto readWrite = U::eStorageBuffer | U::eTransferSrc | U::eTransferDst;
+  buffers.bound.push_back(makeBuffer(ctx, buffers.accumSize, readWrite, false));
+  buffers.bound.push_back(makeBuffer(ctx, sizeof(DeviceCounters), readWrite, false));
+  buffers.readback =
+      makeBuffer(ctx, buffers.accumSize + sizeof(DeviceCounters), U::eTransferDst, true);
 
-  // ---- Pipeline, specialised to the scene's effect set --------------------------------------
+  staging = makeBuffer(ctx, stagingSize, U::eTransferSrc, true);
+  vk::DeviceSize offset = 0;
+  for (size_t i = 0; i < std::size(uploads); ++i) {
+    std::memcpy(static_cast<char*>(staging.mapped) + offset, uploads[i].data, uploads[i].size);
+    cmd.copyBuffer(*staging.buffer, *buffers.bound[i].buffer,
+                   vk::BufferCopy(offset, 0, uploads[i].size));
+    offset += uploads[i].size;
+  }
+  return buffers;
+}
+
+// ---- Pipeline: shaders/pathtrace.comp specialised to the scene's effect set -----------------
+
+ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& scene,
+                                    const VulkanRenderOptions& options,
+                                    const RenderBuffers& buffers) {
   const EffectSet& fx = scene.effects;
   const bool all = !options.specialize;
   const RenderParams& params = scene.params;
@@ -84,65 +113,114 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   }
   const vk::SpecializationInfo specInfo(entries, vk::ArrayProxyNoTemporaries<const SpecData>(spec));
   std::vector<const Buffer*> bound;
-  for (const Buffer& b : buffers) bound.push_back(&b);
-  const std::span<const uint32_t> spirv = debugPrintf
+  for (const Buffer& b : buffers.bound) bound.push_back(&b);
+  const std::span<const uint32_t> spirv = options.context.debugPrintf
                                               ? std::span<const uint32_t>(kPathtraceDebugSpv)
                                               : std::span<const uint32_t>(kPathtraceSpv);
-  const ComputeProgram program =
-      makeComputeProgram(ctx, spirv, bound, sizeof(PassConstants), &specInfo);
+  return makeComputeProgram(ctx, spirv, bound, sizeof(PassConstants), &specInfo);
+}
 
-  // ---- Commands ---------------------------------------------------------------------------
+// ---- Passes: dispatches of the shader, recorded into one command buffer -----------------------
+
+class PassRecorder {
+ public:
+  PassRecorder(const vk::raii::CommandBuffer& cmd, const ComputeProgram& program,
+               const RenderBuffers& buffers, const Camera& cam, uint32_t debugPixel)
+      : cmd_(cmd),
+        program_(program),
+        buffers_(buffers),
+        groupsX_((cam.width + kWorkgroupSize - 1) / kWorkgroupSize),
+        groupsY_((cam.height + kWorkgroupSize - 1) / kWorkgroupSize),
+        debugPixel_(debugPixel) {}
+
+  // Zeroes the accumulation and the counters before the next dispatch reads them.
+  void clearAccumulators() const {
+    cmd_.fillBuffer(*buffers_.accum().buffer, 0, VK_WHOLE_SIZE, 0);
+    cmd_.fillBuffer(*buffers_.counters().buffer, 0, VK_WHOLE_SIZE, 0);
+    barrier(cmd_, S::eTransfer, A::eTransferWrite, S::eComputeShader,
+            A::eShaderRead | A::eShaderWrite);
+  }
+
+  // One pass: sample indices [sampleIndex, sampleIndex + sampleCount) of every pixel (of the
+  // first workgroup only, for the warm-up).
+  void dispatch(uint32_t sampleIndex, uint32_t sampleCount, bool wholeImage = true) const {
+    const PassConstants pc{sampleIndex, sampleCount, debugPixel_, 0u};
+    cmd_.pushConstants<PassConstants>(*program_.layout, vk::ShaderStageFlagBits::eCompute, 0, pc);
+    cmd_.dispatch(wholeImage ? groupsX_ : 1u, wholeImage ? groupsY_ : 1u, 1);
+    barrier(cmd_, S::eComputeShader, A::eShaderWrite, S::eComputeShader | S::eTransfer,
+            A::eShaderRead | A::eShaderWrite | A::eTransferRead);
+  }
+
+  // Copies the accumulation and the counters to the readback buffer, then clears them.
+  void readBack() const {
+    cmd_.copyBuffer(*buffers_.accum().buffer, *buffers_.readback.buffer,
+                    vk::BufferCopy(0, 0, buffers_.accumSize));
+    cmd_.copyBuffer(*buffers_.counters().buffer, *buffers_.readback.buffer,
+                    vk::BufferCopy(0, buffers_.accumSize, sizeof(DeviceCounters)));
+    barrier(cmd_, S::eTransfer, A::eTransferRead, S::eTransfer, A::eTransferWrite);
+    clearAccumulators();
+  }
+
+ private:
+  const vk::raii::CommandBuffer& cmd_;
+  const ComputeProgram& program_;
+  const RenderBuffers& buffers_;
+  uint32_t groupsX_, groupsY_;
+  uint32_t debugPixel_;
+};
+
+// ---- Fold: the batch's float sums into the double-precision film ----------------------------
+
+// `samples` samples per pixel were dispatched since the last fold.
+void foldIntoFilm(const RenderBuffers& buffers, int samples, Film& film, VulkanRenderStats& stats) {
+  const auto* px = static_cast<const AccumPixel*>(buffers.readback.mapped);
+  for (size_t i = 0; i < film.sum.size(); ++i) {
+    film.addSums(i, glm::dvec3(px[i].sum), uint64_t(samples) - px[i].invalid, px[i].invalid);
+  }
+  DeviceCounters c;
+  std::memcpy(&c, static_cast<const char*>(buffers.readback.mapped) + buffers.accumSize,
+              sizeof(c));
+  stats.rays += uint64_t(c.raysHigh) << 32 | c.raysLow;
+  stats.truncatedSamples += c.truncated;
+  stats.maxLoopIterations = std::max(stats.maxLoopIterations, c.maxLoopIterations);
+}
+
+}  // namespace
+
+VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions& options,
+                               Film& film) {
+  const auto start = std::chrono::steady_clock::now();
+  const Camera& cam = scene.params.camera;
+  PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
+  VulkanContext ctx(options.context);
   const Commands commands(ctx);
   const vk::raii::CommandBuffer& cmd = commands.cmd;
-  const vk::raii::QueryPool queries(ctx.device,
-                                    vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, 2));
-  auto submitAndWait = [&]() { commands.submitAndWait(ctx); };
-  using S = vk::PipelineStageFlagBits;
-  using A = vk::AccessFlagBits;
-  auto clearAccumulators = [&]() {
-    cmd.fillBuffer(*accum.buffer, 0, VK_WHOLE_SIZE, 0);
-    cmd.fillBuffer(*counters.buffer, 0, VK_WHOLE_SIZE, 0);
-    barrier(cmd, S::eTransfer, A::eTransferWrite, S::eComputeShader,
-            A::eShaderRead | A::eShaderWrite);
-  };
-  const uint32_t groupsX = (cam.width + kWorkgroupSize - 1) / kWorkgroupSize;
-  const uint32_t groupsY = (cam.height + kWorkgroupSize - 1) / kWorkgroupSize;
+
+  // Upload the scene and build the pipeline.
+  commands.begin();
+  Buffer staging;
+  const RenderBuffers buffers = uploadScene(ctx, scene, cmd, staging);
+  const ComputeProgram program = makePathtraceProgram(ctx, scene, options, buffers);
   const uint32_t debugPixel = options.debugPixelX >= 0 ? uint32_t(options.debugPixelY) * cam.width +
                                                              uint32_t(options.debugPixelX)
                                                        : ~0u;
-  auto dispatch = [&](uint32_t sampleIndex, uint32_t sampleCount, uint32_t gx, uint32_t gy) {
-    const PassConstants pc{sampleIndex, sampleCount, debugPixel, 0u};
-    cmd.pushConstants<PassConstants>(*program.layout, vk::ShaderStageFlagBits::eCompute, 0, pc);
-    cmd.dispatch(gx, gy, 1);
-    barrier(cmd, S::eComputeShader, A::eShaderWrite, S::eComputeShader | S::eTransfer,
-            A::eShaderRead | A::eShaderWrite | A::eTransferRead);
-  };
+  const PassRecorder passes(cmd, program, buffers, cam, debugPixel);
 
-  // Upload the scene, then warm up: drivers (lavapipe especially) compile the shader at its
-  // first dispatch, which must not count as render time. The warm-up's output is cleared.
-  vk::DeviceSize offset = 0;
-  for (size_t i = 0; i < std::size(uploads); ++i) {
-    std::memcpy(static_cast<char*>(staging.mapped) + offset, uploads[i].data, uploads[i].size);
-    offset += uploads[i].size;
-  }
-  commands.begin();
-  offset = 0;
-  for (size_t i = 0; i < std::size(uploads); ++i) {
-    cmd.copyBuffer(*staging.buffer, *buffers[i].buffer, vk::BufferCopy(offset, 0, uploads[i].size));
-    offset += uploads[i].size;
-  }
-  clearAccumulators();
+  // Warm up: drivers (lavapipe especially) compile the shader at its first dispatch, which
+  // must not count as render time. The warm-up's output is cleared.
+  passes.clearAccumulators();
   program.bind(cmd);
-  dispatch(0u, 1u, 1u, 1u);
+  passes.dispatch(0u, 1u, /*wholeImage=*/false);
   barrier(cmd, S::eComputeShader, A::eShaderWrite, S::eTransfer, A::eTransferWrite);
-  clearAccumulators();
-  submitAndWait();
+  passes.clearAccumulators();
+  commands.submitAndWait(ctx);
 
-  // ---- Passes: samplesPerPass samples per pixel per dispatch, folded into the film after
-  // every passesPerFlush dispatches -----------------------------------------------------------
+  // Batches of passes: samplesPerPass samples per pixel per dispatch, folded into the film
+  // after every passesPerFlush dispatches.
   VulkanRenderStats stats;
   stats.device = ctx.info().name;
-  stats.threads = 0;
+  const vk::raii::QueryPool queries(ctx.device,
+                                    vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, 2));
   const double tickSeconds = double(ctx.limits.timestampPeriod) * 1e-9;
   const int perFlush = std::max(1, options.passesPerFlush);
   const int perPass = std::max(1, options.samplesPerPass);
@@ -154,41 +232,26 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
     int samples = 0;  // per pixel, in this batch of passes
     for (int p = 0; p < perFlush && done + samples < options.spp; ++p) {
       const int count = std::min(perPass, options.spp - done - samples);
-      dispatch(options.firstSample + uint32_t(done + samples), uint32_t(count), groupsX, groupsY);
+      passes.dispatch(options.firstSample + uint32_t(done + samples), uint32_t(count));
       samples += count;
     }
     cmd.writeTimestamp(S::eBottomOfPipe, *queries, 1);
-    cmd.copyBuffer(*accum.buffer, *readback.buffer, vk::BufferCopy(0, 0, accumSize));
-    cmd.copyBuffer(*counters.buffer, *readback.buffer,
-                   vk::BufferCopy(0, accumSize, sizeof(DeviceCounters)));
-    barrier(cmd, S::eTransfer, A::eTransferRead, S::eTransfer, A::eTransferWrite);
-    clearAccumulators();
-    submitAndWait();
+    passes.readBack();
+    commands.submitAndWait(ctx);
 
     const auto [result, ticks] =
         queries.getResults<uint64_t>(0, 2, 2 * sizeof(uint64_t), sizeof(uint64_t),
                                      vk::QueryResultFlagBits::e64 | vk::QueryResultFlagBits::eWait);
     PT_CHECK(result == vk::Result::eSuccess);
-    stats.deviceSeconds += double(ticks[1] - ticks[0]) * tickSeconds;
-
-    // Fold the float sums into the double-precision film.
-    const auto* px = static_cast<const AccumPixel*>(readback.mapped);
-    for (size_t i = 0; i < pixels; ++i) {
-      film.sum[i] += glm::dvec3(px[i].sum);
-      film.sampleCount[i] += uint64_t(samples) - px[i].invalid;
-      film.invalidCount[i] += px[i].invalid;
-    }
-    DeviceCounters c;
-    std::memcpy(&c, static_cast<const char*>(readback.mapped) + accumSize, sizeof(c));
-    stats.rays += uint64_t(c.raysHigh) << 32 | c.raysLow;
-    stats.truncatedSamples += c.truncated;
-    stats.maxLoopIterations = std::max(stats.maxLoopIterations, c.maxLoopIterations);
+    stats.seconds += double(ticks[1] - ticks[0]) * tickSeconds;
+    foldIntoFilm(buffers, samples, film, stats);
     done += samples;
     if (options.progress) options.progress(double(done) / double(options.spp));
   }
   stats.invalidSamples = film.totalInvalid();
   stats.validationErrors = ctx.validationErrors();
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats.wallSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }
 

@@ -204,7 +204,7 @@ VulkanContext::VulkanContext(const ContextOptions& options) try {
                       e.what());
 }
 
-std::vector<DeviceInfo> VulkanContext::listDevices() {
+std::vector<DeviceInfo> listVulkanDevices() {
   try {
     vk::raii::Context context;
     const vk::ApplicationInfo app("pt", 1, "pt", 1, VK_API_VERSION_1_3);
