@@ -30,7 +30,8 @@ struct BvhNode {
   uint count;      //  4 bytes: number of triangles in a leaf, 0 for an interior node
 };                 // 32 bytes
 
-// Traversal stack entries per ray. The builder refuses trees deeper than this.
+// Traversal stack entries per ray. Both builders keep every tree within this depth: where a
+// split would go deeper, they split the range in balanced halves instead.
 PT_CONST uint kBvhStackSize = 64u;
 
 // ---- Geometry and materials ------------------------------------------------------------

@@ -18,7 +18,7 @@ constexpr int kBins = 16;
 class SahBuilder {
  public:
   SahBuilder(const std::vector<Triangle>& triangles, size_t leafSize, std::vector<BvhNode>& nodes)
-      : triangles_(triangles), leafSize_(leafSize), nodes_(nodes) {
+      : leafSize_(leafSize), nodes_(nodes) {
     order_.resize(triangles.size());
     centroids_.resize(triangles.size());
     boxes_.resize(triangles.size());
@@ -117,7 +117,6 @@ class SahBuilder {
     return size_t(mid - order_.begin());
   }
 
-  const std::vector<Triangle>& triangles_;
   size_t leafSize_;
   std::vector<BvhNode>& nodes_;
   std::vector<uint32_t> order_;

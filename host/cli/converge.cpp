@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "common/check.h"
 #include "cli/progress.h"
+#include "common/check.h"
 #include "converge/converge.h"
 #include "scene/scene.h"
 

@@ -4,8 +4,8 @@
 
 #include <cstddef>
 
-#include "shared_types.h"
 #include "sampling.h"
+#include "shared_types.h"
 
 namespace pt {
 

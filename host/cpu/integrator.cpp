@@ -54,7 +54,8 @@ vec3 sampleDirectLight(const SceneData& scene, vec3 p, vec3 n, float magnitude, 
   const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
   const vec3 Le = scene.materials[light.material].emission;
   if (debugPrint) {
-    std::fprintf(stderr, "cpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g\n",
+    std::fprintf(stderr,
+                 "cpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g\n",
                  depth, emitter.triangle, light.primitive, lightPdf, weight);
   }
   return beta * f * Le * (cosSurface * weight / lightPdf);

@@ -23,9 +23,10 @@ struct CpuRenderStats : RenderStats {
 // Camera ray through film point (x, y) in [0, width) x [0, height), row 0 at the top.
 Ray cameraRay(const Camera& camera, vec2 filmPoint);
 
-// Radiance arriving at the camera along one path sample of pixel (x, y). Exposed so tests
-// can evaluate single paths; `rays` is incremented by the rays traced. With debugPrint, the
-// path's vertices and light samples go to stderr in the shader's --debug-pixel format.
+// Radiance arriving at the camera along one path sample of pixel (x, y). Exposed for
+// `--debug-pixel` and for tests that evaluate single paths; `rays` is incremented by the rays
+// traced. With debugPrint, the path's vertices and light samples go to stderr in the shader's
+// --debug-pixel format.
 vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
                     bool debugPrint = false);
 

@@ -16,10 +16,10 @@ struct RenderOptions {
 };
 
 struct RenderStats {
-  double seconds = 0.0;         // render time: wall clock on the CPU, device time on a GPU
-  double wallSeconds = 0.0;     // wall clock of the whole call, set-up and upload included
-  uint64_t rays = 0;            // every ray traced: camera, bounce and shadow rays
-  uint64_t invalidSamples = 0;  // samples left out of the film: NaN/Inf, or cut short
+  double seconds = 0.0;           // render time: wall clock on the CPU, device time on a GPU
+  double wallSeconds = 0.0;       // wall clock of the whole call, set-up and upload included
+  uint64_t rays = 0;              // every ray traced: camera, bounce and shadow rays
+  uint64_t invalidSamples = 0;    // samples left out of the film: NaN/Inf, or cut short
   uint64_t truncatedSamples = 0;  // of those, paths given up at lavapipe's loop-iteration cap
 };
 

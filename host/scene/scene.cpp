@@ -407,7 +407,6 @@ Scene loadScene(const std::filesystem::path& path) {
   root.checkKeys({"description", "camera", "integrator", "materials", "shapes"});
 
   Scene scene;
-  scene.sourcePath = path;
   if (auto n = root.find("description")) n->string();
   if (auto n = root.find("camera")) scene.camera = readCamera(*n);
   if (auto n = root.find("integrator")) scene.integrator = readIntegrator(*n);

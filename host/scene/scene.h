@@ -32,7 +32,6 @@ struct IntegratorSettings {
 };
 
 struct Scene {
-  std::filesystem::path sourcePath;  // the JSON file, for messages
   CameraDesc camera;
   IntegratorSettings integrator;
   std::vector<Material> materials;

@@ -178,8 +178,7 @@ void foldIntoFilm(const RenderBuffers& buffers, int samples, Film& film, VulkanR
     film.addSums(i, glm::dvec3(px[i].sum), uint64_t(samples) - px[i].invalid, px[i].invalid);
   }
   DeviceCounters c;
-  std::memcpy(&c, static_cast<const char*>(buffers.readback.mapped) + buffers.accumSize,
-              sizeof(c));
+  std::memcpy(&c, static_cast<const char*>(buffers.readback.mapped) + buffers.accumSize, sizeof(c));
   stats.rays += uint64_t(c.raysHigh) << 32 | c.raysLow;
   stats.truncatedSamples += c.truncated;
   stats.maxLoopIterations = std::max(stats.maxLoopIterations, c.maxLoopIterations);

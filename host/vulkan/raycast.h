@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "bvh/bvh.h"
-#include "vulkan/context.h"
+#include "vulkan/device_info.h"
 
 namespace pt {
 
