@@ -133,8 +133,19 @@ class ObjScanner {
       ++sofar_.normals;
     } else if (key == "f" || key == "l" || key == "p") {
       element(key, rest);
+    } else if (key == "usemtl") {
+      useMaterial(rest);
+    } else if (key == "mtllib") {
+      for (std::string_view name : splitBlanks(rest)) {
+        mtllib_.push_back({std::string(name), lineNumber});
+      }
     }
   }
+
+  // The usemtl index in force for each face, in file order.
+  const std::vector<int>& faceMaterials() const { return faceMaterials_; }
+  const std::vector<ObjMesh::Statement>& usemtl() const { return usemtl_; }
+  const std::vector<ObjMesh::Statement>& mtllib() const { return mtllib_; }
 
   const std::vector<std::size_t>& vertexLines() const { return vertexLines_; }
   std::int64_t faces() const { return sofar_.faces; }
@@ -197,7 +208,23 @@ class ObjScanner {
                         std::to_string(kMaxFaceVertices) + " supported)");
       }
       ++sofar_.faces;
+      faceMaterials_.push_back(currentMaterial_);
     }
+  }
+
+  // `usemtl NAME`: NAME is the first word, as tinyobjloader reads both usemtl and newmtl.
+  void useMaterial(std::string_view rest) {
+    const std::vector<std::string_view> words = splitBlanks(rest);
+    if (words.empty()) fail(line_, "usemtl without a material name");
+    const std::string name(words[0]);
+    for (std::size_t i = 0; i < usemtl_.size(); ++i) {
+      if (usemtl_[i].name == name) {
+        currentMaterial_ = static_cast<int>(i);
+        return;
+      }
+    }
+    currentMaterial_ = static_cast<int>(usemtl_.size());
+    usemtl_.push_back({name, line_});
   }
 
   // Positive indices count from 1 over the whole file; negative ones count back from the
@@ -226,13 +253,14 @@ class ObjScanner {
   Counts sofar_;
   std::size_t line_ = 0;
   std::vector<std::size_t> vertexLines_;  // line of each vertex, for post-load checks
+  int currentMaterial_ = -1;
+  std::vector<int> faceMaterials_;
+  std::vector<ObjMesh::Statement> usemtl_, mtllib_;
 };
 
 }  // namespace
 
-std::vector<std::array<glm::dvec3, 3>> loadObjTriangles(const std::string& text,
-                                                        const std::string& file,
-                                                        const std::string& context) {
+ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std::string& context) {
   // Pass 1: totals, needed to check positive (absolute) indices that refer forward.
   Counts totals;
   forEachLine(text, [&](std::size_t, std::string_view line) {
@@ -250,7 +278,8 @@ std::vector<std::array<glm::dvec3, 3>> loadObjTriangles(const std::string& text,
     throwInputError(file, "", "no faces (an OBJ mesh needs at least one 'f' line)" + context);
   }
 
-  // The actual load. No material reader: materials come from the scene file.
+  // The actual load. No material reader: the pre-scan has the usemtl of every face, and the
+  // scene loader reads MTL files itself (mtl_materials.h).
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
@@ -284,17 +313,23 @@ std::vector<std::array<glm::dvec3, 3>> loadObjTriangles(const std::string& text,
     }
   }
 
-  std::vector<std::array<glm::dvec3, 3>> triangles;
+  ObjMesh mesh;
+  std::vector<std::array<glm::dvec3, 3>>& triangles = mesh.triangles;
   std::int64_t faceCount = 0;
+  // tinyobjloader keeps the faces in file order (shapes in order of appearance), so the
+  // pre-scan's per-face material applies face by face.
+  const std::vector<int>& faceMaterials = scanner.faceMaterials();
+  std::vector<std::size_t> face;
   for (const tinyobj::shape_t& shape : shapes) {
-    const tinyobj::mesh_t& mesh = shape.mesh;
+    const tinyobj::mesh_t& faces = shape.mesh;
     std::size_t offset = 0;
-    for (const unsigned char faceSize : mesh.num_face_vertices) {
+    for (const unsigned char faceSize : faces.num_face_vertices) {
       const std::size_t n = faceSize;
-      if (offset + n > mesh.indices.size()) break;  // reported by the count check below
-      std::vector<std::size_t> face(n);
+      if (offset + n > faces.indices.size()) break;  // reported by the count check below
+      if (faceCount >= static_cast<std::int64_t>(faceMaterials.size())) break;  // ditto
+      face.resize(n);
       for (std::size_t k = 0; k < n; ++k) {
-        const int index = mesh.indices[offset + k].vertex_index;
+        const int index = faces.indices[offset + k].vertex_index;
         if (index < 0 || static_cast<std::size_t>(index) >= vertexCount) {
           throwInputError(file, "",
                           "tinyobjloader produced vertex index " + std::to_string(index) +
@@ -304,6 +339,7 @@ std::vector<std::array<glm::dvec3, 3>> loadObjTriangles(const std::string& text,
       }
       for (std::size_t k = 1; k + 1 < n; ++k) {
         triangles.push_back({vertices[face[0]], vertices[face[k]], vertices[face[k + 1]]});
+        mesh.material.push_back(faceMaterials[static_cast<std::size_t>(faceCount)]);
       }
       offset += n;
       ++faceCount;
@@ -314,7 +350,9 @@ std::vector<std::array<glm::dvec3, 3>> loadObjTriangles(const std::string& text,
                     "tinyobjloader read " + std::to_string(faceCount) + " faces, expected " +
                         std::to_string(scanner.faces()) + context);
   }
-  return triangles;
+  mesh.usemtl = scanner.usemtl();
+  mesh.mtllib = scanner.mtllib();
+  return mesh;
 }
 
 }  // namespace pt::scene_detail

@@ -10,13 +10,31 @@
 
 namespace pt::scene_detail {
 
+// An OBJ file's triangles with the material statements that apply to them.
+struct ObjMesh {
+  std::vector<std::array<glm::dvec3, 3>> triangles;  // file order, polygons fanned
+  // Per triangle: index into usemtl (the `usemtl` in force for its face), or -1 before any.
+  std::vector<int> material;
+  struct Statement {
+    std::string name;  // usemtl: the material name; mtllib: one file name
+    std::size_t line = 0;
+  };
+  std::vector<Statement> usemtl;  // distinct names, with the line of their first use
+  std::vector<Statement> mtllib;  // every file named by an `mtllib` line
+};
+
 // Triangles of an OBJ file in file order, each polygon fanned as (0, i, i + 1). `text` is
 // the file's content and `file` its name for messages; `context` is appended to every
 // message to say which scene entry referenced the file. Throws InputError
 // "<file>: line N: <problem>" for malformed content and "<file>: no faces" for a file
 // without faces.
-std::vector<std::array<glm::dvec3, 3>> loadObjTriangles(const std::string& text,
-                                                        const std::string& file,
-                                                        const std::string& context);
+ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std::string& context);
+
+// Just the triangles (the scene's own material for all of them).
+inline std::vector<std::array<glm::dvec3, 3>> loadObjTriangles(const std::string& text,
+                                                               const std::string& file,
+                                                               const std::string& context) {
+  return loadObjMesh(text, file, context).triangles;
+}
 
 }  // namespace pt::scene_detail

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -17,7 +18,9 @@
 #include "common/check.h"
 #include "common/named_values.h"
 #include "scene/json_reader.h"
+#include "scene/mtl_materials.h"
 #include "scene/obj_mesh.h"
+#include "scene/ply_mesh.h"
 
 namespace pt {
 
@@ -266,30 +269,127 @@ std::vector<Tri> readTriangleShape(const JsonNode& shape) {
   return triangles;
 }
 
-std::vector<Tri> readObjShape(const JsonNode& shape, const std::filesystem::path& scenePath) {
+// A mesh file named by a shape's "file" key, relative to the scene file.
+struct MeshFile {
+  std::filesystem::path path;  // as resolved
+  std::string bytes;
+  std::string context;  // " (referenced by <scene>: shapes[i].file)", for the mesh's messages
+};
+
+MeshFile readMeshFile(const JsonNode& shape, const std::filesystem::path& scenePath) {
   const JsonNode fileNode = shape.require("file");
   const std::string name = fileNode.string();
   if (name.empty()) fileNode.fail("expected a file name, got an empty string");
   const std::filesystem::path given(name);
   const std::filesystem::path resolved =
       given.is_absolute() ? given : scenePath.parent_path() / given;
-  std::string text;
+  MeshFile mesh;
+  mesh.path = resolved;
   std::string why;
-  if (!scene_detail::readTextFile(resolved, &text, &why)) {
+  if (!scene_detail::readTextFile(resolved, &mesh.bytes, &why)) {
     const std::string looked =
         resolved == given ? std::string{} : "looked for " + singleQuoted(resolved.string()) + ": ";
     fileNode.fail("cannot open " + singleQuoted(name) + " (" + looked + why + ")");
   }
-  const std::string context = " (referenced by " + shape.file() + ": " + fileNode.path() + ")";
-  return scene_detail::loadObjTriangles(text, resolved.string(), context);
+  mesh.context = " (referenced by " + shape.file() + ": " + fileNode.path() + ")";
+  return mesh;
+}
+
+// The triangles of one shape and their materials (scene material indices).
+struct ShapeTriangles {
+  std::vector<Tri> triangles;
+  std::vector<uint> materials;  // per triangle; empty: all take the shape's "material"
+};
+
+// Scene materials made from MTL files, shared by every shape that uses the same file.
+struct MtlLibrary {
+  // (MTL file path, material name) -> scene material index
+  std::map<std::pair<std::string, std::string>, uint> sceneIndex;
+  // MTL file path -> its materials, read once
+  std::map<std::string, std::vector<scene_detail::MtlMaterial>> files;
+};
+
+// An OBJ shape with "materials": "mtl": every usemtl names a material of the OBJ's mtllib
+// files, which becomes a scene material; faces before any usemtl take the shape's "material"
+// (an error without one). A missing MTL file or an unknown name is an error at its OBJ line.
+ShapeTriangles readObjWithMtl(const JsonNode& shape, const MeshFile& file,
+                              const std::optional<uint>& fallback, MtlLibrary& library,
+                              Scene& scene) {
+  scene_detail::ObjMesh obj =
+      scene_detail::loadObjMesh(file.bytes, file.path.string(), file.context);
+  const std::string objName = file.path.string();
+  auto failAt = [&](std::size_t line, const std::string& problem) {
+    scene_detail::throwInputError(objName, "line " + std::to_string(line), problem + file.context);
+  };
+  // Every mtllib file, in order; a name's first definition wins, as within one file.
+  std::vector<std::pair<std::string, const scene_detail::MtlMaterial*>> available;
+  for (const scene_detail::ObjMesh::Statement& lib : obj.mtllib) {
+    const std::filesystem::path mtlPath = file.path.parent_path() / lib.name;
+    const std::string key = mtlPath.string();
+    if (!library.files.count(key)) {
+      std::string text, why;
+      if (!scene_detail::readTextFile(mtlPath, &text, &why)) {
+        failAt(lib.line, "cannot open material library " + singleQuoted(lib.name) + " (looked for " +
+                             singleQuoted(key) + ": " + why + ")");
+      }
+      std::vector<scene_detail::MtlMaterial> materials = scene_detail::loadMtlMaterials(text, key);
+      for (const scene_detail::MtlMaterial& m : materials) {
+        for (const std::string& w : m.warnings) scene.warnings.push_back(w);
+      }
+      library.files.emplace(key, std::move(materials));
+    }
+    for (const scene_detail::MtlMaterial& m : library.files.at(key)) available.emplace_back(key, &m);
+  }
+  // Scene material of every usemtl name.
+  std::vector<uint> sceneMaterial(obj.usemtl.size());
+  for (std::size_t i = 0; i < obj.usemtl.size(); ++i) {
+    const std::string& name = obj.usemtl[i].name;
+    const auto match = std::find_if(available.begin(), available.end(),
+                                    [&](const auto& a) { return a.second->name == name; });
+    if (match == available.end()) {
+      std::vector<std::string_view> names;
+      for (const auto& a : available) names.push_back(a.second->name);
+      failAt(obj.usemtl[i].line,
+             "usemtl " + singleQuoted(name) + ": no such material in " +
+                 (obj.mtllib.empty() ? std::string("any mtllib (the file has no mtllib line)")
+                                     : "its mtllib files") +
+                 scene_detail::didYouMean(name, names));
+    }
+    const auto key = std::make_pair(match->first, name);
+    auto [it, inserted] = library.sceneIndex.emplace(key, uint(scene.materials.size()));
+    if (inserted) {
+      scene.materials.push_back(match->second->material);
+      scene.materialNames.push_back(std::filesystem::path(match->first).filename().string() + ":" +
+                                    name);
+    }
+    sceneMaterial[i] = it->second;
+  }
+  ShapeTriangles out;
+  out.triangles = std::move(obj.triangles);
+  out.materials.reserve(obj.material.size());
+  for (std::size_t t = 0; t < obj.material.size(); ++t) {
+    if (obj.material[t] < 0) {
+      if (!fallback) {
+        shape.fail("needs a 'material' for the faces of " + singleQuoted(objName) +
+                   " that come before any usemtl");
+      }
+      out.materials.push_back(*fallback);
+    } else {
+      out.materials.push_back(sceneMaterial[std::size_t(obj.material[t])]);
+    }
+  }
+  return out;
 }
 
 // Appends the triangles of one shape to the scene, transformed and rounded to float,
 // dropping those of zero area.
-void emitTriangles(const JsonNode& shape, const std::vector<Tri>& triangles,
+void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
                    const std::optional<Transform>& transform, uint material, Scene& scene) {
+  const std::vector<Tri>& triangles = shapeTriangles.triangles;
   std::size_t dropped = 0;
-  for (const Tri& tri : triangles) {
+  scene.triangles.reserve(scene.triangles.size() + triangles.size());
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    const Tri& tri = triangles[i];
     Triangle out{};
     glm::vec3* corners[3] = {&out.v0, &out.v1, &out.v2};
     for (std::size_t k = 0; k < 3; ++k) {
@@ -313,7 +413,7 @@ void emitTriangles(const JsonNode& shape, const std::vector<Tri>& triangles,
     if (scene.triangles.size() >= static_cast<std::size_t>(kNoEmitter)) {
       shape.fail("too many triangles in the scene (at most 4294967295)");
     }
-    out.material = material;
+    out.material = shapeTriangles.materials.empty() ? material : shapeTriangles.materials[i];
     out.emitter = kNoEmitter;
     out.primitive = static_cast<uint>(scene.triangles.size());
     scene.triangles.push_back(out);
@@ -336,14 +436,16 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
   }
 
   std::size_t total = 0;
+  MtlLibrary mtlLibrary;
   for (std::size_t i = 0; i < node.size(); ++i) {
     const JsonNode shape = node[i];
     shape.expectObject();
-    enum class Kind { kQuad, kTriangles, kObj };
-    static constexpr NameTable<Kind, 3> kKinds{{
+    enum class Kind { kQuad, kTriangles, kObj, kPly };
+    static constexpr NameTable<Kind, 4> kKinds{{
         {"quad", Kind::kQuad, "a parallelogram"},
         {"triangles", Kind::kTriangles, "a list of triangles"},
         {"obj", Kind::kObj, "a Wavefront OBJ mesh"},
+        {"ply", Kind::kPly, "a Stanford PLY mesh"},
     }};
     const Kind kind = readChoice(shape.require("type"), kKinds, "shape type");
     switch (kind) {
@@ -354,39 +456,68 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
         shape.checkKeys({"type", "name", "material", "vertices", "indices", "transform"});
         break;
       case Kind::kObj:
+        shape.checkKeys({"type", "name", "material", "materials", "file", "transform"});
+        break;
+      case Kind::kPly:
         shape.checkKeys({"type", "name", "material", "file", "transform"});
         break;
     }
     if (auto n = shape.find("name")) n->string();  // documentation only, but must be a string
 
-    const JsonNode materialNode = shape.require("material");
-    const std::string materialName = materialNode.string();
-    const auto found = materialIndex.find(materialName);
-    if (found == materialIndex.end()) {
-      materialNode.fail("unknown material " + singleQuoted(materialName) +
-                        scene_detail::didYouMean(materialName, materialNames));
+    // "materials": "mtl" (OBJ only) takes the materials from the OBJ's MTL files; then
+    // "material" is optional, for faces before any usemtl.
+    bool useMtl = false;
+    if (auto n = shape.find("materials")) {
+      if (n->string() != "mtl") {
+        n->fail("expected 'mtl' (materials from the OBJ's mtllib files), got " + n->describe());
+      }
+      useMtl = true;
+    }
+    std::optional<uint> material;
+    if (!useMtl || shape.find("material")) {
+      const JsonNode materialNode = shape.require("material");
+      const std::string materialName = materialNode.string();
+      const auto found = materialIndex.find(materialName);
+      if (found == materialIndex.end()) {
+        materialNode.fail("unknown material " + singleQuoted(materialName) +
+                          scene_detail::didYouMean(materialName, materialNames));
+      }
+      material = found->second;
     }
 
     std::optional<Transform> transform;
     if (auto n = shape.find("transform")) transform = readTransform(*n);
 
-    std::vector<Tri> triangles;
+    ShapeTriangles triangles;
     switch (kind) {
       case Kind::kQuad: {
         const std::vector<glm::dvec3> v = readPoints(shape.require("vertices"), 4);
         // Fixed split along the v0-v2 diagonal; both halves keep the quad's winding.
-        triangles = {Tri{v[0], v[1], v[2]}, Tri{v[0], v[2], v[3]}};
+        triangles.triangles = {Tri{v[0], v[1], v[2]}, Tri{v[0], v[2], v[3]}};
         break;
       }
       case Kind::kTriangles:
-        triangles = readTriangleShape(shape);
+        triangles.triangles = readTriangleShape(shape);
         break;
-      case Kind::kObj:
-        triangles = readObjShape(shape, scenePath);
+      case Kind::kObj: {
+        const MeshFile file = readMeshFile(shape, scenePath);
+        if (useMtl) {
+          triangles = readObjWithMtl(shape, file, material, mtlLibrary, scene);
+        } else {
+          triangles.triangles =
+              scene_detail::loadObjTriangles(file.bytes, file.path.string(), file.context);
+        }
         break;
+      }
+      case Kind::kPly: {
+        const MeshFile file = readMeshFile(shape, scenePath);
+        triangles.triangles =
+            scene_detail::loadPlyTriangles(file.bytes, file.path.string(), file.context);
+        break;
+      }
     }
-    total += triangles.size();
-    emitTriangles(shape, triangles, transform, found->second, scene);
+    total += triangles.triangles.size();
+    emitTriangles(shape, triangles, transform, material.value_or(0u), scene);
   }
   if (scene.triangles.empty()) {
     node.fail("no triangles left: all " + std::to_string(total) + " have zero area");
