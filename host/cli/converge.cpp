@@ -25,12 +25,12 @@ int runConvergeCommand(const ConvergeArgs& args) {
   if (imageFormatOf(args.reference) == ImageFormat::kPng) {
     throw InputError(args.reference + ": the reference must be a float image (.exr or .pfm)");
   }
-  const Scene scene = loadScene(args.scene);
+  Scene scene = loadScene(args.scene);
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
   // The same overrides as `pt render`.
   const RenderSettings settings = args.overrides.toSettings();
-  const SceneData data = prepareScene(scene, settings);
+  const SceneData data = prepareScene(std::move(scene), settings);
   const Camera& cam = data.params.camera;
 
   const Image reference = readImage(args.reference);

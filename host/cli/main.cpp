@@ -1,11 +1,14 @@
 // The `pt` command line: render a scene, compare two images. Input errors print one line
 // and exit with kExitInputError; see `pt --help` and README.md.
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
 
@@ -46,16 +49,26 @@ struct DiffArgs {
   double heatmapScale = 0.0;
 };
 
+// Peak resident memory of this process so far, in MiB (getrusage: Linux reports KiB).
+double peakResidentMiB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_maxrss) / 1024.0;
+}
+
 int runRender(const RenderArgs& args) {
   if (args.backend == "cpu" && args.samplesPerPass != 1) {
     throw InputError("--samples-per-pass applies to the Vulkan backend only");
   }
-  const Scene scene = loadScene(args.scene);
+  const auto loadStart = std::chrono::steady_clock::now();
+  Scene scene = loadScene(args.scene);
+  const double loadSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
   RenderSettings settings = args.overrides.toSettings();
   settings.spp = args.spp;  // unset: the scene's
-  const SceneData data = prepareScene(scene, settings);
+  const SceneData data = prepareScene(std::move(scene), settings);
 
   std::vector<std::filesystem::path> outputs(args.outputs.begin(), args.outputs.end());
   if (outputs.empty()) outputs.push_back(std::filesystem::path(args.scene).stem() += ".png");
@@ -125,11 +138,14 @@ int runRender(const RenderArgs& args) {
   for (const auto& path : outputs) writeImage(image, path);
 
   std::printf(
-      "%s resolution=%ux%u spp=%d seconds=%.3f Mrays/s=%.3f effects=%s bvh_nodes=%zu "
-      "bvh_build_s=%.4f invalid_samples=%llu\n",
+      "%s resolution=%ux%u spp=%d seconds=%.3f Mrays/s=%.3f effects=%s triangles=%zu "
+      "load_s=%.3f bvh_builder=%s bvh_nodes=%zu bvh_build_s=%.4f peak_rss_mib=%.0f "
+      "invalid_samples=%llu\n",
       backendInfo.c_str(), cam.width, cam.height, data.spp, stats.seconds,
-      double(stats.rays) / stats.seconds * 1e-6, effects.c_str(), data.bvh.nodes.size(),
-      data.bvh.buildSeconds, (unsigned long long)stats.invalidSamples);
+      double(stats.rays) / stats.seconds * 1e-6, effects.c_str(), data.bvh.triangles.size(),
+      loadSeconds, std::string(nameOf(kBuilderNames, settings.builder)).c_str(),
+      data.bvh.nodes.size(), data.bvh.buildSeconds, peakResidentMiB(),
+      (unsigned long long)stats.invalidSamples);
   int status = kExitOk;
   if (stats.invalidSamples > 0) {
     printInvalidSamples(stats.invalidSamples, stats.truncatedSamples);

@@ -104,7 +104,7 @@ vec3 recentre(std::vector<Triangle>& triangles, CameraDesc& camera) {
 
 }  // namespace
 
-SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
+SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   SceneData data;
   const int width = settings.width.value_or(scene.camera.width);
   const int height = settings.height.value_or(scene.camera.height);
@@ -112,7 +112,7 @@ SceneData prepareScene(const Scene& scene, const RenderSettings& settings) {
   data.spp = settings.spp.value_or(integ.spp);
   data.materials = scene.materials;
 
-  std::vector<Triangle> triangles = scene.triangles;
+  std::vector<Triangle> triangles = std::move(scene.triangles);
   CameraDesc camera = scene.camera;
   data.shift = recentre(triangles, camera);
   data.bvh =
