@@ -7,9 +7,11 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <sstream>
 #include <string_view>
+#include <thread>
 
 #include <tiny_obj_loader.h>
 
@@ -271,12 +273,18 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
     if (key == "vn") ++totals.normals;
   });
 
-  // Pass 2: validate every statement tinyobjloader will interpret.
+  // Pass 2: validate every statement tinyobjloader will interpret. It runs on a thread of
+  // its own beside tinyobjloader's parse (the larger cost), whose result is only used once
+  // the scan has passed.
   ObjScanner scanner(file, context, totals);
-  forEachLine(text, [&](std::size_t n, std::string_view line) { scanner.scan(n, line); });
-  if (scanner.faces() == 0) {
-    throwInputError(file, "", "no faces (an OBJ mesh needs at least one 'f' line)" + context);
-  }
+  std::exception_ptr scanError;
+  std::jthread scan([&] {  // joins on destruction too, should the parse throw
+    try {
+      forEachLine(text, [&](std::size_t n, std::string_view line) { scanner.scan(n, line); });
+    } catch (...) {
+      scanError = std::current_exception();
+    }
+  });
 
   // The actual load. No material reader: the pre-scan has the usemtl of every face, and the
   // scene loader reads MTL files itself (mtl_materials.h).
@@ -288,6 +296,11 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
   std::istringstream stream(text);
   const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, nullptr,
                                    /*triangulate=*/false, /*default_vcols_fallback=*/false);
+  scan.join();
+  if (scanError) std::rethrow_exception(scanError);
+  if (scanner.faces() == 0) {
+    throwInputError(file, "", "no faces (an OBJ mesh needs at least one 'f' line)" + context);
+  }
   if (!ok) {
     throwInputError(file, "", "tinyobjloader: " + err.substr(0, err.find('\n')) + context);
   }
