@@ -1,0 +1,924 @@
+// PLY loading: the header is parsed into elements and properties and checked, then the data
+// is decoded element by element straight from the bytes (memcpy and byte swaps for binary,
+// std::from_chars for ascii), every size checked against what is left of the file before
+// anything is read or allocated.
+#include "scene/ply_mesh.h"
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <initializer_list>
+#include <limits>
+#include <string_view>
+
+#include "common/check.h"
+#include "scene/json_reader.h"
+
+namespace pt::scene_detail {
+
+namespace {
+
+using Tri = std::array<glm::dvec3, 3>;
+using IndexTri = std::array<std::uint32_t, 3>;
+
+enum class Format { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
+
+enum class Type : std::uint8_t {
+  kInt8,
+  kUint8,
+  kInt16,
+  kUint16,
+  kInt32,
+  kUint32,
+  kFloat32,
+  kFloat64
+};
+
+struct TypeName {
+  std::string_view name;
+  Type type;
+};
+
+// The classic names first: typeName() reports a type by its first entry.
+constexpr std::array<TypeName, 16> kTypeNames{{{"char", Type::kInt8},
+                                               {"uchar", Type::kUint8},
+                                               {"short", Type::kInt16},
+                                               {"ushort", Type::kUint16},
+                                               {"int", Type::kInt32},
+                                               {"uint", Type::kUint32},
+                                               {"float", Type::kFloat32},
+                                               {"double", Type::kFloat64},
+                                               {"int8", Type::kInt8},
+                                               {"uint8", Type::kUint8},
+                                               {"int16", Type::kInt16},
+                                               {"uint16", Type::kUint16},
+                                               {"int32", Type::kInt32},
+                                               {"uint32", Type::kUint32},
+                                               {"float32", Type::kFloat32},
+                                               {"float64", Type::kFloat64}}};
+
+std::size_t sizeOf(Type type) {
+  switch (type) {
+    case Type::kInt8:
+    case Type::kUint8:
+      return 1;
+    case Type::kInt16:
+    case Type::kUint16:
+      return 2;
+    case Type::kInt32:
+    case Type::kUint32:
+    case Type::kFloat32:
+      return 4;
+    case Type::kFloat64:
+      return 8;
+  }
+  return 1;
+}
+
+bool isInteger(Type type) {
+  return type != Type::kFloat32 && type != Type::kFloat64;
+}
+
+std::string typeName(Type type) {
+  for (const TypeName& t : kTypeNames) {
+    if (t.type == type) return std::string(t.name);
+  }
+  return "?";
+}
+
+// The range of an integer type, for ascii values.
+std::int64_t minOf(Type type) {
+  switch (type) {
+    case Type::kInt8:
+      return std::numeric_limits<std::int8_t>::min();
+    case Type::kInt16:
+      return std::numeric_limits<std::int16_t>::min();
+    case Type::kInt32:
+      return std::numeric_limits<std::int32_t>::min();
+    default:
+      return 0;
+  }
+}
+
+std::int64_t maxOf(Type type) {
+  switch (type) {
+    case Type::kInt8:
+      return std::numeric_limits<std::int8_t>::max();
+    case Type::kUint8:
+      return std::numeric_limits<std::uint8_t>::max();
+    case Type::kInt16:
+      return std::numeric_limits<std::int16_t>::max();
+    case Type::kUint16:
+      return std::numeric_limits<std::uint16_t>::max();
+    case Type::kInt32:
+      return std::numeric_limits<std::int32_t>::max();
+    default:
+      return std::numeric_limits<std::uint32_t>::max();
+  }
+}
+
+// One value of type T from possibly unaligned bytes, reversing them when the file's byte
+// order differs from ours.
+template <typename T>
+T load(const unsigned char* p, bool swap) {
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, p, sizeof(T));
+  if (swap) std::reverse(b, b + sizeof(T));
+  T value;
+  std::memcpy(&value, b, sizeof(T));
+  return value;
+}
+
+// Integer types only (the header check guarantees it where this is called).
+std::int64_t loadInteger(const unsigned char* p, Type type, bool swap) {
+  switch (type) {
+    case Type::kInt8:
+      return load<std::int8_t>(p, swap);
+    case Type::kUint8:
+      return load<std::uint8_t>(p, swap);
+    case Type::kInt16:
+      return load<std::int16_t>(p, swap);
+    case Type::kUint16:
+      return load<std::uint16_t>(p, swap);
+    case Type::kInt32:
+      return load<std::int32_t>(p, swap);
+    case Type::kUint32:
+      return load<std::uint32_t>(p, swap);
+    case Type::kFloat32:
+    case Type::kFloat64:
+      break;
+  }
+  return 0;
+}
+
+// Float types only.
+double loadReal(const unsigned char* p, Type type, bool swap) {
+  if (type == Type::kFloat64) return load<double>(p, swap);
+  return load<float>(p, swap);
+}
+
+bool isBlank(char c) {
+  return c == ' ' || c == '\t' || c == '\r';
+}
+
+// Splits off the next blank-separated token of `rest`; empty when none is left.
+std::string_view nextToken(std::string_view& rest) {
+  std::size_t i = 0;
+  while (i < rest.size() && isBlank(rest[i])) ++i;
+  std::size_t end = i;
+  while (end < rest.size() && !isBlank(rest[end])) ++end;
+  const std::string_view token = rest.substr(i, end - i);
+  rest.remove_prefix(end);
+  return token;
+}
+
+std::size_t countTokens(std::string_view line) {
+  std::size_t n = 0;
+  while (!nextToken(line).empty()) ++n;
+  return n;
+}
+
+// from_chars takes no '+' sign: drop one, but not from "+-3" or "++3".
+bool skipPlus(std::string_view* token) {
+  if (token->empty() || (*token)[0] != '+') return true;
+  token->remove_prefix(1);
+  return !token->empty() && (*token)[0] != '+' && (*token)[0] != '-';
+}
+
+enum class Parse { kOk, kNotNumber, kOutOfRange };
+
+Parse parseInteger(std::string_view token, std::int64_t* value) {
+  if (!skipPlus(&token)) return Parse::kNotNumber;
+  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), *value);
+  if (ptr != token.data() + token.size()) return Parse::kNotNumber;
+  if (ec == std::errc::result_out_of_range) return Parse::kOutOfRange;
+  return ec == std::errc() ? Parse::kOk : Parse::kNotNumber;
+}
+
+// A whole token as a T (float or double). from_chars also takes "inf" and "nan", left for
+// the caller to report; an overflow becomes an infinity, an underflow a zero.
+template <typename T>
+bool parseReal(std::string_view token, T* value) {
+  if (!skipPlus(&token)) return false;
+  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), *value,
+                                         std::chars_format::general);
+  if (ptr != token.data() + token.size()) return false;
+  if (ec == std::errc::result_out_of_range) {
+    // from_chars leaves the value alone: decide by the exponent's sign.
+    const std::size_t e = token.find_first_of("eE");
+    const bool negativeExponent =
+        e != std::string_view::npos && e + 1 < token.size() && token[e + 1] == '-';
+    const T magnitude = negativeExponent ? T(0) : std::numeric_limits<T>::infinity();
+    *value = token[0] == '-' ? -magnitude : magnitude;
+    return true;
+  }
+  return ec == std::errc();
+}
+
+struct Property {
+  std::string name;
+  Type type = Type::kFloat32;  // the scalar's type, or the type of a list's items
+  bool isList = false;
+  Type countType = Type::kUint8;
+  std::size_t line = 0;
+};
+
+enum class Role { kOther, kVertex, kFace, kTristrips };
+
+struct Element {
+  std::string name;
+  std::uint64_t count = 0;
+  std::size_t line = 0;  // of its "element" line
+  Role role = Role::kOther;
+  std::vector<Property> properties;
+  std::array<std::size_t, 3> coords{};  // vertex: the properties x, y and z
+  std::size_t indexList = 0;            // face, tristrips: the vertex index list
+};
+
+constexpr std::array<char, 3> kAxes{'x', 'y', 'z'};
+
+class PlyReader {
+ public:
+  PlyReader(const std::string& bytes, const std::string& file, const std::string& context)
+      : bytes_(bytes),
+        data_(reinterpret_cast<const unsigned char*>(bytes.data())),
+        file_(file),
+        context_(context) {}
+
+  std::vector<Tri> load() {
+    parseHeader();
+    checkHeader();
+    if (format_ == Format::kAscii) {
+      readAscii();
+    } else {
+      readBinary();
+    }
+    if (tris_.empty()) fail("", "no faces (the 'tristrips' element holds no triangle)");
+    PT_CHECK(vertices_.size() == vertexCount_, "PLY vertices not all read");
+    std::vector<Tri> triangles;
+    triangles.reserve(tris_.size());
+    for (const IndexTri& t : tris_) {
+      triangles.push_back({vertices_[t[0]], vertices_[t[1]], vertices_[t[2]]});
+    }
+    return triangles;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& where, const std::string& problem) const {
+    throwInputError(file_, where, problem + context_);
+  }
+  [[noreturn]] void failLine(std::size_t line, const std::string& problem) const {
+    fail("line " + std::to_string(line), problem);
+  }
+  // An error in entry `index` of element `e`; `line` is its line in an ascii file.
+  [[noreturn]] void failEntry(const Element& e, std::uint64_t index, const std::string& problem,
+                              std::size_t line = 0) const {
+    std::string where = e.name + " " + std::to_string(index);
+    if (line > 0) where += " (line " + std::to_string(line) + ")";
+    fail(where, problem);
+  }
+
+  // ---- Header ----
+
+  void parseHeader() {
+    const std::string_view text(bytes_);
+    std::size_t pos = 0;
+    std::size_t line = 0;
+    bool sawFormat = false;
+    while (true) {
+      if (pos >= text.size()) {
+        if (line == 0) failLine(1, "not a PLY file (it is empty)");
+        failLine(line, "the file ends in the header (no 'end_header' line)");
+      }
+      const std::size_t end = std::min(text.find('\n', pos), text.size());
+      std::string_view rest = text.substr(pos, end - pos);
+      pos = end + 1;
+      ++line;
+      if (!rest.empty() && rest.back() == '\r') rest.remove_suffix(1);
+      if (line == 1) {
+        std::string_view magic = rest;
+        if (nextToken(magic) != "ply" || !nextToken(magic).empty()) {
+          failLine(1,
+                   "not a PLY file (the first line must be 'ply', not " + singleQuoted(rest) + ")");
+        }
+        continue;
+      }
+      const std::string_view keyword = nextToken(rest);
+      if (keyword.empty() || keyword == "comment" || keyword == "obj_info") continue;
+      if (keyword == "format") {
+        if (sawFormat) failLine(line, "a second 'format' line");
+        format(line, rest);
+        sawFormat = true;
+      } else if (keyword == "element") {
+        element(line, rest);
+      } else if (keyword == "property") {
+        property(line, rest);
+      } else if (keyword == "end_header") {
+        noMoreTokens(line, rest, "'end_header'");
+        if (!sawFormat) failLine(line, "the header has no 'format' line");
+        headerLines_ = line;
+        dataStart_ = std::min(pos, text.size());
+        return;
+      } else {
+        failLine(line, "unknown header keyword " + singleQuoted(keyword) +
+                           didYouMean(keyword, {"format", "comment", "obj_info", "element",
+                                                "property", "end_header"}));
+      }
+    }
+  }
+
+  void noMoreTokens(std::size_t line, std::string_view rest, const std::string& after) const {
+    const std::string_view extra = nextToken(rest);
+    if (!extra.empty()) failLine(line, "unexpected " + singleQuoted(extra) + " after " + after);
+  }
+
+  void format(std::size_t line, std::string_view rest) {
+    const std::string_view name = nextToken(rest);
+    const std::string_view version = nextToken(rest);
+    if (version.empty()) {
+      failLine(line, "the format line needs a format and a version, e.g. 'format ascii 1.0'");
+    }
+    if (name == "ascii") {
+      format_ = Format::kAscii;
+    } else if (name == "binary_little_endian") {
+      format_ = Format::kBinaryLittleEndian;
+    } else if (name == "binary_big_endian") {
+      format_ = Format::kBinaryBigEndian;
+    } else {
+      failLine(line, "unknown format " + singleQuoted(name) +
+                         didYouMean(name, {"ascii", "binary_little_endian", "binary_big_endian"}));
+    }
+    if (version != "1.0") {
+      failLine(line, "unsupported format version " + singleQuoted(version) + " (only 1.0 is)");
+    }
+    noMoreTokens(line, rest, "the format version");
+  }
+
+  void element(std::size_t line, std::string_view rest) {
+    const std::string_view name = nextToken(rest);
+    const std::string_view countToken = nextToken(rest);
+    if (countToken.empty()) failLine(line, "the element line needs a name and a count");
+    Element e;
+    e.name = name;
+    e.line = line;
+    const auto [ptr, ec] =
+        std::from_chars(countToken.data(), countToken.data() + countToken.size(), e.count);
+    if (ec != std::errc() || ptr != countToken.data() + countToken.size()) {
+      failLine(line, "element count " + singleQuoted(countToken) + " is not a non-negative " +
+                         (ec == std::errc::result_out_of_range ? "64-bit " : "") + "integer");
+    }
+    noMoreTokens(line, rest, "the element count");
+    if (name == "vertex") e.role = Role::kVertex;
+    if (name == "face") e.role = Role::kFace;
+    if (name == "tristrips") e.role = Role::kTristrips;
+    // Two elements of a role would make the indices ambiguous; other names do not matter.
+    if (e.role != Role::kOther) {
+      for (const Element& other : elements_) {
+        if (other.name == e.name) {
+          failLine(line, "a second '" + e.name + "' element (the first is on line " +
+                             std::to_string(other.line) + ")");
+        }
+      }
+    }
+    elements_.push_back(std::move(e));
+  }
+
+  Type parseType(std::size_t line, std::string_view name) const {
+    for (const TypeName& t : kTypeNames) {
+      if (t.name == name) return t.type;
+    }
+    std::vector<std::string_view> names;
+    for (const TypeName& t : kTypeNames) names.push_back(t.name);
+    failLine(line, "unknown property type " + singleQuoted(name) + didYouMean(name, names));
+  }
+
+  void property(std::size_t line, std::string_view rest) {
+    if (elements_.empty()) failLine(line, "a property before any 'element' line");
+    Property p;
+    p.line = line;
+    std::string_view first = nextToken(rest);
+    if (first == "list") {
+      const std::string_view countType = nextToken(rest);
+      const std::string_view itemType = nextToken(rest);
+      const std::string_view name = nextToken(rest);
+      if (name.empty()) {
+        failLine(line,
+                 "a list property needs a count type, an item type and a name, e.g. "
+                 "'property list uchar int vertex_indices'");
+      }
+      p.isList = true;
+      p.countType = parseType(line, countType);
+      p.type = parseType(line, itemType);
+      p.name = name;
+      if (!isInteger(p.countType)) {
+        failLine(line, "the count type of list '" + p.name + "' is '" + typeName(p.countType) +
+                           "' (it must be an integer type)");
+      }
+    } else {
+      const std::string_view name = nextToken(rest);
+      if (name.empty()) {
+        failLine(line, "a property needs a type and a name, e.g. 'property float x'");
+      }
+      p.type = parseType(line, first);
+      p.name = name;
+    }
+    noMoreTokens(line, rest, "the property name");
+    elements_.back().properties.push_back(std::move(p));
+  }
+
+  // Finds the one property of `e` named one of `names`: npos if none; an error if two.
+  std::size_t findProperty(const Element& e, std::initializer_list<std::string_view> names) const {
+    std::size_t found = std::string::npos;
+    for (std::size_t j = 0; j < e.properties.size(); ++j) {
+      const Property& p = e.properties[j];
+      if (std::find(names.begin(), names.end(), p.name) == names.end()) continue;
+      if (found != std::string::npos) {
+        failLine(p.line, "element '" + e.name + "' already has a property '" +
+                             e.properties[found].name + "' (line " +
+                             std::to_string(e.properties[found].line) + ")");
+      }
+      found = j;
+    }
+    return found;
+  }
+
+  void checkHeader() {
+    const Element* vertex = nullptr;
+    bool anyFaces = false;
+    bool anyFaceEntries = false;
+    for (Element& e : elements_) {
+      if (e.role == Role::kVertex) {
+        vertex = &e;
+        for (std::size_t c = 0; c < 3; ++c) {
+          const std::string name(1, kAxes[c]);
+          const std::size_t j = findProperty(e, {name});
+          if (j == std::string::npos) {
+            failLine(e.line, "element 'vertex' has no property '" + name + "'");
+          }
+          const Property& p = e.properties[j];
+          if (p.isList || isInteger(p.type)) {
+            failLine(p.line, "vertex property '" + name + "' is " +
+                                 (p.isList ? "a list" : "'" + typeName(p.type) + "'") +
+                                 " (it must be float or double)");
+          }
+          e.coords[c] = j;
+        }
+      } else if (e.role == Role::kFace || e.role == Role::kTristrips) {
+        const std::size_t j = e.role == Role::kFace
+                                  ? findProperty(e, {"vertex_indices", "vertex_index"})
+                                  : findProperty(e, {"vertex_indices"});
+        if (j == std::string::npos) {
+          failLine(e.line, "element '" + e.name + "' has no list property 'vertex_indices'");
+        }
+        const Property& p = e.properties[j];
+        if (!p.isList || !isInteger(p.type)) {
+          failLine(p.line, "'" + p.name + "' of element '" + e.name + "' must be a list of an " +
+                               "integer type, e.g. 'property list uchar int " + p.name + "'");
+        }
+        e.indexList = j;
+        anyFaces = true;
+        anyFaceEntries = anyFaceEntries || e.count > 0;
+      }
+    }
+    if (vertex == nullptr) fail("header", "no 'vertex' element");
+    if (!anyFaces) fail("header", "no 'face' element");
+    if (!anyFaceEntries) fail("", "no faces (the header declares 0)");
+    vertexCount_ = vertex->count;
+
+    // Counts that could not fit in the file even at the smallest size of an entry, so that a
+    // header claiming billions of entries is an error before anything is allocated. Binary
+    // entries of one size are left to readBinaryElement, whose exact check can name the
+    // entry where a truncated file ends.
+    const std::uint64_t dataBytes = bytes_.size() - dataStart_;
+    for (const Element& e : elements_) {
+      if (e.properties.empty()) continue;
+      if (format_ != Format::kAscii && !hasList(e)) continue;
+      const std::uint64_t minBytes = minEntryBytes(e);
+      // An ascii entry with p values takes at least 2p - 1 characters, plus a line break
+      // before the next entry.
+      const bool fits = format_ == Format::kAscii ? e.count <= (dataBytes + 1) / minBytes
+                                                  : e.count <= dataBytes / minBytes;
+      if (!fits) {
+        failLine(e.line, "element '" + e.name + "' count " + std::to_string(e.count) +
+                             " cannot fit in the file (each entry takes at least " +
+                             std::to_string(minBytes) + " bytes, and the data after the " +
+                             "header is " + std::to_string(dataBytes) + " bytes)");
+      }
+    }
+  }
+
+  static bool hasList(const Element& e) {
+    return std::any_of(e.properties.begin(), e.properties.end(),
+                       [](const Property& p) { return p.isList; });
+  }
+
+  // The fewest bytes an entry of `e` can take: all lists empty; in ascii, one character per
+  // value and a blank or line break after it.
+  std::uint64_t minEntryBytes(const Element& e) const {
+    std::uint64_t bytes = 0;
+    for (const Property& p : e.properties) {
+      bytes += format_ == Format::kAscii ? 2 : sizeOf(p.isList ? p.countType : p.type);
+    }
+    return bytes;
+  }
+
+  // How many entries of `e` to reserve memory for: its count, but no more than the data
+  // left could hold.
+  std::size_t reserveFor(const Element& e, std::size_t pos) const {
+    const std::uint64_t minBytes = std::max<std::uint64_t>(1, minEntryBytes(e));
+    return static_cast<std::size_t>(
+        std::min<std::uint64_t>(e.count, (bytes_.size() - pos) / minBytes + 1));
+  }
+
+  // ---- Faces, strips and vertices, shared by both encodings ----
+
+  std::uint32_t checkedIndex(const Element& e, std::uint64_t entry, std::int64_t index,
+                             std::size_t line) const {
+    if (index < 0) {
+      failEntry(
+          e, entry,
+          "negative vertex index " + std::to_string(index) +
+              (e.role == Role::kTristrips ? " (only -1, which restarts a strip, is allowed)" : ""),
+          line);
+    }
+    if (static_cast<std::uint64_t>(index) >= vertexCount_) {
+      failEntry(e, entry,
+                "vertex index " + std::to_string(index) + " out of range (file has " +
+                    std::to_string(vertexCount_) + (vertexCount_ == 1 ? " vertex)" : " vertices)"),
+                line);
+    }
+    return static_cast<std::uint32_t>(index);
+  }
+
+  // A polygon of n vertices, fanned as (0, i, i + 1); next() yields its indices in order.
+  template <typename Next>
+  void addPolygon(const Element& e, std::uint64_t entry, std::uint64_t n, std::size_t line,
+                  Next&& next) {
+    if (n < 3) {
+      failEntry(e, entry,
+                "face has " + std::to_string(n) + (n == 1 ? " vertex" : " vertices") +
+                    " (need at least 3)",
+                line);
+    }
+    const std::uint32_t first = checkedIndex(e, entry, next(), line);
+    std::uint32_t previous = checkedIndex(e, entry, next(), line);
+    for (std::uint64_t k = 2; k < n; ++k) {
+      const std::uint32_t current = checkedIndex(e, entry, next(), line);
+      tris_.push_back({first, previous, current});
+      previous = current;
+    }
+  }
+
+  // Triangle strips, -1 starting a new one: triangle k of a strip is (v_k, v_k+1, v_k+2),
+  // the first two swapped for odd k so that all keep the winding of the first.
+  template <typename Next>
+  void addStrips(const Element& e, std::uint64_t entry, std::uint64_t n, std::size_t line,
+                 Next&& next) {
+    std::uint32_t a = 0;
+    std::uint32_t b = 0;
+    std::uint64_t inStrip = 0;
+    for (std::uint64_t k = 0; k < n; ++k) {
+      const std::int64_t index = next();
+      if (index == -1) {
+        inStrip = 0;
+        continue;
+      }
+      const std::uint32_t c = checkedIndex(e, entry, index, line);
+      // A repeated vertex is how strips are stitched or turned, not geometry: such
+      // triangles are skipped here (the parity still counts them).
+      if (inStrip >= 2 && a != b && b != c && a != c) {
+        if ((inStrip - 2) % 2 == 0) {
+          tris_.push_back({a, b, c});
+        } else {
+          tris_.push_back({b, a, c});
+        }
+      }
+      a = b;
+      b = c;
+      ++inStrip;
+    }
+  }
+
+  // Coordinates must be finite and, like every vertex the renderer sees, fit a float.
+  void checkVertex(const Element& e, std::uint64_t entry, const glm::dvec3& p,
+                   std::size_t line) const {
+    for (int c = 0; c < 3; ++c) {
+      const double v = p[c];
+      if (std::fabs(v) <= std::numeric_limits<float>::max()) continue;
+      const std::string axis(1, kAxes[c]);
+      if (!std::isfinite(v)) {
+        failEntry(
+            e, entry,
+            "coordinate is not finite (" + axis + " = " + (std::isnan(v) ? "nan" : "inf") + ")",
+            line);
+      }
+      failEntry(
+          e, entry,
+          "coordinate is too large for a 32-bit float (" + axis + " = " + formatNumber(v) + ")",
+          line);
+    }
+  }
+
+  // ---- Binary ----
+
+  [[noreturn]] void failTruncated(const Element& e, std::uint64_t entry,
+                                  const std::string& note = "") const {
+    failEntry(
+        e, entry,
+        "truncated binary data (file ends at byte " + std::to_string(bytes_.size()) + note + ")");
+  }
+
+  void readBinary() {
+    const bool fileLittle = format_ == Format::kBinaryLittleEndian;
+    const bool swap = fileLittle != (std::endian::native == std::endian::little);
+    std::size_t pos = dataStart_;
+    for (const Element& e : elements_) pos = readBinaryElement(e, pos, swap);
+    if (pos != bytes_.size()) {
+      fail("byte " + std::to_string(pos),
+           std::to_string(bytes_.size() - pos) +
+               " bytes of data after the last element (do the header's counts match the data?)");
+    }
+  }
+
+  // Decodes the entries of `e` from byte `pos`; returns where the next element starts.
+  std::size_t readBinaryElement(const Element& e, std::size_t pos, bool swap) {
+    if (e.properties.empty() || e.count == 0) return pos;
+    const std::size_t size = bytes_.size();
+    if (!hasList(e)) {
+      // Entries of one size: the whole element is bounds-checked at once.
+      const std::size_t stride = minEntryBytes(e);
+      if (e.count > (size - pos) / stride) {
+        failTruncated(e, (size - pos) / stride,
+                      "; the header declares " + std::to_string(e.count) + " entries of " +
+                          std::to_string(stride) + " bytes from byte " + std::to_string(pos));
+      }
+      if (e.role == Role::kVertex) readFixedVertices(e, data_ + pos, stride, swap);
+      return pos + static_cast<std::size_t>(e.count) * stride;
+    }
+
+    if (e.role == Role::kVertex) vertices_.reserve(reserveFor(e, pos));
+    if (e.role == Role::kFace) tris_.reserve(tris_.size() + reserveFor(e, pos));
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+      glm::dvec3 point(0.0);
+      for (std::size_t j = 0; j < e.properties.size(); ++j) {
+        const Property& p = e.properties[j];
+        if (!p.isList) {
+          const std::size_t bytes = sizeOf(p.type);
+          if (size - pos < bytes) failTruncated(e, i);
+          if (e.role == Role::kVertex) {
+            for (int c = 0; c < 3; ++c) {
+              if (e.coords[c] == j) point[c] = loadReal(data_ + pos, p.type, swap);
+            }
+          }
+          pos += bytes;
+          continue;
+        }
+        const std::size_t countBytes = sizeOf(p.countType);
+        if (size - pos < countBytes) failTruncated(e, i);
+        const std::int64_t n = loadInteger(data_ + pos, p.countType, swap);
+        pos += countBytes;
+        if (n < 0) {
+          failEntry(e, i, "list '" + p.name + "' has a negative count (" + std::to_string(n) + ")");
+        }
+        const std::size_t itemBytes = sizeOf(p.type);
+        if (static_cast<std::uint64_t>(n) > (size - pos) / itemBytes) {
+          // A count that fits the data after the header is taken for a cut file; one that
+          // does not is a wrong count.
+          if (static_cast<std::uint64_t>(n) <= (size - dataStart_) / itemBytes) {
+            failTruncated(e, i);
+          }
+          failEntry(e, i,
+                    "list '" + p.name + "' count " + std::to_string(n) +
+                        " is more than the rest of the file can hold (" +
+                        std::to_string(size - pos) + " bytes left, " + std::to_string(itemBytes) +
+                        " per item)");
+        }
+        const unsigned char* items = data_ + pos;
+        pos += static_cast<std::size_t>(n) * itemBytes;
+        if (j != e.indexList || e.role == Role::kOther || e.role == Role::kVertex) continue;
+        auto next = [&, k = std::size_t{0}]() mutable {
+          return loadInteger(items + itemBytes * k++, p.type, swap);
+        };
+        if (e.role == Role::kFace) {
+          addPolygon(e, i, static_cast<std::uint64_t>(n), 0, next);
+        } else {
+          addStrips(e, i, static_cast<std::uint64_t>(n), 0, next);
+        }
+      }
+      if (e.role == Role::kVertex) {
+        checkVertex(e, i, point, 0);
+        vertices_.push_back(point);
+      }
+    }
+    return pos;
+  }
+
+  void readFixedVertices(const Element& e, const unsigned char* base, std::size_t stride,
+                         bool swap) {
+    std::array<std::size_t, 3> offset{};
+    std::array<Type, 3> type{};
+    for (std::size_t c = 0; c < 3; ++c) {
+      for (std::size_t j = 0; j < e.coords[c]; ++j) offset[c] += sizeOf(e.properties[j].type);
+      type[c] = e.properties[e.coords[c]].type;
+    }
+    vertices_.resize(static_cast<std::size_t>(e.count));
+    for (std::size_t i = 0; i < vertices_.size(); ++i) {
+      const unsigned char* entry = base + i * stride;
+      const glm::dvec3 point(loadReal(entry + offset[0], type[0], swap),
+                             loadReal(entry + offset[1], type[1], swap),
+                             loadReal(entry + offset[2], type[2], swap));
+      checkVertex(e, i, point, 0);
+      vertices_[i] = point;
+    }
+  }
+
+  // ---- Ascii: one entry per line ----
+
+  // The next line holding anything but blanks (blank lines are tolerated anywhere); false
+  // at the end of the file. line_ is its line number.
+  bool nextLine(std::string_view* out) {
+    const std::string_view text(bytes_);
+    while (pos_ < text.size()) {
+      const std::size_t end = std::min(text.find('\n', pos_), text.size());
+      std::string_view line = text.substr(pos_, end - pos_);
+      pos_ = end + 1;
+      ++line_;
+      std::string_view rest = line;
+      if (!nextToken(rest).empty()) {
+        *out = line;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void readAscii() {
+    pos_ = dataStart_;
+    line_ = headerLines_;
+    for (const Element& e : elements_) readAsciiElement(e);
+    std::string_view line;
+    if (nextLine(&line)) {
+      failLine(line_, "data after the last element (do the header's counts match the data?)");
+    }
+  }
+
+  void readAsciiElement(const Element& e) {
+    if (e.properties.empty() || e.count == 0) return;
+    if (e.role == Role::kVertex) vertices_.reserve(reserveFor(e, pos_));
+    if (e.role == Role::kFace) tris_.reserve(tris_.size() + reserveFor(e, pos_));
+    const std::size_t propertyCount = e.properties.size();
+    // Whether a list follows each property: then a short line's value count is a minimum.
+    std::vector<bool> listAfter(propertyCount, false);
+    for (std::size_t j = propertyCount; j-- > 1;) {
+      listAfter[j - 1] = listAfter[j] || e.properties[j].isList;
+    }
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+      std::string_view line;
+      if (!nextLine(&line)) {
+        failEntry(e, i,
+                  "the file ends before this entry (the header declares " +
+                      std::to_string(e.count) + " '" + e.name + "' entries)",
+                  line_ + 1);
+      }
+      std::string_view rest = line;
+      std::size_t consumed = 0;
+      // The next value; `needed` is how many values at least, this one included, the
+      // rest of the entry still needs (for the message when the line is too short).
+      auto value = [&](std::uint64_t needed, bool exact) {
+        const std::string_view token = nextToken(rest);
+        if (token.empty()) {
+          const std::size_t found = countTokens(line);
+          failEntry(e, i,
+                    "the line has " + std::to_string(found) + (found == 1 ? " value" : " values") +
+                        ", expected " + (exact ? "" : "at least ") +
+                        std::to_string(consumed + needed),
+                    line_);
+        }
+        ++consumed;
+        return token;
+      };
+      glm::dvec3 point(0.0);
+      for (std::size_t j = 0; j < propertyCount; ++j) {
+        const Property& p = e.properties[j];
+        const std::size_t after = propertyCount - j - 1;
+        if (!p.isList) {
+          const std::string_view token = value(1 + after, !listAfter[j]);
+          // Other properties are only counted: their values do not matter here.
+          if (e.role != Role::kVertex) continue;
+          for (int c = 0; c < 3; ++c) {
+            if (e.coords[c] == j) point[c] = asciiCoordinate(e, i, token, kAxes[c], p.type);
+          }
+          continue;
+        }
+        const std::string_view countToken = value(1 + after, false);
+        const std::int64_t n = asciiInteger(e, i, countToken, p.countType, &p);
+        if (n < 0) {
+          failEntry(e, i, "list '" + p.name + "' has a negative count (" + std::to_string(n) + ")",
+                    line_);
+        }
+        const std::uint64_t count = static_cast<std::uint64_t>(n);
+        std::uint64_t k = 0;
+        auto nextIndex = [&]() {
+          const std::string_view token = value(count - k + after, !listAfter[j]);
+          ++k;
+          return asciiInteger(e, i, token, p.type, nullptr);
+        };
+        if (j == e.indexList && e.role == Role::kFace) {
+          addPolygon(e, i, count, line_, nextIndex);
+        } else if (j == e.indexList && e.role == Role::kTristrips) {
+          addStrips(e, i, count, line_, nextIndex);
+        } else {
+          for (; k < count; ++k) value(count - k + after, !listAfter[j]);
+        }
+      }
+      if (!nextToken(rest).empty()) {
+        const std::size_t found = countTokens(line);
+        failEntry(e, i,
+                  "the line has " + std::to_string(found) + " values, expected " +
+                      std::to_string(consumed),
+                  line_);
+      }
+      if (e.role == Role::kVertex) {
+        checkVertex(e, i, point, line_);
+        vertices_.push_back(point);
+      }
+    }
+  }
+
+  // A list count (of `list`) or, with no list, a vertex index.
+  std::int64_t asciiInteger(const Element& e, std::uint64_t entry, std::string_view token,
+                            Type type, const Property* list) const {
+    std::int64_t value = 0;
+    const Parse result = parseInteger(token, &value);
+    if (result == Parse::kOk && value >= minOf(type) && value <= maxOf(type)) return value;
+    const std::string what = list ? "list '" + list->name + "' count" : "vertex index";
+    if (result == Parse::kNotNumber) {
+      failEntry(e, entry, what + " " + singleQuoted(token) + " is not an integer", line_);
+    }
+    failEntry(
+        e, entry,
+        what + " " + singleQuoted(token) + " is out of range for its type '" + typeName(type) + "'",
+        line_);
+  }
+
+  double asciiCoordinate(const Element& e, std::uint64_t entry, std::string_view token, char axis,
+                         Type type) const {
+    // Parsed at the property's own precision: a float property rounds once, straight from
+    // the decimal text, exactly as a binary file of the same mesh would hold it.
+    double value = 0.0;
+    bool ok = false;
+    if (type == Type::kFloat32) {
+      float f = 0.0f;
+      ok = parseReal(token, &f);
+      value = f;
+    } else {
+      ok = parseReal(token, &value);
+    }
+    if (!ok) {
+      failEntry(
+          e, entry,
+          "coordinate " + std::string(1, axis) + " " + singleQuoted(token) + " is not a number",
+          line_);
+    }
+    if (std::fabs(value) <= std::numeric_limits<float>::max()) return value;
+    // Too large or really infinite: the text as a double tells which (a float property's
+    // overflow has already become an infinity).
+    double asDouble = value;
+    parseReal(token, &asDouble);
+    failEntry(e, entry,
+              std::string(std::isfinite(asDouble) ? "coordinate is too large for a 32-bit float"
+                                                  : "coordinate is not finite") +
+                  " (" + std::string(1, axis) + " = " + singleQuoted(token) + ")",
+              line_);
+  }
+
+  const std::string& bytes_;
+  const unsigned char* data_;
+  const std::string& file_;
+  const std::string& context_;
+
+  Format format_ = Format::kAscii;
+  std::vector<Element> elements_;
+  std::size_t headerLines_ = 0;
+  std::size_t dataStart_ = 0;
+  std::uint64_t vertexCount_ = 0;
+
+  std::size_t pos_ = 0;   // ascii: start of the next line
+  std::size_t line_ = 0;  // ascii: number of the line last read
+
+  std::vector<glm::dvec3> vertices_;
+  std::vector<IndexTri> tris_;
+};
+
+}  // namespace
+
+std::vector<std::array<glm::dvec3, 3>> loadPlyTriangles(const std::string& bytes,
+                                                        const std::string& file,
+                                                        const std::string& context) {
+  return PlyReader(bytes, file, context).load();
+}
+
+}  // namespace pt::scene_detail
