@@ -2,14 +2,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <fstream>
+#include <cmath>
 #include <random>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "bvh/bvh.h"
 #include "bvh/traverse.h"
-#include "scene/scene.h"
 #include "closed_mesh.h"
+#include "scene/scene.h"
 #include "test_util.h"
 
 namespace pt {

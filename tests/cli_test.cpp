@@ -1,38 +1,24 @@
 // The command-line contract: exit statuses, one-line errors, no half-written outputs.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
-#include <fstream>
-#include <sys/wait.h>
+#include <algorithm>
+#include <filesystem>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "test_util.h"
 
 namespace pt {
 namespace {
 
-const std::string kPt = PT_BINARY;
-const std::string kConfigs = std::string(PT_SOURCE_DIR) + "/configs";
+using test::PtResult;
+using test::runPt;
 
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
-
-// Runs `pt args`, capturing stdout and stderr through files.
-Result runPt(const std::string& args, const test::TempDir& dir) {
-  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = kPt + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int raw = std::system(cmd.c_str());
-  Result r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  auto slurp = [](const std::filesystem::path& p) {
-    std::ifstream f(p);
-    return std::string(std::istreambuf_iterator<char>(f), {});
-  };
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
+// The path of a scene file in configs/, for the command line.
+std::string config(const std::string& name) {
+  return (test::kConfigs / name).string();
 }
 
 int lineCount(const std::string& s) {
@@ -41,11 +27,10 @@ int lineCount(const std::string& s) {
 
 TEST(Cli, RenderWritesEveryOutputAndOneStatsLine) {
   test::TempDir dir;
-  const Result r = runPt("render " + kConfigs +
-                             "/cornell-box.json --backend cpu --spp 2 --width 32 --height 32 " +
-                             "--threads 2 --out " + (dir / "a.png").string() + " --out " +
-                             (dir / "a.exr").string() + " --out " + (dir / "a.pfm").string(),
-                         dir);
+  const PtResult r = runPt("render " + config("cornell-box.json") +
+                           " --backend cpu --spp 2 --width 32 --height 32 --threads 2 --out " +
+                           (dir / "a.png").string() + " --out " + (dir / "a.exr").string() +
+                           " --out " + (dir / "a.pfm").string());
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* f : {"a.png", "a.exr", "a.pfm"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
@@ -55,17 +40,14 @@ TEST(Cli, RenderWritesEveryOutputAndOneStatsLine) {
     EXPECT_NE(r.out.find(key), std::string::npos) << key << " in " << r.out;
   }
   // The same render compared with itself agrees; against a different seed it does not.
-  EXPECT_EQ(runPt("diff " + (dir / "a.exr").string() + " " + (dir / "a.pfm").string(), dir).status,
-            0);
-  ASSERT_EQ(runPt("render " + kConfigs +
-                      "/cornell-box.json --backend cpu --spp 2 --width 32 --height 32 " +
-                      "--seed 9 --out " + (dir / "b.exr").string(),
-                  dir)
+  EXPECT_EQ(runPt("diff " + (dir / "a.exr").string() + " " + (dir / "a.pfm").string()).status, 0);
+  ASSERT_EQ(runPt("render " + config("cornell-box.json") +
+                  " --backend cpu --spp 2 --width 32 --height 32 --seed 9 --out " +
+                  (dir / "b.exr").string())
                 .status,
             0);
-  const Result d = runPt("diff " + (dir / "a.exr").string() + " " + (dir / "b.exr").string() +
-                             " --heatmap " + (dir / "heat.png").string(),
-                         dir);
+  const PtResult d = runPt("diff " + (dir / "a.exr").string() + " " + (dir / "b.exr").string() +
+                           " --heatmap " + (dir / "heat.png").string());
   EXPECT_EQ(d.status, 1) << d.out;
   EXPECT_NE(d.out.find("rmse="), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(dir / "heat.png"));
@@ -79,12 +61,12 @@ struct BadCase {
 
 TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
   test::TempDir dir;
-  std::ofstream(dir / "broken.json") << "{ \"materials\": [ }";
-  std::ofstream(dir / "typo.json") << R"({"materials": [{"name": "m"}],
+  dir.write("broken.json", "{ \"materials\": [ }");
+  dir.write("typo.json", R"({"materials": [{"name": "m"}],
     "shapes": [{"type": "quad", "material": "m", "vertices": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]}],
-    "camera": {"widht": 10}})";
+    "camera": {"widht": 10}})");
   const std::string out = " --out " + (dir / "out.png").string();
-  const std::string box = kConfigs + "/cornell-box.json";
+  const std::string box = config("cornell-box.json");
   const std::vector<BadCase> cases = {
       {"missing scene", "render " + (dir / "nope.json").string() + out, "nope.json"},
       {"malformed json", "render " + (dir / "broken.json").string() + out, "broken.json"},
@@ -104,54 +86,67 @@ TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.name);
-    const Result r = runPt(c.args, dir);
+    const PtResult r = runPt(c.args);
     EXPECT_EQ(r.status, 2) << r.err;
     EXPECT_EQ(lineCount(r.err), 1) << r.err;
     EXPECT_NE(r.err.find(c.expectInError), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir / "out.png"));
     EXPECT_FALSE(std::filesystem::exists(dir / "out.bmp"));
   }
-  // Nothing but the inputs and the captured streams is left in the directory (no temp files).
-  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
-    const std::string name = entry.path().filename().string();
-    EXPECT_TRUE(name == "broken.json" || name == "typo.json" || name == "stdout.txt" ||
-                name == "stderr.txt")
-        << name;
-  }
+  // Nothing but the inputs is left in the directory (no temporary files).
+  EXPECT_EQ(dir.listing(), (std::vector<std::string>{"broken.json", "typo.json"}));
 }
 
 TEST(CliVulkan, RendersOnTheDefaultBackendWithValidation) {
   test::TempDir dir;
-  const Result r =
-      runPt("render " + kConfigs + "/cornell-mirror.json --spp 2 --width 16 --height 16 " +
-                "--validation --out " + (dir / "v.exr").string(),
-            dir);
+  const PtResult r =
+      runPt("render " + config("cornell-mirror.json") +
+            " --spp 2 --width 16 --height 16 --validation --out " + (dir / "v.exr").string());
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* key : {"backend=vulkan", "device=", "effects=diffuse+mirror+nee+mis+rr",
                           "invalid_samples=0", "Mrays/s="}) {
     EXPECT_NE(r.out.find(key), std::string::npos) << key << " in " << r.out;
   }
   EXPECT_EQ(r.err.find("validation"), std::string::npos) << r.err;
-  const Result d = runPt("devices", dir);
-  EXPECT_EQ(d.status, 0);
-  EXPECT_GE(lineCount(d.out), 1);
+
+  // `pt devices` lists every device as "INDEX: NAME (TYPE; DRIVER)", indices counting from 0,
+  // and among them the device the render ran on: in CI lavapipe, listed as
+  // "0: llvmpipe (LLVM 15.0.6, 256 bits) (cpu; llvmpipe Mesa 22.3.6 (LLVM 15.0.6))".
+  std::smatch used;
+  ASSERT_TRUE(std::regex_search(r.out, used, std::regex("device=\"([^\"]+)\""))) << r.out;
+  const PtResult d = runPt("devices");
+  ASSERT_EQ(d.status, 0) << d.err;
+  const std::regex format(
+      R"((\d+): (.+) \((discrete|integrated|virtual|cpu|other); (.+)\)( unsuitable: .+)?)");
+  std::istringstream lines(d.out);
+  int count = 0;
+  bool listed = false;
+  for (std::string line; std::getline(lines, line); ++count) {
+    std::smatch m;
+    ASSERT_TRUE(std::regex_match(line, m, format)) << line;
+    EXPECT_EQ(m[1].str(), std::to_string(count)) << line;
+    if (m[2].str() != used[1].str()) continue;
+    listed = true;
+    EXPECT_FALSE(m[5].matched) << "the render ran on it, yet: " << line;
+    if (m[2].str().find("llvmpipe") != std::string::npos) {
+      EXPECT_EQ(m[3].str(), "cpu") << line;
+      EXPECT_NE(m[4].str().find("llvmpipe"), std::string::npos) << line;
+    }
+  }
+  EXPECT_GE(count, 1);
+  EXPECT_TRUE(listed) << "no line for " << used[1].str() << " in:\n" << d.out;
 }
 
 TEST(CliVulkan, NoDriverGivesItsOwnExitStatus) {
   test::TempDir dir;
   // Point the loader at a driver manifest that does not exist: no Vulkan driver at all.
   const std::string env = "VK_ICD_FILENAMES=" + (dir / "none.json").string() +
-                          " VK_DRIVER_FILES=" + (dir / "none.json").string() + " ";
-  const auto out = dir / "o.txt", err = dir / "e.txt";
-  const std::string cmd = env + kPt + " render " + kConfigs + "/cornell-box.json --spp 1 --out " +
-                          (dir / "x.png").string() + " >" + out.string() + " 2>" + err.string();
-  const int raw = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(raw));
-  EXPECT_EQ(WEXITSTATUS(raw), 3);
-  std::ifstream f(err);
-  const std::string text(std::istreambuf_iterator<char>(f), {});
-  EXPECT_EQ(lineCount(text), 1) << text;
-  EXPECT_NE(text.find("Vulkan"), std::string::npos) << text;
+                          " VK_DRIVER_FILES=" + (dir / "none.json").string();
+  const PtResult r = runPt(
+      "render " + config("cornell-box.json") + " --spp 1 --out " + (dir / "x.png").string(), env);
+  EXPECT_EQ(r.status, 3);
+  EXPECT_EQ(lineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("Vulkan"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
 }
 

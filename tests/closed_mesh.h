@@ -7,9 +7,9 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <algorithm>
 #include <map>
+#include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -23,12 +23,12 @@ namespace pt::test {
 inline const char* const kBunnyObj = "/usr/share/glmark2/models/bunny.obj";
 
 inline std::vector<Triangle> loadBunny() {
-  TempDir dir;
-  std::ofstream(dir / "bunny.json") << R"({
-    "materials": [{"name": "white", "reflectance": [0.5, 0.5, 0.5]}],
-    "shapes": [{"type": "obj", "file": ")"
-                                    << kBunnyObj << R"(", "material": "white"}]})";
-  return loadScene(dir / "bunny.json").triangles;
+  const std::string file = kBunnyObj;
+  const std::string scene = R"({"materials": [{"name": "white", "reflectance": [0.5, 0.5, 0.5]}],
+    "shapes": [{"type": "obj", "material": "white", "file": ")" +
+                            file + "\"}]}";
+  const TempDir dir;
+  return loadScene(dir.write("bunny.json", scene)).triangles;
 }
 
 // Vertices are matched by exact position: a closed mesh shares them bit for bit.

@@ -1,7 +1,10 @@
 // The CPU reference integrator against closed-form answers and against itself.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "cpu/integrator.h"
 #include "render/prepare.h"
@@ -11,17 +14,11 @@
 namespace pt {
 namespace {
 
-const std::filesystem::path kConfigs = std::filesystem::path(PT_SOURCE_DIR) / "configs";
-
-// Adds quad (c -/+ u -/+ v) as two triangles whose geometric normal is cross(u, v).
-void addQuad(Scene& scene, vec3 c, vec3 u, vec3 v, uint material) {
-  const vec3 p0 = c - u - v, p1 = c + u - v, p2 = c + u + v, p3 = c - u + v;
-  scene.triangles.push_back(Triangle{p0, material, p1, kNoEmitter, p2, 0});
-  scene.triangles.push_back(Triangle{p0, material, p2, kNoEmitter, p3, 0});
-}
+using test::kConfigs;
 
 // A closed cube [-s, s]^3 whose faces all face inward, every face with material `faceMaterial`
-// except those listed in `otherFaces` (face index 0..5), which get material `other`.
+// except those listed in `otherFaces` (face index 0..5), which get material `other`. (The +x,
+// +y and +z faces are split along the other diagonal than test::addInwardCube's.)
 Scene makeFurnace(float s, std::vector<Material> materials, uint faceMaterial = 0,
                   std::vector<int> otherFaces = {}, uint other = 0) {
   Scene scene;
@@ -35,7 +32,7 @@ Scene makeFurnace(float s, std::vector<Material> materials, uint faceMaterial = 
       const vec3 v = s * cross(inward, axes[(a + 1) % 3]);  // cross(u, v) = s^2 inward
       const bool isOther =
           std::find(otherFaces.begin(), otherFaces.end(), face) != otherFaces.end();
-      addQuad(scene, side * s * axes[a], u, v, isOther ? other : faceMaterial);
+      test::addQuad(scene, side * s * axes[a], u, v, isOther ? other : faceMaterial);
       ++face;
     }
   }
@@ -123,7 +120,7 @@ TEST(CpuCornell, DirectlyVisibleLightIsExactlyLe) {
   const Camera& cam = data.params.camera;
   ASSERT_EQ(cam.width, 256u);
   Film film(256, 256);
-  const RenderStats stats = renderCpu(data, CpuRenderOptions{.threads = 2, .spp = 4}, film);
+  const RenderStats stats = renderCpu(data, test::cpuOptions(2, 4), film);
   EXPECT_EQ(stats.invalidSamples, 0u);
   EXPECT_GT(stats.rays, 256u * 256u * 4u);
   const Image image = film.resolve();
@@ -152,14 +149,14 @@ TEST(CpuCornell, SameImageWithOneAndTwoThreads) {
   const Scene scene = loadScene(kConfigs / "cornell-mirror.json");
   const SceneData data = prepareScene(scene, RenderSettings{.width = 48, .height = 48});
   Film one(48, 48), two(48, 48);
-  renderCpu(data, CpuRenderOptions{.threads = 1, .spp = 8}, one);
-  renderCpu(data, CpuRenderOptions{.threads = 2, .spp = 8}, two);
+  renderCpu(data, test::cpuOptions(1, 8), one);
+  renderCpu(data, test::cpuOptions(2, 8), two);
   const Image a = one.resolve(), b = two.resolve();
   for (size_t i = 0; i < a.pixels.size(); ++i) ASSERT_EQ(a.pixels[i], b.pixels[i]) << i;
   // And a different seed gives a different image (the seed is really used).
   const SceneData other = prepareScene(scene, RenderSettings{.width = 48, .height = 48, .seed = 7});
   Film three(48, 48);
-  renderCpu(other, CpuRenderOptions{.threads = 2, .spp = 8}, three);
+  renderCpu(other, test::cpuOptions(2, 8), three);
   EXPECT_NE(three.resolve().pixels, a.pixels);
 }
 

@@ -3,12 +3,13 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <bit>
 #include <cfloat>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -24,6 +25,7 @@
 
 #include "common/check.h"
 #include "image/image.h"
+#include "test_util.h"
 
 namespace pt {
 namespace {
@@ -36,31 +38,7 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 // A fresh directory per test, named after it, removed afterwards.
 class ImageTempDir : public testing::Test {
  protected:
-  void SetUp() override {
-    const testing::TestInfo* info = testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = std::string("pt-image-test-") + std::to_string(::getpid()) + "-" +
-                       info->test_suite_name() + "-" + info->name();
-    std::replace(name.begin(), name.end(), '/', '_');
-    dir_ = fs::temp_directory_path() / name;
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-
-  // Names of everything in the directory, so tests can see no temporary file was left behind.
-  std::vector<std::string> listing(const fs::path& dir) const {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(dir)) {
-      names.push_back(entry.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
-  fs::path dir_;
+  test::TempDir dir_;
 };
 
 using ImageExr = ImageTempDir;
@@ -69,10 +47,7 @@ using ImagePng = ImageTempDir;
 using ImageErrors = ImageTempDir;
 using ImageWrite = ImageTempDir;
 
-std::string readBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+using test::readFile;
 
 void writeBytes(const fs::path& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
@@ -258,7 +233,7 @@ TEST_F(ImagePfm, StoresBottomRowFirstInLittleEndian) {
   const fs::path path = dir_ / "rows.pfm";
   writeImage(image, path);
 
-  const std::string bytes = readBytes(path);
+  const std::string bytes = readFile(path);
   const std::string header = "PF\n2 2\n-1.0\n";
   ASSERT_EQ(bytes.size(), header.size() + 2 * 2 * 3 * 4);
   EXPECT_EQ(bytes.substr(0, header.size()), header);
@@ -398,8 +373,8 @@ TEST_F(ImageErrors, MalformedExrAndPngNameThePath) {
   const Image image = awkwardImage(false);
   writeImage(image, dir_ / "good.exr");
   writeImage(image, dir_ / "good.png");
-  const std::string exr = readBytes(dir_ / "good.exr");
-  const std::string png = readBytes(dir_ / "good.png");
+  const std::string exr = readFile(dir_ / "good.exr");
+  const std::string png = readFile(dir_ / "good.png");
   const std::pair<const char*, std::string> files[] = {
       {"garbage.exr", "this is not an image"},          {"header-only.exr", exr.substr(0, 40)},
       {"truncated.exr", exr.substr(0, exr.size() / 2)}, {"garbage.png", "this is not an image"},
@@ -428,7 +403,7 @@ TEST_F(ImageErrors, UnknownExtensionNamesTheFile) {
 TEST_F(ImageErrors, EmptyImageIsNotWritten) {
   const fs::path path = dir_ / "empty.pfm";
   expectMessageStartsWithPath(inputErrorOf([&] { writeImage(Image(), path); }), path);
-  EXPECT_TRUE(listing(dir_).empty());
+  EXPECT_TRUE(dir_.listing().empty());
 }
 
 // ---- Atomic writes --------------------------------------------------------------------------
@@ -440,7 +415,7 @@ TEST_F(ImageWrite, IntoMissingDirectoryThrowsAndLeavesNothing) {
     expectMessageStartsWithPath(message, path);
     EXPECT_NE(message.find("cannot write"), std::string::npos) << message;
   }
-  EXPECT_TRUE(listing(dir_).empty());
+  EXPECT_TRUE(dir_.listing().empty());
 }
 
 TEST_F(ImageWrite, OverwriteReplacesTheFileAndLeavesNoTemporaries) {
@@ -454,7 +429,7 @@ TEST_F(ImageWrite, OverwriteReplacesTheFileAndLeavesNoTemporaries) {
     EXPECT_EQ(back.at(1, 1), glm::vec3(0.0f)) << name;
     EXPECT_EQ(back.at(2, 2), glm::vec3(1.0f)) << name;
   }
-  EXPECT_EQ(listing(dir_), (std::vector<std::string>{"a.exr", "a.pfm", "a.png"}));
+  EXPECT_EQ(dir_.listing(), (std::vector<std::string>{"a.exr", "a.pfm", "a.png"}));
 }
 
 TEST_F(ImageWrite, FailedWriteMidFileKeepsTheExistingFile) {
@@ -465,7 +440,7 @@ TEST_F(ImageWrite, FailedWriteMidFileKeepsTheExistingFile) {
   Image old(2, 2);
   old.at(1, 0) = glm::vec3(0.75f);
   writeImage(old, path);
-  const std::string before = readBytes(path);
+  const std::string before = readFile(path);
 
   const pid_t child = ::fork();
   ASSERT_GE(child, 0);
@@ -488,8 +463,8 @@ TEST_F(ImageWrite, FailedWriteMidFileKeepsTheExistingFile) {
   ASSERT_EQ(::waitpid(child, &status, 0), child);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0) << "1: no error, 2: wrong message, 3: other exception";
-  EXPECT_EQ(readBytes(path), before);
-  EXPECT_EQ(listing(dir_), std::vector<std::string>{"keep.pfm"});
+  EXPECT_EQ(readFile(path), before);
+  EXPECT_EQ(dir_.listing(), std::vector<std::string>{"keep.pfm"});
 }
 
 TEST_F(ImageWrite, FailedRenameKeepsTheTargetAndRemovesTheTemporary) {
@@ -500,8 +475,8 @@ TEST_F(ImageWrite, FailedRenameKeepsTheTargetAndRemovesTheTemporary) {
   writeBytes(path / "inside", "x");
   const std::string message = inputErrorOf([&] { writeImage(Image(4, 4), path); });
   expectMessageStartsWithPath(message, path);
-  EXPECT_EQ(listing(dir_), std::vector<std::string>{"target.exr"});
-  EXPECT_EQ(readBytes(path / "inside"), "x");
+  EXPECT_EQ(dir_.listing(), std::vector<std::string>{"target.exr"});
+  EXPECT_EQ(readFile(path / "inside"), "x");
 }
 
 // ---- Diff -----------------------------------------------------------------------------------

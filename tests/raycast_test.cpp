@@ -3,13 +3,15 @@
 // axis-parallel rays, all with the validation layers on.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
+#include <vector>
 
 #include "bvh/traverse.h"
-#include "scene/scene.h"
 #include "closed_mesh.h"
-#include "test_util.h"
 #include "render_compare.h"
+#include "scene/scene.h"
+#include "test_util.h"
 #include "vulkan/raycast.h"
 
 namespace pt {

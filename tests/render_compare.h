@@ -8,6 +8,7 @@
 
 #include "cpu/integrator.h"
 #include "render/prepare.h"
+#include "test_util.h"
 #include "vulkan/backend.h"
 
 namespace pt {
@@ -38,7 +39,7 @@ inline Comparison renderBoth(const SceneData& data, int spp, bool specialize = t
   const Camera& cam = data.params.camera;
   Film cpu(int(cam.width), int(cam.height)), gpu(int(cam.width), int(cam.height));
   Comparison c;
-  c.cpu = renderCpu(data, CpuRenderOptions{.threads = 2, .spp = spp}, cpu);
+  c.cpu = renderCpu(data, test::cpuOptions(2, spp), cpu);
   EXPECT_EQ(c.cpu.invalidSamples, 0u);
   VulkanRenderOptions options = validatedOptions(spp);
   options.specialize = specialize;

@@ -2,8 +2,12 @@
 // geometry and light that must never produce NaN, Inf or unbounded pixels.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
+#include <string>
+#include <utility>
 
 #include "render_compare.h"
 #include "scene/scene.h"
@@ -12,22 +16,9 @@
 namespace pt {
 namespace {
 
-// Adds quad (c -/+ u -/+ v) as two triangles whose geometric normal is cross(u, v).
-void addQuad(Scene& scene, vec3 c, vec3 u, vec3 v, uint material) {
-  scene.triangles.push_back(Triangle{c - u - v, material, c + u - v, kNoEmitter, c + u + v, 0});
-  scene.triangles.push_back(Triangle{c - u - v, material, c + u + v, kNoEmitter, c - u + v, 0});
-}
-
-// The six inward-facing faces of the cube [-1, 1]^3; face f gets materials[f].
-void addClosedCube(Scene& scene, const uint (&materials)[6]) {
-  const vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
-  addQuad(scene, -x, y, z, materials[0]);
-  addQuad(scene, x, z, y, materials[1]);
-  addQuad(scene, -y, z, x, materials[2]);
-  addQuad(scene, y, x, z, materials[3]);
-  addQuad(scene, -z, x, y, materials[4]);
-  addQuad(scene, z, y, x, materials[5]);
-}
+using test::addInwardCube;
+using test::addQuad;
+using test::kConfigs;
 
 SceneData finish(Scene& scene, CameraDesc camera, int maxDepth = 100000) {
   for (uint i = 0; i < scene.triangles.size(); ++i) scene.triangles[i].primitive = i;
@@ -61,7 +52,7 @@ TEST(RobustFurnace, ClosedFormOnBothBackendsUpToAlbedo099) {
       scene.materials = {Material{vec3(a), kMaterialDiffuse, Le, 0},
                          Material{vec3(a), kMaterialMirror, Le, 0}};
       const uint m = mirrors ? 1u : 0u;
-      addClosedCube(scene, {0, m, 0, m, 0, 0});
+      addInwardCube(scene, {0, m, 0, m, 0, 0});
       // Paths at albedo 0.99 average 100 bounces: fewer pixels, more samples each.
       const int size = a > 0.95f ? 8 : 16;
       const SceneData data = finish(scene, CameraDesc{vec3(0.1f, -0.2f, 0.05f), vec3(1, 0.3f, 0.7f),
@@ -148,7 +139,7 @@ SceneData litBox(const std::function<void(Scene&)>& extra) {
   scene.materials = {Material{vec3(0.7f), kMaterialDiffuse, vec3(0.0f), 0},
                      Material{vec3(0.2f, 0.6f, 0.2f), kMaterialDiffuse, vec3(0.0f), 0},
                      Material{vec3(0.0f), kMaterialDiffuse, vec3(4.0f), 0}};
-  addClosedCube(scene, {0, 0, 0, 2, 0, 0});
+  addInwardCube(scene, {0, 0, 0, 2, 0, 0});
   extra(scene);
   return finish(scene,
                 CameraDesc{vec3(0, 0, -0.9f), vec3(0, -0.3f, 0), vec3(0, 1, 0), 80.0f, 24, 24}, 64);
@@ -220,7 +211,7 @@ TEST(RobustDegenerate, TwoFacingMirrorsAtMaxDepth64) {
 
 // The Cornell box with every coordinate (geometry and camera) multiplied by `scale`.
 SceneData scaledCornell(float scale, int size) {
-  Scene scene = loadScene(std::filesystem::path(PT_SOURCE_DIR) / "configs" / "cornell-box.json");
+  Scene scene = loadScene(kConfigs / "cornell-box.json");
   for (Triangle& t : scene.triangles) {
     t.v0 *= scale;
     t.v1 *= scale;
@@ -268,7 +259,7 @@ TEST(RobustScale, CornellBoxFarFromTheOriginRendersTheSameImage) {
   // would be): the renderer moves it back next to the origin, exactly, so only the rounding
   // of the input geometry (at most 0.004 units in a 556-unit box) can change the image.
   constexpr int kSize = 32, kSpp = 16;
-  Scene scene = loadScene(std::filesystem::path(PT_SOURCE_DIR) / "configs" / "cornell-box.json");
+  Scene scene = loadScene(kConfigs / "cornell-box.json");
   const Comparison unit =
       renderBoth(prepareScene(scene, RenderSettings{.width = kSize, .height = kSize}), kSpp);
   const vec3 offset(1e5f);

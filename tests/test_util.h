@@ -1,14 +1,29 @@
-// Helpers shared by the tests: procedural meshes and temporary files.
+// Helpers shared by the tests: procedural meshes, temporary files, the configs/ directory and
+// running the pt command line.
 #pragma once
 
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdlib>
 #include <filesystem>
-#include <random>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include "common/shared.h"
+#include "cpu/integrator.h"
+#include "scene/scene.h"
 
 namespace pt::test {
+
+// The scene files in configs/.
+inline const std::filesystem::path kConfigs = std::filesystem::path(PT_SOURCE_DIR) / "configs";
 
 // A UV sphere of 2 * rings * segments triangles (minus the pole slivers' neighbours), with
 // outward winding; vertices shared exactly between neighbouring triangles.
@@ -33,23 +48,110 @@ inline std::vector<Triangle> makeSphere(vec3 center, float radius, int rings, in
   return tris;
 }
 
-// A fresh empty directory under the system's temp directory, removed by the destructor.
+// Adds quad (c -/+ u -/+ v) as two triangles, (p0, p1, p2) and (p0, p2, p3) with p0 = c - u - v,
+// p1 = c + u - v, p2 = c + u + v, p3 = c - u + v, whose geometric normal is cross(u, v).
+// Primitive ids are left 0 for the caller to number.
+inline void addQuad(Scene& scene, vec3 c, vec3 u, vec3 v, uint material) {
+  const vec3 p0 = c - u - v, p1 = c + u - v, p2 = c + u + v, p3 = c - u + v;
+  scene.triangles.push_back(Triangle{p0, material, p1, kNoEmitter, p2, 0});
+  scene.triangles.push_back(Triangle{p0, material, p2, kNoEmitter, p3, 0});
+}
+
+// The six faces of the cube [-1, 1]^3 as quads facing inward, in the order -x, +x, -y, +y, -z,
+// +z; face f gets materials[f].
+inline void addInwardCube(Scene& scene, const uint (&materials)[6]) {
+  const vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  addQuad(scene, -x, y, z, materials[0]);
+  addQuad(scene, x, z, y, materials[1]);
+  addQuad(scene, -y, z, x, materials[2]);
+  addQuad(scene, y, x, z, materials[3]);
+  addQuad(scene, -z, x, y, materials[4]);
+  addQuad(scene, z, y, x, materials[5]);
+}
+
+// A fresh empty directory under the system's temp directory, named after the process and the
+// running test; removed, with everything in it, by the destructor. (Keep the name short: the
+// scene loader's messages cut quoted paths at 80 characters, and scene tests match them.)
 class TempDir {
  public:
   TempDir() {
-    std::random_device rd;
-    path_ = std::filesystem::temp_directory_path() / ("pt-test-" + std::to_string(rd()));
-    std::filesystem::create_directories(path_);
+    std::string name = "pt-" + std::to_string(::getpid());
+    if (const testing::TestInfo* info = testing::UnitTest::GetInstance()->current_test_info()) {
+      name += std::string("-") + info->test_suite_name() + "-" + info->name();
+    }
+    std::replace(name.begin(), name.end(), '/', '_');  // parameterised tests' names
+    // A number that makes it new: a test may hold several, and a crashed run may have left one.
+    static std::atomic<int> count = 0;
+    do {
+      path_ = std::filesystem::temp_directory_path() / (name + "-" + std::to_string(count++));
+    } while (!std::filesystem::create_directory(path_));
   }
   ~TempDir() {
     std::error_code ec;
     std::filesystem::remove_all(path_, ec);
   }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
   const std::filesystem::path& path() const { return path_; }
   std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+  // Writes `text` to the file `name` (its directories created as needed); returns its path.
+  std::filesystem::path write(const std::string& name, const std::string& text) const {
+    const std::filesystem::path p = path_ / name;
+    std::filesystem::create_directories(p.parent_path());
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+
+  // The names of everything directly in the directory, sorted: tests check with it that
+  // nothing was left behind.
+  std::vector<std::string> listing() const {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(path_)) {
+      names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  }
 
  private:
   std::filesystem::path path_;
 };
+
+// The whole content of a file ("" when it cannot be read).
+inline std::string readFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// What a run of the pt command line gave back.
+struct PtResult {
+  int status = -1;       // exit status; -1 when pt did not exit (killed by a signal)
+  std::string out, err;  // everything it wrote to stdout and to stderr
+};
+
+// Runs `pt args` through the shell, with `environment` ("NAME=value ...") put before it, and
+// captures both streams (through files in a directory of its own).
+inline PtResult runPt(const std::string& args, const std::string& environment = "") {
+  const TempDir streams;
+  const std::filesystem::path out = streams / "stdout.txt", err = streams / "stderr.txt";
+  const std::string command = environment + (environment.empty() ? "" : " ") + PT_BINARY + " " +
+                              args + " >" + out.string() + " 2>" + err.string();
+  const int raw = std::system(command.c_str());
+  PtResult result;
+  result.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  result.out = readFile(out);
+  result.err = readFile(err);
+  return result;
+}
+
+// CPU render options for `spp` samples per pixel on `threads` threads.
+inline CpuRenderOptions cpuOptions(int threads, int spp) {
+  CpuRenderOptions options;
+  options.threads = threads;
+  options.spp = spp;
+  return options;
+}
 
 }  // namespace pt::test

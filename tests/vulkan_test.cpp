@@ -2,16 +2,20 @@
 // validation layers on: it must agree with the CPU reference sample for sample.
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "cpu/integrator.h"
 #include "render/prepare.h"
-#include "scene/scene.h"
-#include "vulkan/backend.h"
 #include "render_compare.h"
+#include "scene/scene.h"
+#include "test_util.h"
+#include "vulkan/backend.h"
+#include "vulkan/context.h"
 
 namespace pt {
 namespace {
 
-const std::filesystem::path kConfigs = std::filesystem::path(PT_SOURCE_DIR) / "configs";
+using test::kConfigs;
 
 SceneData prepare(const std::string& config, int size) {
   return prepareScene(loadScene(kConfigs / config), RenderSettings{.width = size, .height = size});
@@ -65,6 +69,11 @@ TEST(Vulkan, UnspecializedShaderGivesTheSameImage) {
   options.specialize = false;
   const VulkanRenderStats s2 = renderVulkan(data, options, b);
   EXPECT_EQ(s1.validationErrors + s2.validationErrors, 0u);
+  // Every sample of both renders is in its image: none NaN or Inf, none cut short.
+  EXPECT_EQ(s1.invalidSamples, 0u);
+  EXPECT_EQ(s2.invalidSamples, 0u);
+  EXPECT_EQ(s1.truncatedSamples, 0u);
+  EXPECT_EQ(s2.truncatedSamples, 0u);
   const DiffStats d = diffImages(a.resolve(), b.resolve(), 1e-5);
   EXPECT_EQ(d.pixelsOverThreshold, 0u) << "max " << d.maxAbsError;
 }
@@ -93,14 +102,10 @@ SceneData mirrorBox(int maxDepth) {
   Scene scene;
   scene.materials = {Material{vec3(1.0f), kMaterialMirror, vec3(0.0f), 0},
                      Material{vec3(1.0f), kMaterialMirror, vec3(1.0f), 0}};
-  auto quad = [&](vec3 c, vec3 u, vec3 v, uint m) {
-    scene.triangles.push_back(Triangle{c - u - v, m, c + u - v, kNoEmitter, c + u + v, 0});
-    scene.triangles.push_back(Triangle{c - u - v, m, c + u + v, kNoEmitter, c - u + v, 0});
-  };
-  const vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
-  quad(-x, y, z, 0), quad(x, z, y, 0), quad(-y, z, x, 0), quad(y, x, z, 0), quad(-z, x, y, 0),
-      quad(z, y, x, 0);
-  quad(vec3(0.1f, 0.0f, 0.5f), 0.05f * y, 0.05f * x, 1);  // emits towards -z, reflects
+  test::addInwardCube(scene, {0, 0, 0, 0, 0, 0});
+  const vec3 x(1, 0, 0), y(0, 1, 0);
+  // The emitter: emits towards -z, reflects.
+  test::addQuad(scene, vec3(0.1f, 0.0f, 0.5f), 0.05f * y, 0.05f * x, 1);
   for (uint i = 0; i < scene.triangles.size(); ++i) scene.triangles[i].primitive = i;
   scene.camera = CameraDesc{vec3(0.3f, 0.2f, -0.5f), vec3(0.2f, 0.1f, 1), y, 60.0f, 8, 8};
   scene.integrator.maxDepth = maxDepth;
