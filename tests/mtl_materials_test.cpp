@@ -11,7 +11,8 @@
 namespace pt {
 namespace {
 
-const std::filesystem::path kMtlData = std::filesystem::path(PT_SOURCE_DIR) / "tests/data/scene/mtl";
+const std::filesystem::path kMtlData =
+    std::filesystem::path(PT_SOURCE_DIR) / "tests/data/scene/mtl";
 
 std::string loadError(const std::filesystem::path& scene) {
   try {
@@ -42,11 +43,11 @@ TEST(SceneMtl, CornellStyleMaterialsMapByTheDocumentedRule) {
   EXPECT_EQ(floor.reflectance, vec3(0.725f, 0.71f, 0.68f));  // Kd
   EXPECT_EQ(floor.emission, vec3(0.0f));
   const Material& light = materialNamed(scene, "light");
-  EXPECT_EQ(light.emission, vec3(17.0f, 12.0f, 4.0f));  // Ke
-  EXPECT_EQ(light.reflectance, vec3(0.78f));            // Ka is ignored, Kd kept
+  EXPECT_EQ(light.emission, vec3(17.0f, 12.0f, 4.0f));      // Ke
+  EXPECT_EQ(light.reflectance, vec3(0.78f));                // Ka is ignored, Kd kept
   const Material& mirror = materialNamed(scene, "mirror");  // illum 3
   EXPECT_EQ(mirror.type, kMaterialMirror);
-  EXPECT_EQ(mirror.reflectance, vec3(0.9f));  // Ks
+  EXPECT_EQ(mirror.reflectance, vec3(0.9f));              // Ks
   const Material& shiny = materialNamed(scene, "shiny");  // Ns 5000, Ks brighter than Kd
   EXPECT_EQ(shiny.type, kMaterialMirror);
   EXPECT_EQ(shiny.reflectance, vec3(0.8f));
@@ -83,9 +84,9 @@ TEST(SceneMtl, CornellStyleMaterialsMapByTheDocumentedRule) {
 TEST(SceneMtl, UnknownUsemtlNamesTheObjLine) {
   test::TempDir dir;
   dir.write("m.mtl", "newmtl red\nKd 0.8 0.1 0.1\n");
-  dir.write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\nusemtl rad\nf 1 3 2\n");
-  const std::string m = loadError(dir.write(
-      "s.json", R"({"materials": [{"name": "w"}],
+  dir.write("m.obj",
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\nusemtl rad\nf 1 3 2\n");
+  const std::string m = loadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"}]})"));
   EXPECT_NE(m.find("m.obj: line 7: usemtl 'rad': no such material in its mtllib files (did you "
                    "mean 'red'?)"),
@@ -97,8 +98,7 @@ TEST(SceneMtl, UnknownUsemtlNamesTheObjLine) {
 TEST(SceneMtl, MissingMtlFileNamesTheObjLine) {
   test::TempDir dir;
   dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib gone.mtl\nusemtl red\nf 1 2 3\n");
-  const std::string m = loadError(dir.write(
-      "s.json", R"({"materials": [{"name": "w"}],
+  const std::string m = loadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"}]})"));
   EXPECT_NE(m.find("m.obj: line 4: cannot open material library 'gone.mtl'"), std::string::npos)
       << m;
@@ -108,36 +108,45 @@ TEST(SceneMtl, FacesBeforeAnyUsemtlTakeTheShapesMaterialOrFail) {
   test::TempDir dir;
   dir.write("m.mtl", "newmtl red\nKd 0.8 0.1 0.1\n");
   dir.write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nusemtl red\nf 1 3 2\n");
-  const Scene scene = loadScene(dir.write(
-      "s.json", R"({"materials": [{"name": "w"}],
+  const Scene scene = loadScene(dir.write("s.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl",
                                 "material": "w"}]})"));
   ASSERT_EQ(scene.triangles.size(), 2u);
   EXPECT_EQ(scene.triangles[0].material, 0u);  // "w"
   EXPECT_EQ(scene.materialNames[scene.triangles[1].material], "m.mtl:red");
 
-  const std::string m = loadError(dir.write(
-      "t.json", R"({"materials": [{"name": "w"}],
+  const std::string m = loadError(dir.write("t.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"}]})"));
   EXPECT_NE(m.find("t.json: shapes[0]: needs a 'material' for the faces of"), std::string::npos)
       << m;
   EXPECT_NE(m.find("m.obj' that come before any usemtl"), std::string::npos) << m;
 }
 
+TEST(SceneMtl, LongPathsAreNeverCutInMessages) {
+  test::TempDir dir;
+  const std::string deep = std::string(90, 'd') + "/" + std::string(40, 'e');
+  dir.write(deep + "/m.obj", "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+  const std::string m =
+      loadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
+                    "shapes": [{"type": "obj", "file": ")" +
+                                        deep + R"(/m.obj", "materials": "mtl"}]})"));
+  const std::string full = (dir.path() / deep / "missing.mtl").string();
+  EXPECT_NE(m.find("(looked for '" + full + "': No such file or directory)"), std::string::npos)
+      << m;
+}
+
 TEST(SceneMtl, BadColoursAndBadKeyAreInputErrors) {
   test::TempDir dir;
   dir.write("m.mtl", "newmtl hot\nKd 1.5 0.1 0.1\n");
   dir.write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl hot\nf 1 2 3\n");
-  const std::string m = loadError(dir.write(
-      "s.json", R"({"materials": [{"name": "w"}],
+  const std::string m = loadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"}]})"));
   EXPECT_NE(m.find("m.mtl: material 'hot': Kd: expected colour components in [0, 1], got (1.5, "
                    "0.1, 0.1)"),
             std::string::npos)
       << m;
 
-  const std::string k = loadError(dir.write(
-      "k.json", R"({"materials": [{"name": "w"}],
+  const std::string k = loadError(dir.write("k.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "json"}]})"));
   EXPECT_NE(k.find("shapes[0].materials: expected 'mtl'"), std::string::npos) << k;
 }
@@ -153,8 +162,9 @@ TEST(ScenePly, PlyShapeGivesTheSameTrianglesAsTheEquivalentObj) {
   dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 2 0\nf 1 2 3 4\nf 4 3 5\n");
   auto load = [&](const std::string& type, const std::string& file) {
     return loadScene(dir.write(type + ".json", R"({"materials": [{"name": "w"}],
-        "shapes": [{"type": ")" + type + R"(", "file": ")" + file +
-                                                 R"(", "material": "w",
+        "shapes": [{"type": ")" + type + R"(", "file": ")" +
+                                                   file +
+                                                   R"(", "material": "w",
                     "transform": {"scale": [2, 2, 2], "translate": [1, 0, 0]}}]})"));
   };
   const Scene ply = load("ply", "m.ply");
@@ -171,11 +181,11 @@ TEST(ScenePly, PlyShapeGivesTheSameTrianglesAsTheEquivalentObj) {
 
 TEST(ScenePly, MalformedPlyNamesTheSceneEntry) {
   test::TempDir dir;
-  dir.write("m.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                     "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
-                     "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n");
-  const std::string m = loadError(dir.write(
-      "s.json", R"({"materials": [{"name": "w"}],
+  dir.write("m.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+            "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n");
+  const std::string m = loadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "ply", "file": "m.ply", "material": "w"}]})"));
   EXPECT_NE(m.find("m.ply: face 0"), std::string::npos) << m;
   EXPECT_NE(m.find("out of range"), std::string::npos) << m;

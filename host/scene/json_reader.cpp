@@ -351,6 +351,12 @@ std::string singleQuoted(std::string_view s) {
   return out + (cut ? "...'" : "'");
 }
 
+std::string quotedPath(std::string_view path) {
+  std::string out = "'";
+  appendEscaped(out, path);
+  return out + "'";
+}
+
 std::string formatNumber(double value) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.9g", value);

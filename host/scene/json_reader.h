@@ -43,6 +43,10 @@ std::string didYouMean(std::string_view word, const std::vector<std::string_view
 // past 80 bytes cut to "...".
 std::string singleQuoted(std::string_view s);
 
+// A file path in single quotes, escaped like singleQuoted but never cut: its end is the
+// file name, the part a reader needs most.
+std::string quotedPath(std::string_view path);
+
 // A number for a message, to 9 significant digits ("1.5", "1e+39").
 std::string formatNumber(double value);
 

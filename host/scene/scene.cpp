@@ -27,6 +27,7 @@ namespace pt {
 namespace {
 
 using scene_detail::JsonNode;
+using scene_detail::quotedPath;
 using scene_detail::singleQuoted;
 using Tri = std::array<glm::dvec3, 3>;
 
@@ -288,8 +289,8 @@ MeshFile readMeshFile(const JsonNode& shape, const std::filesystem::path& sceneP
   std::string why;
   if (!scene_detail::readTextFile(resolved, &mesh.bytes, &why)) {
     const std::string looked =
-        resolved == given ? std::string{} : "looked for " + singleQuoted(resolved.string()) + ": ";
-    fileNode.fail("cannot open " + singleQuoted(name) + " (" + looked + why + ")");
+        resolved == given ? std::string{} : "looked for " + quotedPath(resolved.string()) + ": ";
+    fileNode.fail("cannot open " + quotedPath(name) + " (" + looked + why + ")");
   }
   mesh.context = " (referenced by " + shape.file() + ": " + fileNode.path() + ")";
   return mesh;
@@ -329,8 +330,8 @@ ShapeTriangles readObjWithMtl(const JsonNode& shape, const MeshFile& file,
     if (!library.files.count(key)) {
       std::string text, why;
       if (!scene_detail::readTextFile(mtlPath, &text, &why)) {
-        failAt(lib.line, "cannot open material library " + singleQuoted(lib.name) + " (looked for " +
-                             singleQuoted(key) + ": " + why + ")");
+        failAt(lib.line, "cannot open material library " + quotedPath(lib.name) + " (looked for " +
+                             quotedPath(key) + ": " + why + ")");
       }
       std::vector<scene_detail::MtlMaterial> materials = scene_detail::loadMtlMaterials(text, key);
       for (const scene_detail::MtlMaterial& m : materials) {
@@ -338,7 +339,8 @@ ShapeTriangles readObjWithMtl(const JsonNode& shape, const MeshFile& file,
       }
       library.files.emplace(key, std::move(materials));
     }
-    for (const scene_detail::MtlMaterial& m : library.files.at(key)) available.emplace_back(key, &m);
+    for (const scene_detail::MtlMaterial& m : library.files.at(key))
+      available.emplace_back(key, &m);
   }
   // Scene material of every usemtl name.
   std::vector<uint> sceneMaterial(obj.usemtl.size());
@@ -370,7 +372,7 @@ ShapeTriangles readObjWithMtl(const JsonNode& shape, const MeshFile& file,
   for (std::size_t t = 0; t < obj.material.size(); ++t) {
     if (obj.material[t] < 0) {
       if (!fallback) {
-        shape.fail("needs a 'material' for the faces of " + singleQuoted(objName) +
+        shape.fail("needs a 'material' for the faces of " + quotedPath(objName) +
                    " that come before any usemtl");
       }
       out.materials.push_back(*fallback);
