@@ -13,11 +13,14 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/converge.h"
+#include "cli/film_states.h"
+#include "cli/interrupt.h"
 #include "cli/overrides.h"
 #include "cli/progress.h"
 #include "common/check.h"
 #include "common/named_values.h"
 #include "cpu/integrator.h"
+#include "image/film_state.h"
 #include "image/image.h"
 #include "render/prepare.h"
 #include "render/render_options.h"
@@ -39,7 +42,13 @@ struct RenderArgs {
   std::optional<int> spp;
   int threads = 0;
   int samplesPerPass = 1;
-  std::vector<std::string> outputs;
+  std::vector<std::string> outputs;  // images, or film states (.ptstate)
+  // Film states: written every checkpointEvery seconds, when interrupted and at the end.
+  std::string checkpoint;
+  double checkpointEvery = 60.0;
+  std::string resume;                       // a film state to continue
+  std::string samples;                      // "FIRST:COUNT": one slice of sample indices
+  std::optional<int> taskIndex, taskCount;  // slice taskIndex of taskCount equal slices
 };
 
 struct DiffArgs {
@@ -56,10 +65,72 @@ double peakResidentMiB() {
   return double(usage.ru_maxrss) / 1024.0;
 }
 
+// The slice of the job's samples that `--task-index`/`--task-count` (or a Slurm array task's
+// SLURM_ARRAY_TASK_ID) choose, if any.
+std::optional<std::pair<int, int>> chosenTask(const RenderArgs& args) {
+  std::optional<int> index = args.taskIndex;
+  if (!index && args.taskCount) {
+    const char* env = std::getenv("SLURM_ARRAY_TASK_ID");
+    if (!env) {
+      throw InputError(
+          "--task-count: give --task-index, or run as a Slurm array task "
+          "(SLURM_ARRAY_TASK_ID)");
+    }
+    char extra = 0;
+    int value = -1;
+    if (std::sscanf(env, "%d%c", &value, &extra) != 1 || value < 0) {
+      throw InputError(std::string("SLURM_ARRAY_TASK_ID: expected a task index, got '") + env +
+                       "'");
+    }
+    index = value;
+  }
+  if (!index) return std::nullopt;
+  if (!args.taskCount) throw InputError("--task-index: give --task-count too");
+  if (*index >= *args.taskCount) {
+    throw InputError("task index " + std::to_string(*index) + " is not below --task-count " +
+                     std::to_string(*args.taskCount));
+  }
+  return std::make_pair(*index, *args.taskCount);
+}
+
+// Refuses outputs that cannot be written before any time is spent on the render.
+void checkOutputPath(const std::filesystem::path& path, bool state) {
+  if (!state) imageFormatOf(path);
+  const auto dir = path.parent_path();
+  if (!dir.empty() && !std::filesystem::is_directory(dir)) {
+    throw InputError(path.string() + ": directory '" + dir.string() + "' does not exist");
+  }
+  if (std::filesystem::is_directory(path)) throw InputError(path.string() + ": is a directory");
+}
+
 int runRender(const RenderArgs& args) {
   if (args.backend == "cpu" && args.samplesPerPass != 1) {
     throw InputError("--samples-per-pass applies to the Vulkan backend only");
   }
+  const std::optional<std::pair<int, int>> task = chosenTask(args);
+  std::optional<SampleRange> sliceArg;
+  if (!args.samples.empty()) sliceArg = parseSampleRange(args.samples, "--samples");
+
+  // Outputs: images and film states. A render that keeps a film state writes no default image.
+  std::vector<std::filesystem::path> images;
+  std::vector<std::filesystem::path> states;
+  for (const std::string& out : args.outputs) (isStatePath(out) ? states : images).push_back(out);
+  std::string checkpoint = args.checkpoint;
+  if (checkpoint.empty()) checkpoint = args.resume;  // a resumed render keeps its state file
+  if (!checkpoint.empty()) states.push_back(checkpoint);
+  if ((sliceArg || task) && states.empty()) {
+    throw InputError(std::string(sliceArg ? "--samples" : "--task-index") +
+                     ": give --checkpoint FILE: a slice's film state is what `pt merge` combines");
+  }
+  if (images.empty() && states.empty()) {
+    images.push_back(std::filesystem::path(args.scene).stem() += ".png");
+  }
+  for (const auto& path : images) checkOutputPath(path, false);
+  for (const auto& path : states) checkOutputPath(path, true);
+  // A film state to continue is read before the scene, so that a bad one is refused at once.
+  std::optional<FilmState> resumed;
+  if (!args.resume.empty()) resumed = readFilmState(args.resume);
+
   const auto loadStart = std::chrono::steady_clock::now();
   Scene scene = loadScene(args.scene);
   const double loadSeconds =
@@ -70,17 +141,6 @@ int runRender(const RenderArgs& args) {
   settings.spp = args.spp;  // unset: the scene's
   const SceneData data = prepareScene(std::move(scene), settings);
 
-  std::vector<std::filesystem::path> outputs(args.outputs.begin(), args.outputs.end());
-  if (outputs.empty()) outputs.push_back(std::filesystem::path(args.scene).stem() += ".png");
-  // Check every output before spending time on the render.
-  for (const auto& path : outputs) {
-    imageFormatOf(path);
-    const auto dir = path.parent_path();
-    if (!dir.empty() && !std::filesystem::is_directory(dir)) {
-      throw InputError(path.string() + ": directory '" + dir.string() + "' does not exist");
-    }
-  }
-
   const Camera& cam = data.params.camera;
   int debugX = -1, debugY = -1;
   if (!args.debugPixel.empty()) {
@@ -90,62 +150,200 @@ int runRender(const RenderArgs& args) {
       throw InputError("--debug-pixel: expected X,Y inside the " + std::to_string(cam.width) + "x" +
                        std::to_string(cam.height) + " image, got '" + args.debugPixel + "'");
     }
-    // The CPU reference's paths first; the shader's follow from the validation layer.
-    uint64_t rays = 0;
-    for (int s = 0; s < data.spp; ++s) {
-      sampleRadiance(data, uvec2(debugX, debugY), uint32_t(s), rays, /*debugPrint=*/true);
+  }
+
+  VulkanRenderOptions vulkan;
+  vulkan.context.device = args.device;
+  // PT_VALIDATION=1 turns the validation layers on without changing command lines (tests).
+  const char* env = std::getenv("PT_VALIDATION");
+  vulkan.context.validation = args.validation || (env && std::string(env) == "1");
+  vulkan.samplesPerPass = args.samplesPerPass;
+  vulkan.specialize = !args.noSpecialize;
+  vulkan.context.debugPrintf = debugX >= 0;
+  vulkan.debugPixelX = debugX;
+  vulkan.debugPixelY = debugY;
+  const bool onCpu = args.backend == "cpu";
+
+  // The sample indices this render covers: the job's [0, spp), or one slice of it. On Vulkan
+  // a slice starts at a batch boundary, or it would not merge to the one-run image's bits.
+  const SampleRange job{0, uint32_t(data.spp)};
+  SampleRange target = job;
+  const uint32_t unit = onCpu ? 1u : vulkanBatchSize(vulkan);
+  if (sliceArg) {
+    target = *sliceArg;
+    if (target.first % unit != 0) {
+      throw InputError("--samples " + args.samples + ": on the Vulkan backend FIRST must be a " +
+                       "multiple of " + std::to_string(unit) + " (samples per pass x " +
+                       std::to_string(vulkan.passesPerFlush) +
+                       " passes per fold), so that slices merge to the one-run image");
+    }
+  } else if (task) {
+    target = taskSlice(job, task->first, task->second, unit);
+    if (target.count() == 0) {
+      throw InputError("--task-count " + std::to_string(task->second) + ": task " +
+                       std::to_string(task->first) + " gets no samples of " + job.toString() +
+                       (unit > 1 ? " (slices are whole batches of " + std::to_string(unit) + ")"
+                                 : std::string()));
     }
   }
-  Film film(int(cam.width), int(cam.height));
+
+  // The film state: resumed, or new. (Its settings hash the scene: only when kept.)
+  FilmState state;
+  if (!states.empty()) {
+    state.settings = imageSettings(data, settings, args.backend,
+                                   onCpu ? KeyValues{} : vulkanImageSettings(vulkan));
+  }
+  state.film = Film(int(cam.width), int(cam.height));
+  if (resumed) {
+    const std::string diff = settingsDifference(resumed->settings, state.settings);
+    if (!diff.empty()) {
+      throw InputError(args.resume + ": rendered with other settings (there vs here): " + diff);
+    }
+    const std::vector<SampleRange>& have = resumed->ranges;
+    if (have.size() > 1) {
+      throw InputError(args.resume + ": holds samples with a gap; only a state of one range of " +
+                       "samples can be continued (merge it instead)");
+    }
+    if (!have.empty() && have[0].first != target.first) {
+      throw InputError(args.resume + ": holds samples " + have[0].toString() +
+                       ", but this render's samples start at " + std::to_string(target.first) +
+                       " (give the --samples or task it was rendered with)");
+    }
+    if (!have.empty() && have[0].end > target.end) {
+      throw InputError(args.resume + ": holds samples " + have[0].toString() +
+                       ", more than this render's " + target.toString() + " (give a larger --spp)");
+    }
+    state.film = std::move(resumed->film);
+    state.ranges = resumed->ranges;
+    state.open = std::move(resumed->open);
+    state.info = resumed->info;
+  }
+  auto setInfo = [&](const std::string& key, const std::string& value) {
+    for (auto& [k, v] : state.info) {
+      if (k == key) {
+        v = value;
+        return;
+      }
+    }
+    state.info.emplace_back(key, value);
+  };
+  setInfo("scene", args.scene);
+  if (task) {
+    setInfo("job", job.toString());
+    setInfo("task", std::to_string(task->first) + "/" + std::to_string(task->second));
+  }
+  const uint32_t start = state.ranges.empty() ? target.first : state.ranges[0].end;
+  if (resumed) {
+    std::fprintf(stderr, "resuming %s: %u of %u samples per pixel done\n", args.resume.c_str(),
+                 start - target.first, target.count());
+  }
+
+  if (debugX >= 0) {
+    // The CPU reference's paths first; the shader's follow from the validation layer.
+    uint64_t rays = 0;
+    for (uint32_t s = start; s < target.end; ++s) {
+      sampleRadiance(data, uvec2(debugX, debugY), s, rays, /*debugPrint=*/true);
+    }
+  }
+
+  // Stop cleanly at SIGINT or SIGTERM; write the film state every checkpointEvery seconds.
+  const InterruptGuard interrupt;
+  auto stateAt = [&](uint32_t end) {
+    state.ranges.clear();
+    if (end > target.first) state.ranges.push_back(SampleRange{target.first, end});
+  };
+  auto writeStates = [&] {
+    for (const auto& path : states) writeFilmState(state, path);
+  };
+  auto lastCheckpoint = std::chrono::steady_clock::now();
+  auto checkpointDue = [&](int done) {
+    if (checkpoint.empty()) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (std::chrono::duration<double>(now - lastCheckpoint).count() < args.checkpointEvery) return;
+    stateAt(start + uint32_t(done));
+    writeFilmState(state, checkpoint);
+    lastCheckpoint = std::chrono::steady_clock::now();
+  };
+
   Progress progress("rendering");
   RenderStats stats;  // what both backends report
   std::string backendInfo;
   std::string effects = data.effects.toString();
   uint32_t validationErrors = 0;
-  if (args.backend == "cpu") {
+  OpenBatch carried = std::move(state.open);  // the film absorbs it at the first fold
+  state.open = OpenBatch{};
+  if (onCpu) {
     CpuRenderOptions options;
     options.threads = args.threads;
-    options.spp = data.spp;
+    options.firstSample = start;
+    options.spp = int(target.end - start);
     options.progress = [&progress](double f) { progress.update(f); };
-    const CpuRenderStats cpu = renderCpu(data, options, film);
+    options.stop = &interrupt.stopFlag();
+    options.checkpoint = checkpointDue;
+    const CpuRenderStats cpu = renderCpu(data, options, state.film);
     stats = cpu;
     backendInfo = "backend=cpu threads=" + std::to_string(cpu.threads);
   } else {
-    VulkanRenderOptions options;
-    options.context.device = args.device;
-    // PT_VALIDATION=1 turns the validation layers on without changing command lines (tests).
-    const char* env = std::getenv("PT_VALIDATION");
-    options.context.validation = args.validation || (env && std::string(env) == "1");
-    options.spp = data.spp;
-    options.samplesPerPass = args.samplesPerPass;
-    options.specialize = !args.noSpecialize;
-    options.context.debugPrintf = debugX >= 0;
-    options.debugPixelX = debugX;
-    options.debugPixelY = debugY;
+    VulkanRenderOptions& options = vulkan;
+    options.firstSample = start;
+    options.spp = int(target.end - start);
     options.progress = [&progress](double f) { progress.update(f); };
-    const VulkanRenderStats gpu = renderVulkan(data, options, film);
+    options.stop = &interrupt.stopFlag();
+    options.checkpoint = checkpointDue;
+    options.openBatch = &carried;
+    options.keepOpenBatch = !states.empty();
+    VulkanRenderStats gpu = renderVulkan(data, options, state.film);
     stats = gpu;
+    state.open = std::move(gpu.open);
     validationErrors = gpu.validationErrors;
     // Throughput from the device's timestamps; wall time also counts set-up and upload.
     backendInfo = "backend=vulkan device=\"" + gpu.device +
                   "\" wall_seconds=" + std::to_string(gpu.wallSeconds) +
                   " max_loop_iterations=" + std::to_string(gpu.maxLoopIterations);
     if (args.noSpecialize) effects = "all(unspecialized)";
+    const std::string* before = resumed ? resumed->infoValue("device") : nullptr;
+    if (before && *before != gpu.device) {
+      std::fprintf(stderr,
+                   "warning: %s was rendered on \"%s\", continued on \"%s\": the image is as "
+                   "valid, but its bits differ from a render on one device\n",
+                   args.resume.c_str(), before->c_str(), gpu.device.c_str());
+    }
+    setInfo("device", gpu.device);
   }
   progress.finish();
 
-  const Image image = film.resolve();
-  for (const auto& path : outputs) writeImage(image, path);
+  // What the film holds now: whole passes (and on Vulkan perhaps an open batch).
+  const uint32_t reached = start + uint32_t(stats.samplesDone);
+  stateAt(reached);
+  const uint32_t spp = reached - target.first;
+  const bool interrupted = stats.stopped;
+  if (spp > 0) {
+    writeStates();  // first: it is what a later resume or merge needs
+    const Image image = state.combinedFilm().resolve();
+    for (const auto& path : images) writeImage(image, path);
+  }
 
   std::printf(
-      "%s resolution=%ux%u spp=%d seconds=%.3f Mrays/s=%.3f effects=%s triangles=%zu "
+      "%s resolution=%ux%u spp=%u seconds=%.3f Mrays/s=%.3f effects=%s triangles=%zu "
       "load_s=%.3f bvh_builder=%s bvh_nodes=%zu bvh_build_s=%.4f peak_rss_mib=%.0f "
       "invalid_samples=%llu\n",
-      backendInfo.c_str(), cam.width, cam.height, data.spp, stats.seconds,
-      double(stats.rays) / stats.seconds * 1e-6, effects.c_str(), data.bvh.triangles.size(),
-      loadSeconds, std::string(nameOf(kBuilderNames, settings.builder)).c_str(),
-      data.bvh.nodes.size(), data.bvh.buildSeconds, peakResidentMiB(),
-      (unsigned long long)stats.invalidSamples);
+      backendInfo.c_str(), cam.width, cam.height, spp, stats.seconds,
+      stats.seconds > 0.0 ? double(stats.rays) / stats.seconds * 1e-6 : 0.0, effects.c_str(),
+      data.bvh.triangles.size(), loadSeconds,
+      std::string(nameOf(kBuilderNames, settings.builder)).c_str(), data.bvh.nodes.size(),
+      data.bvh.buildSeconds, peakResidentMiB(), (unsigned long long)stats.invalidSamples);
+  std::fflush(stdout);
+  if (interrupted) {
+    std::string what = spp == 0 ? "before a pass was complete: nothing written"
+                                : "after " + std::to_string(spp) + " of " +
+                                      std::to_string(target.count()) + " samples per pixel";
+    if (spp > 0) {
+      what += states.empty() ? " (no --checkpoint: it cannot be continued)"
+                             : "; continue with --resume " + states.back().string();
+    }
+    std::fprintf(stderr, "pt: stopped by %s %s\n", interrupt.signalName(), what.c_str());
+    return kExitInterrupted;
+  }
   int status = kExitOk;
   if (stats.invalidSamples > 0) {
     printInvalidSamples(stats.invalidSamples, stats.truncatedSamples);
@@ -248,7 +446,32 @@ int main(int argc, char** argv) {
   addOverrideOptions(render, r.overrides);
   render->add_option("--debug-pixel", r.debugPixel,
                      "Print pixel X,Y's paths from the CPU reference and from the shader");
-  render->add_option("--out", r.outputs, "Output image (.png, .exr, .pfm); repeatable");
+  render->add_option("--out", r.outputs,
+                     "Output image (.png, .exr, .pfm) or film state (.ptstate); repeatable");
+  render->add_option("--checkpoint", r.checkpoint,
+                     "Film state file, written every --checkpoint-every seconds, when "
+                     "interrupted and at the end (continue it with --resume)");
+  render
+      ->add_option("--checkpoint-every", r.checkpointEvery,
+                   "Seconds between checkpoints of the film state")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  render->add_option("--resume", r.resume,
+                     "Continue the render in this film state to the target spp (checkpoints go "
+                     "back to it unless --checkpoint says otherwise)");
+  CLI::Option* samples = render->add_option(
+      "--samples", r.samples,
+      "Render only sample indices FIRST to FIRST+COUNT-1 (a slice for `pt merge`)");
+  CLI::Option* taskIndex =
+      render
+          ->add_option("--task-index", r.taskIndex,
+                       "Render slice I of --task-count equal slices of the spp (default: "
+                       "SLURM_ARRAY_TASK_ID)")
+          ->check(CLI::NonNegativeNumber);
+  CLI::Option* taskCount =
+      render->add_option("--task-count", r.taskCount, "Number of slices the spp is split into")
+          ->check(CLI::PositiveNumber);
+  samples->excludes(taskIndex)->excludes(taskCount)->excludes("--spp");
 
   DiffArgs d;
   CLI::App* diff = app.add_subcommand(
@@ -288,6 +511,15 @@ int main(int argc, char** argv) {
   addOverrideOptions(converge, c.overrides);
   converge->add_flag("--no-specialize", c.noSpecialize, "Vulkan: compile every effect in");
 
+  MergeArgs m;
+  CLI::App* merge = app.add_subcommand(
+      "merge", "Combine film states of disjoint sample ranges into the one-run image");
+  merge->add_option("states", m.states, "Film state files (render --checkpoint)")->required();
+  merge->add_option("--out", m.outputs,
+                    "Output image (.png, .exr, .pfm) or film state (.ptstate); repeatable");
+  merge->add_flag("--partial", m.partial,
+                  "Merge even when samples are missing (the image has fewer spp)");
+
   CLI::App* devices = app.add_subcommand("devices", "List Vulkan devices");
 
   try {
@@ -301,6 +533,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*render) return runRender(r);
+    if (*merge) return runMerge(m);
     if (*diff) return runDiff(d);
     if (*devices) return runDevices();
     if (*converge) return runConvergeCommand(c);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <barrier>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,11 +13,22 @@
 #include <thread>
 #include <vector>
 
+#include <sched.h>
+
 #include "bvh/traverse.h"
 #include "common/check.h"
 
 namespace pt {
 namespace {
+
+// The CPUs this process may run on: what Slurm, taskset or a container allotted, which can be
+// fewer than the machine has (std::thread::hardware_concurrency counts those).
+int availableCpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
+  return int(std::max(1u, std::thread::hardware_concurrency()));
+}
 
 // Samples direct illumination at diffuse vertex p with shading normal n (next-event
 // estimation, pbrt's SampleLd): picks an emitter from the alias table with uChoose, a uniform
@@ -183,47 +195,116 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
   const auto start = std::chrono::steady_clock::now();
   CpuRenderStats stats;
-  stats.threads = options.threads > 0 ? options.threads
-                                      : int(std::max(1u, std::thread::hardware_concurrency()));
+  stats.threads = options.threads > 0 ? options.threads : availableCpus();
 
-  // Tiles are handed out through an atomic counter; each pixel belongs to one tile, so
-  // threads write disjoint film pixels. Random numbers depend on (pixel, sample) only, so
-  // the image does not depend on the thread count or the tile order.
-  constexpr int kTile = 16;
+  // Progressive passes over the whole image, one sample index per pass, so that the film
+  // always holds whole passes: stopped at any moment, it is a uniform image of k samples per
+  // pixel. Samples go into the film as they are traced and are also kept in `pass`; a stop
+  // drops the pass under way by taking its traced tiles back out, which the film's exact sums
+  // undo bit for bit. So the time to stop is one tile, not one pass. Within a pass, tiles are
+  // handed out through an atomic counter and each pixel belongs to one tile, so threads write
+  // disjoint pixels. Random numbers depend on (pixel, sample) only and the sums are exact, so
+  // the image's bits do not depend on the thread count, the tile order, or how the passes
+  // were split between runs.
+  constexpr int kTile = 8;  // small: a pass ends with less waiting for the last tiles
   const int tilesX = (film.width + kTile - 1) / kTile;
   const int tilesY = (film.height + kTile - 1) / kTile;
   const int tileCount = tilesX * tilesY;
-  std::atomic<int> nextTile{0};
-  std::atomic<int> tilesDone{0};
+  std::vector<vec3> pass(film.sum.size());
+  std::vector<char> traced(static_cast<size_t>(tileCount));  // tiles of this pass in the film
+  auto forTilePixels = [&](int tile, auto&& f) {
+    const int x0 = (tile % tilesX) * kTile;
+    const int y0 = (tile / tilesX) * kTile;
+    for (int y = y0; y < std::min(y0 + kTile, film.height); ++y) {
+      for (int x = x0; x < std::min(x0 + kTile, film.width); ++x) {
+        f(x, y, pass[size_t(y) * size_t(film.width) + size_t(x)]);
+      }
+    }
+  };
+  auto stopRequested = [&] {
+    return options.stop && options.stop->load(std::memory_order_relaxed);
+  };
+
+  // The threads meet at a barrier twice a pass: before tracing (the main thread has set the
+  // pass up) and after it (the main thread then checkpoints, or takes a dropped pass out).
+  std::barrier sync(stats.threads);
+  int passIndex = 0;      // written by the main thread between passes only
+  bool finished = false;  // likewise
+  std::atomic<int> nextTile{0}, tilesDone{0};
+  std::atomic<bool> dropped{false};
   std::atomic<uint64_t> totalRays{0};
   std::mutex progressMutex;
 
-  auto worker = [&]() {
-    uint64_t rays = 0;
+  auto trace = [&](uint64_t& rays) {
+    const uint32_t sampleIndex = options.firstSample + uint32_t(passIndex);
     for (int tile; (tile = nextTile.fetch_add(1)) < tileCount;) {
-      const int x0 = (tile % tilesX) * kTile;
-      const int y0 = (tile / tilesX) * kTile;
-      for (int y = y0; y < std::min(y0 + kTile, film.height); ++y) {
-        for (int x = x0; x < std::min(x0 + kTile, film.width); ++x) {
-          for (int s = 0; s < options.spp; ++s) {
-            const uint32_t sampleIndex = options.firstSample + uint32_t(s);
-            film.add(x, y, sampleRadiance(scene, uvec2(x, y), sampleIndex, rays));
-          }
-        }
+      if (stopRequested()) {
+        dropped = true;
+        break;
       }
+      forTilePixels(tile, [&](int x, int y, vec3& sample) {
+        sample = sampleRadiance(scene, uvec2(x, y), sampleIndex, rays);
+        film.add(x, y, sample);
+      });
+      traced[size_t(tile)] = 1;
       const int done = tilesDone.fetch_add(1) + 1;
       if (options.progress) {
         std::unique_lock lock(progressMutex, std::try_to_lock);
-        if (lock.owns_lock()) options.progress(double(done) / double(tileCount));
+        if (lock.owns_lock()) {
+          options.progress((double(passIndex) + double(done) / double(tileCount)) /
+                           double(options.spp));
+        }
       }
+    }
+  };
+  auto worker = [&] {
+    uint64_t rays = 0;
+    for (;;) {
+      sync.arrive_and_wait();
+      if (finished) break;
+      trace(rays);
+      sync.arrive_and_wait();
     }
     totalRays += rays;
   };
   std::vector<std::thread> threads;
   for (int i = 1; i < stats.threads; ++i) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
-  if (options.progress) options.progress(1.0);
+
+  // The main thread traces too, and between passes reports progress and checkpoints.
+  // However it leaves the loop (a stop, or a checkpoint that throws), the workers are released.
+  uint64_t rays = 0;
+  auto releaseWorkers = [&] {
+    finished = true;
+    sync.arrive_and_wait();
+    for (std::thread& t : threads) t.join();
+  };
+  try {
+    for (; passIndex < options.spp && !stopRequested(); ++passIndex) {
+      nextTile = 0;
+      tilesDone = 0;
+      std::fill(traced.begin(), traced.end(), 0);
+      sync.arrive_and_wait();
+      trace(rays);
+      sync.arrive_and_wait();
+      if (dropped) {
+        for (int tile = 0; tile < tileCount; ++tile) {
+          if (traced[size_t(tile)]) {
+            forTilePixels(tile, [&](int x, int y, vec3& sample) { film.takeBack(x, y, sample); });
+          }
+        }
+        break;
+      }
+      stats.samplesDone = passIndex + 1;
+      if (options.checkpoint) options.checkpoint(stats.samplesDone);
+    }
+  } catch (...) {
+    releaseWorkers();
+    throw;
+  }
+  releaseWorkers();
+  totalRays += rays;
+  stats.stopped = stats.samplesDone < options.spp;
+  if (options.progress && !stats.stopped) options.progress(1.0);
 
   stats.rays = totalRays;
   stats.invalidSamples = film.totalInvalid();

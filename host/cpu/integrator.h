@@ -1,4 +1,5 @@
-// The CPU reference path tracer: plain C++, written for clarity, multithreaded over tiles.
+// The CPU reference path tracer: plain C++, written for clarity, in progressive passes over
+// the image, multithreaded over tiles.
 // It reads the same flat arrays and draws the same random numbers as the shader, so a
 // difference image between the two backends points at a bug.
 #pragma once
@@ -13,7 +14,7 @@
 namespace pt {
 
 struct CpuRenderOptions : RenderOptions {
-  int threads = 0;  // 0: all hardware threads
+  int threads = 0;  // 0: every CPU this process may run on (its affinity mask)
 };
 
 struct CpuRenderStats : RenderStats {
@@ -30,7 +31,9 @@ Ray cameraRay(const Camera& camera, vec2 filmPoint);
 vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
                     bool debugPrint = false);
 
-// Renders into film (which must have the camera's resolution), adding spp samples per pixel.
+// Renders into film (which must have the camera's resolution), adding spp samples per pixel
+// in passes of one sample index each; stopped early (options.stop), it adds whole passes
+// only, stats.samplesDone of them. Uses every CPU the process may run on unless told.
 CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film);
 
 }  // namespace pt

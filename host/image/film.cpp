@@ -1,21 +1,38 @@
-// Film: the per-pixel double-precision radiance accumulator renderers add samples to.
+// Film: the per-pixel exact radiance accumulator renderers add samples to.
 
 #include "image/image.h"
+
+#include <string>
+
+#include "common/memory.h"
 
 namespace pt {
 
 Film::Film(int w, int h) : width(w), height(h) {
   PT_CHECK(w >= 0 && h >= 0, "film size must not be negative");
   const size_t n = size_t(w) * size_t(h);
+  // Refused with the numbers before allocating, not killed by the OOM killer halfway. The
+  // resolved Image is counted too: it is allocated while the film is alive.
+  constexpr size_t kBytesPerPixel =
+      sizeof(decltype(sum)::value_type) + sizeof(decltype(sampleCount)::value_type) +
+      sizeof(decltype(invalidCount)::value_type) + sizeof(decltype(exact)::value_type) +
+      sizeof(decltype(Image::pixels)::value_type);
+  checkFitsInMemory(uint64_t(n) * kBytesPerPixel,
+                    "a " + std::to_string(w) + "x" + std::to_string(h) + " film",
+                    std::to_string(kBytesPerPixel) + " bytes per pixel");
   sum.assign(n, glm::dvec3(0.0));
   sampleCount.assign(n, 0);
   invalidCount.assign(n, 0);
+  exact.assign(n, {});
 }
 
 void Film::merge(const Film& other) {
   PT_CHECK(width == other.width && height == other.height, "merging films of different sizes");
   for (size_t i = 0; i < sum.size(); ++i) {
-    sum[i] += other.sum[i];
+    for (int c = 0; c < 3; ++c) {
+      exact[i][c].add(other.exact[i][c]);
+      sum[i][c] = exact[i][c].toDouble();
+    }
     sampleCount[i] += other.sampleCount[i];
     invalidCount[i] += other.invalidCount[i];
   }

@@ -2,6 +2,7 @@
 // Knows nothing of scenes or renderers.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "common/check.h"
+#include "image/exact_sum.h"
 
 namespace pt {
 
@@ -74,14 +76,18 @@ float srgbToLinear(float encoded);
 // as 0, rounded to nearest.
 uint8_t linearToSrgb8(float linear);
 
-// Per-pixel sums of linear radiance in double precision plus sample counts, so that long
-// renders (1e6+ samples per pixel) do not drift. Invalid (NaN/Inf) samples are not added;
-// they are counted per pixel so they can be reported, never silently dropped.
+// Per-pixel sums of linear radiance plus sample counts. The sums are exact (ExactSum), so a
+// pixel's value does not depend on the order its samples were added in: renders split
+// across threads, passes, interruptions and machines give the same bits, and long renders
+// (1e6+ samples per pixel) do not drift. `sum` holds each exact sum rounded to double.
+// Invalid (NaN/Inf) samples are not added; they are counted per pixel so they can be
+// reported, never silently dropped.
 struct Film {
   int width = 0, height = 0;
-  std::vector<glm::dvec3> sum;         // row-major, row 0 top
-  std::vector<uint64_t> sampleCount;   // valid samples added per pixel
-  std::vector<uint64_t> invalidCount;  // NaN/Inf samples seen per pixel
+  std::vector<glm::dvec3> sum;                 // row-major, row 0 top: exact[i] rounded to double
+  std::vector<uint64_t> sampleCount;           // valid samples added per pixel
+  std::vector<uint64_t> invalidCount;          // NaN/Inf samples seen per pixel
+  std::vector<std::array<ExactSum, 3>> exact;  // the sums themselves, per channel
 
   Film() = default;
   Film(int w, int h);
@@ -89,27 +95,59 @@ struct Film {
   // Inline because it runs once per sample. Threads may call it concurrently for disjoint
   // pixels: it touches only pixel (x, y) and takes no lock.
   void add(int x, int y, glm::vec3 radiance) {
-    PT_CHECK(x >= 0 && x < width && y >= 0 && y < height, "film pixel out of range");
+    PT_DCHECK(x >= 0 && x < width && y >= 0 && y < height, "film pixel out of range");
     const size_t i = size_t(y) * size_t(width) + size_t(x);
     if (std::isfinite(radiance.x) && std::isfinite(radiance.y) && std::isfinite(radiance.z)) {
-      sum[i] += glm::dvec3(radiance);
+      addExact(i, radiance);
       ++sampleCount[i];
     } else {
       ++invalidCount[i];
     }
   }
 
-  // Adds a batch of pixel i's samples (row-major index), summed elsewhere: the sum of its
-  // `valid` finite samples and the number of `invalid` ones (the Vulkan backend's fold).
-  void addSums(size_t i, glm::dvec3 radianceSum, uint64_t valid, uint64_t invalid) {
-    sum[i] += radianceSum;
-    sampleCount[i] += valid;
+  // Undoes add(x, y, radiance) exactly, as if it had never been called (the sums are exact
+  // integers underneath, so subtracting restores their bits): how a stopped render drops the
+  // samples of a pass it did not finish.
+  void takeBack(int x, int y, glm::vec3 radiance) {
+    PT_CHECK(x >= 0 && x < width && y >= 0 && y < height, "film pixel out of range");
+    const size_t i = size_t(y) * size_t(width) + size_t(x);
+    if (std::isfinite(radiance.x) && std::isfinite(radiance.y) && std::isfinite(radiance.z)) {
+      PT_CHECK(sampleCount[i] > 0, "taking back a sample that was not added");
+      addExact(i, -radiance);
+      --sampleCount[i];
+    } else {
+      PT_CHECK(invalidCount[i] > 0, "taking back a sample that was not added");
+      --invalidCount[i];
+    }
+  }
+
+  // Adds a batch of pixel i's samples (row-major index), summed elsewhere in float: the sum
+  // of its `valid` finite samples and the number of `invalid` ones (the Vulkan backend's
+  // fold). A non-finite sum (float overflow of finite samples) counts them all as invalid.
+  void addSums(size_t i, glm::vec3 radianceSum, uint64_t valid, uint64_t invalid) {
+    if (std::isfinite(radianceSum.x) && std::isfinite(radianceSum.y) &&
+        std::isfinite(radianceSum.z)) {
+      addExact(i, radianceSum);
+      sampleCount[i] += valid;
+    } else {
+      invalid += valid;
+    }
     invalidCount[i] += invalid;
   }
 
-  void merge(const Film& other);  // sizes must match (PT_CHECK)
+  // Adds other's samples (sizes must match, PT_CHECK). Exact: merging in any order gives the
+  // same film.
+  void merge(const Film& other);
   uint64_t totalInvalid() const;
   Image resolve() const;  // sum / count per pixel (0 where count == 0)
+
+ private:
+  void addExact(size_t i, glm::vec3 v) {
+    for (int c = 0; c < 3; ++c) {
+      exact[i][c].add(v[c]);
+      sum[i][c] = exact[i][c].toDouble();
+    }
+  }
 };
 
 }  // namespace pt

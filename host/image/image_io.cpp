@@ -1,10 +1,10 @@
 // Image files: EXR via tinyexr, PFM by hand, PNG via stb, plus the sRGB curve. Every format
-// is encoded to and decoded from memory, so file access and its errors live in one place.
+// is encoded to and decoded from memory, so file access and its errors live in one place
+// (file_io.cpp).
 
 #include "image/image.h"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cctype>
 #include <cerrno>
@@ -16,8 +16,6 @@
 #include <memory>
 #include <string_view>
 #include <system_error>
-
-#include <unistd.h>
 
 #include <tinyexr.h>
 
@@ -34,11 +32,13 @@
 #define STBI_WRITE_NO_STDIO
 #include <stb/stb_image_write.h>
 
+#include "common/memory.h"
+#include "image/file_io.h"
+
 namespace pt {
 namespace {
 
 namespace fs = std::filesystem;
-using Bytes = std::vector<unsigned char>;
 
 // Throws the one-line InputError every image failure uses: "<path>: <what>". Library messages
 // can contain newlines, which would break the one-line promise, so they become spaces.
@@ -46,61 +46,6 @@ using Bytes = std::vector<unsigned char>;
   std::replace(what.begin(), what.end(), '\n', ' ');
   while (!what.empty() && what.back() == ' ') what.pop_back();
   throw InputError(path.string() + ": " + what);
-}
-
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
-
-Bytes readFile(const fs::path& path) {
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (status.type() == fs::file_type::not_found) fail(path, "not found");
-  if (ec) fail(path, "cannot access: " + ec.message());
-  if (fs::is_directory(status)) fail(path, "is a directory, not an image file");
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
-  if (!file) fail(path, std::string("cannot open: ") + std::strerror(errno));
-  Bytes bytes;
-  unsigned char chunk[1 << 16];
-  size_t n;
-  while ((n = std::fread(chunk, 1, sizeof(chunk), file.get())) > 0) {
-    bytes.insert(bytes.end(), chunk, chunk + n);
-  }
-  if (std::ferror(file.get())) fail(path, std::string("cannot read: ") + std::strerror(errno));
-  return bytes;
-}
-
-// Writes to "<name>.tmp-<pid>-<n>" beside the target, flushes it to disk and renames it over
-// the target. rename() within one directory is atomic, so readers (and a crash) see either
-// the old file or the complete new one, never a partial one. The counter keeps two threads of
-// one process writing the same target from sharing a temporary file.
-void writeFileAtomically(const fs::path& path, const Bytes& bytes) {
-  static std::atomic<unsigned> counter{0};
-  fs::path tmp = path;
-  tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-
-  // "wx" never opens something that already exists, so a stray file or directory of that name
-  // is left alone and the failure is reported instead.
-  std::FILE* file = std::fopen(tmp.c_str(), "wx");
-  if (!file) fail(path, std::string("cannot write: ") + std::strerror(errno));
-  int error = 0;
-  if (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) {
-    error = errno;
-  }
-  if (std::fflush(file) != 0 && !error) error = errno;
-  if (::fsync(::fileno(file)) != 0 && !error) error = errno;
-  if (std::fclose(file) != 0 && !error) error = errno;
-  std::error_code ec;
-  if (error) {
-    fs::remove(tmp, ec);
-    fail(path, std::string("cannot write: ") + std::strerror(error));
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    fail(path, "cannot move the finished file into place: " + ec.message());
-  }
 }
 
 // ---- sRGB -----------------------------------------------------------------------------------
@@ -419,6 +364,22 @@ Image decodePng(const Bytes& data, const fs::path& path) {
   if (data.size() > size_t(INT_MAX)) fail(path, "PNG file too large");
   const int size = int(data.size());
   int width = 0, height = 0, channelsInFile = 0;
+  // The header's size is checked before decoding: deflate expands at most 1032:1, so a PNG
+  // whose rows, even at 1 bit per pixel, need more than that many times its own size is
+  // corrupt, whatever it says; and what passes must still fit in memory (the decoded pixels
+  // plus the float image).
+  if (stbi_info_from_memory(data.data(), size, &width, &height, &channelsInFile)) {
+    const uint64_t depth = stbi_is_16_bit_from_memory(data.data(), size) ? 2 : 1;
+    const uint64_t minRawBytes = uint64_t(height) * (1 + (uint64_t(width) + 7) / 8);
+    if (minRawBytes / 1032 > uint64_t(size)) {
+      fail(path, "header says " + std::to_string(width) + "x" + std::to_string(height) +
+                     " pixels, more than " + std::to_string(size) + " bytes of PNG can hold");
+    }
+    checkFitsInMemory(
+        uint64_t(width) * uint64_t(height) * (3 * depth + sizeof(glm::vec3)),
+        path.string() + ": a " + std::to_string(width) + "x" + std::to_string(height) + " PNG",
+        "decoded pixels and the float image");
+  }
   // Colour, grey and alpha variants all come back as RGB (alpha dropped). 16-bit files keep
   // their precision. Gamma and ICC chunks are ignored: PNG here means sRGB.
   if (stbi_is_16_bit_from_memory(data.data(), size)) {
@@ -494,7 +455,7 @@ void writeImage(const Image& image, const std::filesystem::path& path) {
 
 Image readImage(const std::filesystem::path& path) {
   const ImageFormat format = imageFormatOf(path);
-  const Bytes bytes = readFile(path);
+  const Bytes bytes = readWholeFile(path, "an image file");
   switch (format) {
     case ImageFormat::kExr:
       return decodeExr(bytes, path);

@@ -3,6 +3,7 @@
 // backend (host/vulkan) extend these with their own knobs; neither includes the other.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 
@@ -13,6 +14,14 @@ struct RenderOptions {
   int spp = 1;
   // Called now and then from one thread with the fraction of work done, in [0, 1].
   std::function<void(double)> progress;
+  // When it reads true (set by a signal handler, say) the render stops early: the CPU drops
+  // the pass under way, the Vulkan backend stops after the dispatch under way. The film then
+  // holds whole passes; RenderStats::samplesDone says how many.
+  const std::atomic<bool>* stop = nullptr;
+  // Called on the rendering thread whenever the film holds exactly the samples [firstSample,
+  // firstSample + done) of this call (after every pass on the CPU, after every fold of a batch
+  // on Vulkan), so that a checkpoint of the film can be written from it.
+  std::function<void(int done)> checkpoint;
 };
 
 struct RenderStats {
@@ -21,6 +30,8 @@ struct RenderStats {
   uint64_t rays = 0;              // every ray traced: camera, bounce and shadow rays
   uint64_t invalidSamples = 0;    // samples left out of the film: NaN/Inf, or cut short
   uint64_t truncatedSamples = 0;  // of those, paths given up at lavapipe's loop-iteration cap
+  int samplesDone = 0;            // samples per pixel rendered: spp, or fewer when stopped
+  bool stopped = false;           // RenderOptions::stop ended the render early
 };
 
 }  // namespace pt

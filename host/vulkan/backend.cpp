@@ -1,6 +1,6 @@
 // Vulkan backend; see backend.h. Host code kept small: device-local buffers filled through
 // one staging buffer, one descriptor set, one compute pipeline specialised to the scene's
-// effect set, one command buffer re-recorded per batch of passes. renderVulkan reads as its
+// effect set, one command buffer re-recorded for every dispatch. renderVulkan reads as its
 // four stages: upload, pipeline, batches of passes, fold into the film.
 #include "vulkan/backend.h"
 
@@ -171,19 +171,54 @@ class PassRecorder {
   uint32_t debugPixel_;
 };
 
-// ---- Fold: the batch's float sums into the double-precision film ----------------------------
+// ---- Fold: the batch's float sums into the film's exact sums --------------------------------
 
-// `samples` samples per pixel were dispatched since the last fold.
-void foldIntoFilm(const RenderBuffers& buffers, int samples, Film& film, VulkanRenderStats& stats) {
-  const auto* px = static_cast<const AccumPixel*>(buffers.readback.mapped);
-  for (size_t i = 0; i < film.sum.size(); ++i) {
-    film.addSums(i, glm::dvec3(px[i].sum), uint64_t(samples) - px[i].invalid, px[i].invalid);
-  }
+// The device counters in the readback buffer into the statistics.
+void addCounters(const RenderBuffers& buffers, VulkanRenderStats& stats) {
   DeviceCounters c;
   std::memcpy(&c, static_cast<const char*>(buffers.readback.mapped) + buffers.accumSize, sizeof(c));
   stats.rays += uint64_t(c.raysHigh) << 32 | c.raysLow;
   stats.truncatedSamples += c.truncated;
   stats.maxLoopIterations = std::max(stats.maxLoopIterations, c.maxLoopIterations);
+}
+
+// `samples` samples per pixel were dispatched since the last fold. The float sums are added
+// to the film exactly, so a batch contributes the same bits whenever it is folded.
+void foldIntoFilm(const RenderBuffers& buffers, int samples, Film& film, VulkanRenderStats& stats) {
+  const auto* px = static_cast<const AccumPixel*>(buffers.readback.mapped);
+  for (size_t i = 0; i < film.sum.size(); ++i) {
+    film.addSums(i, px[i].sum, uint64_t(samples) - px[i].invalid, px[i].invalid);
+  }
+  addCounters(buffers, stats);
+}
+
+// The read-back sums of the batch [first, first + count), kept open instead of folded.
+OpenBatch readOpenBatch(const RenderBuffers& buffers, uint32_t first, uint32_t count, size_t pixels,
+                        VulkanRenderStats& stats) {
+  const auto* px = static_cast<const AccumPixel*>(buffers.readback.mapped);
+  OpenBatch open;
+  open.first = first;
+  open.count = count;
+  open.sum.resize(pixels);
+  open.invalid.resize(pixels);
+  for (size_t i = 0; i < pixels; ++i) {
+    open.sum[i] = px[i].sum;
+    open.invalid[i] = px[i].invalid;
+  }
+  addCounters(buffers, stats);
+  return open;
+}
+
+// Records the upload of an open batch's sums into the (cleared) accumulation, through
+// `staging` (kept alive by the caller until the commands have run).
+void uploadOpenBatch(const VulkanContext& ctx, const vk::raii::CommandBuffer& cmd,
+                     const RenderBuffers& buffers, const OpenBatch& open, Buffer& staging) {
+  staging = makeBuffer(ctx, buffers.accumSize, U::eTransferSrc, true);
+  auto* px = static_cast<AccumPixel*>(staging.mapped);
+  for (size_t i = 0; i < open.sum.size(); ++i) px[i] = AccumPixel{open.sum[i], open.invalid[i]};
+  cmd.copyBuffer(*staging.buffer, *buffers.accum().buffer, vk::BufferCopy(0, 0, buffers.accumSize));
+  barrier(cmd, S::eTransfer, A::eTransferWrite, S::eComputeShader,
+          A::eShaderRead | A::eShaderWrite);
 }
 
 }  // namespace
@@ -217,43 +252,119 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   commands.submitAndWait(ctx);
 
   // Batches of passes: samplesPerPass samples per pixel per dispatch, folded into the film
-  // after every passesPerFlush dispatches.
+  // after every passesPerFlush dispatches. Batches cover the sample indices [k * batch,
+  // (k + 1) * batch), aligned to absolute sample indices rather than to this call's first
+  // sample, and passes step from the batch's first sample: a render that is stopped and
+  // continued, or split into slices at batch boundaries, sums every batch in float exactly
+  // as one uninterrupted render does, and the film's exact sums do the rest.
   VulkanRenderStats stats;
   stats.device = ctx.info().name;
   const vk::raii::QueryPool queries(ctx.device,
                                     vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, 2));
   const double tickSeconds = double(ctx.limits.timestampPeriod) * 1e-9;
-  const int perFlush = std::max(1, options.passesPerFlush);
-  const int perPass = std::max(1, options.samplesPerPass);
-  for (int done = 0; done < options.spp;) {
-    commands.begin();
-    cmd.resetQueryPool(*queries, 0, 2);
-    program.bind(cmd);
-    cmd.writeTimestamp(S::eTopOfPipe, *queries, 0);
-    int samples = 0;  // per pixel, in this batch of passes
-    for (int p = 0; p < perFlush && done + samples < options.spp; ++p) {
-      const int count = std::min(perPass, options.spp - done - samples);
-      passes.dispatch(options.firstSample + uint32_t(done + samples), uint32_t(count));
-      samples += count;
-    }
-    cmd.writeTimestamp(S::eBottomOfPipe, *queries, 1);
-    passes.readBack();
-    commands.submitAndWait(ctx);
+  const uint32_t perPass = uint32_t(std::max(1, options.samplesPerPass));
+  const uint64_t batch = uint64_t(perPass) * uint64_t(std::max(1, options.passesPerFlush));
+  const uint32_t first = options.firstSample;
+  const uint32_t end = first + uint32_t(options.spp);
+  const size_t pixels = film.sum.size();
+  auto stopRequested = [&] {
+    return options.stop && options.stop->load(std::memory_order_relaxed);
+  };
 
-    const auto [result, ticks] =
-        queries.getResults<uint64_t>(0, 2, 2 * sizeof(uint64_t), sizeof(uint64_t),
-                                     vk::QueryResultFlagBits::e64 | vk::QueryResultFlagBits::eWait);
-    PT_CHECK(result == vk::Result::eSuccess);
-    stats.seconds += double(ticks[1] - ticks[0]) * tickSeconds;
-    foldIntoFilm(buffers, samples, film, stats);
-    done += samples;
-    if (options.progress) options.progress(double(done) / double(options.spp));
+  uint32_t next = first;               // the next sample index to dispatch
+  uint32_t batchFirst = first;         // the first sample index of the batch under way
+  const OpenBatch* carried = nullptr;  // an open batch handed in, until it is uploaded
+  Buffer openStaging;
+  if (options.openBatch && !options.openBatch->empty()) {
+    carried = options.openBatch;
+    PT_CHECK(carried->first + carried->count == first && carried->sum.size() == pixels &&
+                 carried->invalid.size() == pixels,
+             "an open batch must end where the render starts and match the film");
+    batchFirst = carried->first;
   }
-  stats.invalidSamples = film.totalInvalid();
+  for (;;) {
+    const uint32_t batchEnd = uint32_t(std::min<uint64_t>(end, (batchFirst / batch + 1) * batch));
+    // Dispatch by dispatch, each submitted on its own, so that a stop waits for one dispatch.
+    bool stopped = false;
+    while (next < batchEnd) {
+      if (stopRequested()) {
+        stopped = true;
+        break;
+      }
+      commands.begin();
+      if (carried) {
+        uploadOpenBatch(ctx, cmd, buffers, *carried, openStaging);
+        carried = nullptr;
+      }
+      cmd.resetQueryPool(*queries, 0, 2);
+      program.bind(cmd);
+      cmd.writeTimestamp(S::eTopOfPipe, *queries, 0);
+      const uint32_t count = std::min(perPass, batchEnd - next);
+      passes.dispatch(next, count);
+      cmd.writeTimestamp(S::eBottomOfPipe, *queries, 1);
+      commands.submitAndWait(ctx);
+      const auto [result, ticks] = queries.getResults<uint64_t>(
+          0, 2, 2 * sizeof(uint64_t), sizeof(uint64_t),
+          vk::QueryResultFlagBits::e64 | vk::QueryResultFlagBits::eWait);
+      PT_CHECK(result == vk::Result::eSuccess);
+      stats.seconds += double(ticks[1] - ticks[0]) * tickSeconds;
+      next += count;
+      if (options.progress) options.progress(double(next - first) / double(options.spp));
+    }
+    const uint32_t batchSamples = next - batchFirst;
+    const bool whole = next == (batchFirst / batch + 1) * batch;
+    const bool keepOpen = stopped || (!whole && options.keepOpenBatch);
+    if (batchSamples > 0) {
+      if (carried) {  // nothing dispatched since it was handed in: it is still on the host
+        if (keepOpen) {
+          stats.open = *carried;
+        } else {
+          carried->foldInto(film);
+        }
+        carried = nullptr;
+      } else {
+        commands.begin();
+        passes.readBack();
+        commands.submitAndWait(ctx);
+        if (keepOpen) {
+          stats.open = readOpenBatch(buffers, batchFirst, batchSamples, pixels, stats);
+        } else {
+          foldIntoFilm(buffers, int(batchSamples), film, stats);
+        }
+      }
+    }
+    if (keepOpen) {
+      stats.stopped = stopped;
+      break;
+    }
+    batchFirst = next;
+    if (options.checkpoint && batchSamples > 0) options.checkpoint(int(next - first));
+    if (next >= end) break;
+    if (stopRequested()) {
+      stats.stopped = true;
+      break;
+    }
+  }
+  stats.samplesDone = int(next - first);
+  stats.invalidSamples = film.totalInvalid() + stats.open.invalidTotal();
   stats.validationErrors = ctx.validationErrors();
   stats.wallSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
+}
+
+KeyValues vulkanImageSettings(const VulkanRenderOptions& options) {
+  const std::span<const uint32_t> spirv = options.context.debugPrintf
+                                              ? std::span<const uint32_t>(kPathtraceDebugSpv)
+                                              : std::span<const uint32_t>(kPathtraceSpv);
+  return {{"samples_per_pass", std::to_string(std::max(1, options.samplesPerPass))},
+          {"passes_per_fold", std::to_string(std::max(1, options.passesPerFlush))},
+          {"specialize", options.specialize ? "on" : "off"},
+          {"shader", hexHash(hashBytes(spirv.data(), spirv.size_bytes()))}};
+}
+
+uint32_t vulkanBatchSize(const VulkanRenderOptions& options) {
+  return uint32_t(std::max(1, options.samplesPerPass) * std::max(1, options.passesPerFlush));
 }
 
 }  // namespace pt

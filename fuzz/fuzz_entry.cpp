@@ -1,0 +1,117 @@
+// Fuzz entry points: each feeds the bytes to one reader exactly as `pt` would and turns an
+// InputError into Outcome::kInputError. Readers that take a path get the bytes through a file
+// in a directory of this process's own.
+#include "fuzz/fuzz_entry.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+#include "common/check.h"
+#include "image/image.h"
+#include "scene/mtl_materials.h"
+#include "scene/obj_mesh.h"
+#include "scene/ply_mesh.h"
+#include "scene/scene.h"
+
+namespace pt::fuzz {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Small meshes a fuzzed scene can reference by name ("mesh.obj", "mesh.ply", with "mesh.mtl"
+// for the OBJ's mtllib): fixed, so that the scene fuzzer explores the JSON, not the meshes.
+constexpr const char* kObj =
+    "mtllib mesh.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl red\nf 1 2 3\nusemtl lamp\n"
+    "f 1 3 4\n";
+constexpr const char* kMtl = "newmtl red\nKd 0.8 0.1 0.1\nnewmtl lamp\nKd 0 0 0\nKe 4 4 4\n";
+constexpr const char* kPly =
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+    "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+    "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+
+void writeFile(const fs::path& path, const void* data, std::size_t size) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(static_cast<const char*>(data), std::streamsize(size));
+  PT_CHECK(out.good(), "fuzz: cannot write " + path.string());
+}
+
+// /tmp/pt-fuzz-<pid>, made once with the fixed meshes in it and removed at exit.
+const fs::path& workDir() {
+  struct Dir {
+    fs::path path = fs::temp_directory_path() / ("pt-fuzz-" + std::to_string(::getpid()));
+    Dir() {
+      fs::create_directories(path);
+      writeFile(path / "mesh.obj", kObj, std::char_traits<char>::length(kObj));
+      writeFile(path / "mesh.mtl", kMtl, std::char_traits<char>::length(kMtl));
+      writeFile(path / "mesh.ply", kPly, std::char_traits<char>::length(kPly));
+    }
+    ~Dir() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
+}
+
+template <typename F>
+Outcome guarded(F&& f) {
+  try {
+    f();
+    return Outcome::kAccepted;
+  } catch (const InputError&) {
+    return Outcome::kInputError;
+  }
+}
+
+std::string text(const std::uint8_t* data, std::size_t size) {
+  return std::string(reinterpret_cast<const char*>(data), size);
+}
+
+}  // namespace
+
+Outcome fuzzScene(const std::uint8_t* data, std::size_t size) {
+  const fs::path path = workDir() / "scene.json";
+  writeFile(path, data, size);
+  return guarded([&] { loadScene(path); });
+}
+
+Outcome fuzzObj(const std::uint8_t* data, std::size_t size) {
+  return guarded([&] { scene_detail::loadObjMesh(text(data, size), "fuzz.obj", ""); });
+}
+
+Outcome fuzzMtl(const std::uint8_t* data, std::size_t size) {
+  return guarded([&] { scene_detail::loadMtlMaterials(text(data, size), "fuzz.mtl"); });
+}
+
+Outcome fuzzPly(const std::uint8_t* data, std::size_t size) {
+  return guarded([&] { scene_detail::loadPlyTriangles(text(data, size), "fuzz.ply", ""); });
+}
+
+// The format is chosen by the magic number, as a user's misnamed file would not be: each
+// decoder then sees mostly inputs meant for it. Anything else goes to the PNG decoder.
+Outcome fuzzImage(const std::uint8_t* data, std::size_t size) {
+  const char* extension = ".png";
+  if (size >= 2 && data[0] == 'P' && (data[1] == 'F' || data[1] == 'f')) extension = ".pfm";
+  if (size >= 4 && data[0] == 0x76 && data[1] == 0x2f && data[2] == 0x31 && data[3] == 0x01) {
+    extension = ".exr";
+  }
+  const fs::path path = workDir() / (std::string("image") + extension);
+  writeFile(path, data, size);
+  return guarded([&] { readImage(path); });
+}
+
+const std::vector<Target>& targets() {
+  static const std::vector<Target> all = {{"scene", fuzzScene},
+                                          {"obj", fuzzObj},
+                                          {"mtl", fuzzMtl},
+                                          {"ply", fuzzPly},
+                                          {"image", fuzzImage}};
+  return all;
+}
+
+}  // namespace pt::fuzz

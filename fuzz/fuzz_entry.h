@@ -1,0 +1,28 @@
+// The entry points the fuzz targets (fuzz/*_fuzzer.cpp) and the regression replay
+// (tests/fuzz_regression_test.cpp) share: one per reader of outside data.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pt::fuzz {
+
+// What an input did: accepted, or refused with an InputError (the only allowed failure).
+// Any other exception propagates, and a crash is a crash: both are bugs.
+enum class Outcome { kAccepted, kInputError };
+
+Outcome fuzzScene(const std::uint8_t* data, std::size_t size);  // JSON beside fixed meshes
+Outcome fuzzObj(const std::uint8_t* data, std::size_t size);    // loadObjMesh
+Outcome fuzzMtl(const std::uint8_t* data, std::size_t size);    // loadMtlMaterials
+Outcome fuzzPly(const std::uint8_t* data, std::size_t size);    // loadPlyTriangles
+Outcome fuzzImage(const std::uint8_t* data, std::size_t size);  // readImage: EXR, PFM, PNG
+
+struct Target {
+  const char* name;  // the directory name under fuzz/corpus/ and tests/data/fuzz-regressions/
+  Outcome (*run)(const std::uint8_t*, std::size_t);
+};
+const std::vector<Target>& targets();
+
+}  // namespace pt::fuzz

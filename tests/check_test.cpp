@@ -1,0 +1,110 @@
+// Error tiers (docs/errors.md): a failed internal check exits with kExitInternal and one
+// line; PT_DCHECK is compiled out of Release builds; films that cannot fit in memory are
+// refused with the numbers before anything is allocated.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <fstream>
+#include <string>
+
+#include "common/check.h"
+#include "common/memory.h"
+#include "image/image.h"
+#include "test_util.h"
+
+namespace pt {
+namespace {
+
+struct ShellRun {
+  int status = -1;  // -1 when killed by a signal
+  std::string err;
+};
+
+ShellRun runShell(const std::string& command) {
+  const test::TempDir dir;
+  const std::string errFile = (dir / "stderr.txt").string();
+  const int raw = std::system(("(" + command + ") 2>" + errFile).c_str());
+  ShellRun run;
+  run.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  std::ifstream in(errFile);
+  run.err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return run;
+}
+
+TEST(ErrorTiers, FailedCheckExitsWithTheInternalStatusAndOneLine) {
+  const ShellRun r = runShell(std::string(PT_CHECK_FAIL_BINARY) + " >/dev/null");
+  EXPECT_EQ(r.status, kExitInternal) << r.err;
+  EXPECT_NE(r.err.find("internal error: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("check failed: argc < 0: failed on purpose"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+TEST(ErrorTiers, DebugCheckIsCompiledOutUnderNdebug) {
+  const ShellRun r = runShell(std::string(PT_CHECK_FAIL_BINARY) + " dcheck >/dev/null");
+#ifdef NDEBUG
+  EXPECT_EQ(r.status, 0) << r.err;
+  int evaluated = 0;
+  PT_DCHECK(++evaluated < 0, "never evaluated");
+  EXPECT_EQ(evaluated, 0);
+#else
+  EXPECT_EQ(r.status, kExitInternal) << r.err;
+  EXPECT_NE(r.err.find("debug-only check"), std::string::npos) << r.err;
+#endif
+}
+
+TEST(MemoryLimit, RefusalGivesTheNumbers) {
+  const std::uint64_t gib = std::uint64_t(1) << 30;
+  EXPECT_NO_THROW(checkFitsInMemory(gib, "a thing", "detail", 2 * gib));
+  try {
+    checkFitsInMemory(40 * gib, "a 16384x16384 film", "160 bytes per pixel", 3 * gib / 2);
+    FAIL() << "not refused";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "a 16384x16384 film needs 40.0 GiB (160 bytes per pixel), but only 1.5 GiB of "
+                 "memory is available");
+  }
+}
+
+TEST(MemoryLimit, AvailableMemoryIsPlausible) {
+  const std::uint64_t available = availableMemoryBytes();
+  EXPECT_GT(available, std::uint64_t(1) << 20);  // this test itself runs in it
+}
+
+// The sanitizers reserve terabytes of address space, so `ulimit -v` cannot apply to them.
+#if defined(__SANITIZE_ADDRESS__)
+#define PT_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define PT_TEST_ASAN 1
+#endif
+#endif
+
+TEST(MemoryLimit, HugeFilmIsRefusedBeforeAllocating) {
+#ifdef PT_TEST_ASAN
+  GTEST_SKIP() << "ulimit -v does not work under AddressSanitizer";
+#else
+  // 16384 x 16384 pixels at well over 40 bytes each: tens of GiB, refused under a 2 GiB
+  // address-space limit (the check reads RLIMIT_AS) with exit status 2 and the numbers.
+  const test::TempDir dir;
+  const std::string out = (dir / "huge.exr").string();
+  const ShellRun r =
+      runShell("ulimit -v 2097152 && " + std::string(PT_BINARY) + " render " +
+               (test::kConfigs / "cornell-box.json").string() +
+               " --backend cpu --spp 1 --width 16384 --height 16384 --out " + out + " >/dev/null");
+  EXPECT_EQ(r.status, kExitInputError) << r.err;
+  EXPECT_NE(r.err.find("a 16384x16384 film needs "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bytes per pixel), but only "), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+#endif
+}
+
+TEST(MemoryLimit, FilmConstructorRefusesWhatCannotFit) {
+  // In process: 2^20 x 2^14 pixels at over 40 bytes each is over 640 GiB, more than any test
+  // machine has; refused before anything is allocated.
+  EXPECT_THROW(Film(1 << 20, 1 << 14), InputError);
+}
+
+}  // namespace
+}  // namespace pt
