@@ -15,11 +15,9 @@
 #include "test_util.h"
 
 namespace pt {
-namespace {
+namespace test {
 
-using test::loadBunny;
-
-// Checks every structural invariant of a built BVH.
+// Checks every structural invariant of a built BVH (bvh_build_test.cpp uses it too).
 void expectValidBvh(const Bvh& bvh, size_t triangleCount, int maxLeafSize) {
   ASSERT_EQ(bvh.triangles.size(), triangleCount);
   ASSERT_LE(bvh.maxDepth, int(kBvhStackSize));
@@ -72,6 +70,12 @@ void expectValidBvh(const Bvh& bvh, size_t triangleCount, int maxLeafSize) {
   }
   for (size_t i = 0; i < triangleCount; ++i) EXPECT_EQ(seenPrimitive[i], 1) << "primitive " << i;
 }
+
+}  // namespace test
+namespace {
+
+using test::expectValidBvh;
+using test::loadBunny;
 
 // Morton codes of the reordered triangles, normalised as the builder does, are sorted.
 void expectMortonOrder(const Bvh& bvh) {
@@ -203,7 +207,6 @@ TEST(BvhBuild, BunnyInvariants) {
 
 TEST(BvhTraversal, MatchesBruteForceOnBunny) {
   const std::vector<Triangle> bunny = loadBunny();
-  const Bvh bvh = buildBvh(bunny, BvhBuildOptions{4});
   // Ray set: origins around the mesh; half aimed at a random point of a random triangle (so
   // most hit), half in uniformly random directions (many miss).
   constexpr int kRays = 100000;
@@ -256,25 +259,30 @@ TEST(BvhTraversal, MatchesBruteForceOnBunny) {
       });
     for (auto& th : pool) th.join();
   }
-  int hits = 0, mismatches = 0, anyHitMismatches = 0;
-  for (int i = 0; i < kRays; ++i) {
-    const auto hit = closestHit(bvh, rays[i]);
-    const BruteHit& e = expected[i];
-    hits += e.found;
-    // Same distance bit for bit (the triangle may differ only where two share that
-    // distance, at an edge, so the distance is what is compared).
-    const bool same = hit.has_value() == e.found && (!e.found || hit->t == e.t);
-    if (!same && ++mismatches <= 5) ADD_FAILURE() << "ray " << i << " closest hit differs";
-    // Any-hit within a range that may or may not contain the closest hit.
-    const float tMax = e.found ? e.t * shadowFraction[i] : 1e3f;
-    const bool blocked = anyHit(bvh, rays[i], tMax);
-    const bool expectBlocked = e.found && e.t < tMax;
-    if (blocked != expectBlocked && ++anyHitMismatches <= 5)
-      ADD_FAILURE() << "ray " << i << " any-hit differs";
+  // The LBVH and the PLOC tree (the SAH tree is compared with the LBVH below).
+  for (BvhBuilder builder : {BvhBuilder::kLbvh, BvhBuilder::kPloc}) {
+    SCOPED_TRACE(std::string(nameOf(kBuilderNames, builder)));
+    const Bvh bvh = buildBvh(bunny, BvhBuildOptions{4, builder});
+    int hits = 0, mismatches = 0, anyHitMismatches = 0;
+    for (int i = 0; i < kRays; ++i) {
+      const auto hit = closestHit(bvh, rays[i]);
+      const BruteHit& e = expected[i];
+      hits += e.found;
+      // Same distance bit for bit (the triangle may differ only where two share that
+      // distance, at an edge, so the distance is what is compared).
+      const bool same = hit.has_value() == e.found && (!e.found || hit->t == e.t);
+      if (!same && ++mismatches <= 5) ADD_FAILURE() << "ray " << i << " closest hit differs";
+      // Any-hit within a range that may or may not contain the closest hit.
+      const float tMax = e.found ? e.t * shadowFraction[i] : 1e3f;
+      const bool blocked = anyHit(bvh, rays[i], tMax);
+      const bool expectBlocked = e.found && e.t < tMax;
+      if (blocked != expectBlocked && ++anyHitMismatches <= 5)
+        ADD_FAILURE() << "ray " << i << " any-hit differs";
+    }
+    EXPECT_EQ(mismatches, 0);
+    EXPECT_EQ(anyHitMismatches, 0);
+    EXPECT_GT(hits, kRays / 2);  // the test exercises hits, not just misses
   }
-  EXPECT_EQ(mismatches, 0);
-  EXPECT_EQ(anyHitMismatches, 0);
-  EXPECT_GT(hits, kRays / 2);  // the test exercises hits, not just misses
 }
 
 TEST(BvhTraversal, BinnedSahTracesLikeTheLbvhOnBunny) {

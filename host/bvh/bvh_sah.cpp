@@ -5,7 +5,6 @@
 // exists to measure what the faster LBVH build costs in trace time.
 #include <algorithm>
 #include <array>
-#include <chrono>
 
 #include "bvh/bvh_build.h"
 #include "common/check.h"
@@ -128,7 +127,6 @@ class SahBuilder {
 }  // namespace
 
 Bvh buildBinnedSahBvh(std::vector<Triangle> triangles, size_t leafSize) {
-  const auto start = std::chrono::steady_clock::now();
   Bvh bvh;
   bvh.nodes.reserve(2 * triangles.size());
   SahBuilder builder(triangles, leafSize, bvh.nodes);
@@ -138,8 +136,6 @@ Bvh buildBinnedSahBvh(std::vector<Triangle> triangles, size_t leafSize) {
   bvh.triangles.resize(triangles.size());
   for (size_t i = 0; i < triangles.size(); ++i) bvh.triangles[i] = triangles[builder.order()[i]];
   bvh.nodes.shrink_to_fit();
-  bvh.buildSeconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return bvh;
 }
 

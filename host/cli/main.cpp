@@ -325,13 +325,14 @@ int runRender(const RenderArgs& args) {
 
   std::printf(
       "%s resolution=%ux%u spp=%u seconds=%.3f Mrays/s=%.3f effects=%s triangles=%zu "
-      "load_s=%.3f bvh_builder=%s bvh_nodes=%zu bvh_build_s=%.4f peak_rss_mib=%.0f "
-      "invalid_samples=%llu\n",
+      "load_s=%.3f bvh_builder=%s bvh_nodes=%zu bvh_build_s=%.4f bvh_sah_cost=%.2f "
+      "peak_rss_mib=%.0f invalid_samples=%llu\n",
       backendInfo.c_str(), cam.width, cam.height, spp, stats.seconds,
       stats.seconds > 0.0 ? double(stats.rays) / stats.seconds * 1e-6 : 0.0, effects.c_str(),
       data.bvh.triangles.size(), loadSeconds,
       std::string(nameOf(kBuilderNames, settings.builder)).c_str(), data.bvh.nodes.size(),
-      data.bvh.buildSeconds, peakResidentMiB(), (unsigned long long)stats.invalidSamples);
+      data.bvh.buildSeconds, data.bvh.sahCost, peakResidentMiB(),
+      (unsigned long long)stats.invalidSamples);
   std::fflush(stdout);
   if (interrupted) {
     std::string what = spp == 0 ? "before a pass was complete: nothing written"
