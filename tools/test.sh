@@ -9,9 +9,15 @@ cmake --build build
 ctest --test-dir build --output-on-failure -j "$(nproc)"
 
 # The CPU side again under AddressSanitizer + UndefinedBehaviorSanitizer (docs/errors.md),
-# without NDEBUG so that every PT_DCHECK runs too. Lavapipe's JIT does not run under ASan, so
-# the Vulkan tests (and the Slurm cluster test) stay in the normal run above.
+# without NDEBUG so that every PT_DCHECK runs too. The Vulkan tests proper (and the Slurm
+# cluster test) stay in the normal run above: they pass under ASan but take long there.
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DPT_SANITIZE=ON
 cmake --build build-asan --target pt_tests
-ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -E 'Vulkan|GpuTraversal' -LE slurm
+vulkan='Vulkan|GpuTraversal'
+both='Robust|SeedScene'  # CPU tests that also render on lavapipe to compare
+ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -E "$vulkan|$both" -LE slurm
+# Lavapipe's LLVM leaks 128 bytes in a library the driver unloads before LeakSanitizer can
+# name it, so leak detection is off for these; memory errors and undefined behaviour still fail.
+ASAN_OPTIONS=detect_leaks=0 ctest --test-dir build-asan --output-on-failure -j "$(nproc)" \
+  -R "$both" -E "$vulkan"
