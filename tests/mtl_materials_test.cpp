@@ -122,6 +122,25 @@ TEST(SceneMtl, FacesBeforeAnyUsemtlTakeTheShapesMaterialOrFail) {
   EXPECT_NE(m.find("m.obj' that come before any usemtl"), std::string::npos) << m;
 }
 
+// MTL materials are appended to the scene's materials; a later shape's misspelled material
+// must still get a suggestion from the JSON's names (fuzzing found those views dangling).
+TEST(SceneMtl, UnknownMaterialAfterAnMtlShapeStillSuggestsTheRightName) {
+  test::TempDir dir;
+  dir.write("m.mtl",
+            "newmtl a\nKd 0.1 0.1 0.1\nnewmtl b\nKd 0.2 0.2 0.2\nnewmtl c\nKd 0.3 0.3 0.3\n");
+  dir.write("m.obj",
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\nusemtl b\n"
+            "f 1 3 2\nusemtl c\nf 2 1 3\n");
+  const std::string m =
+      loadError(dir.write("s.json", R"({"materials": [{"name": "white"}, {"name": "light"}],
+                    "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"},
+                               {"type": "quad", "material": "lihgt",
+                                "vertices": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]}]})"));
+  EXPECT_NE(m.find("shapes[1].material: unknown material 'lihgt' (did you mean 'light'?)"),
+            std::string::npos)
+      << m;
+}
+
 TEST(SceneMtl, LongPathsAreNeverCutInMessages) {
   test::TempDir dir;
   const std::string deep = std::string(90, 'd') + "/" + std::string(40, 'e');

@@ -431,10 +431,13 @@ void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
 void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Scene& scene) {
   if (node.size() == 0) node.fail("expected at least one shape");
   std::unordered_map<std::string, uint> materialIndex;
+  // Views into a copy of the JSON's material names: shapes with "materials": "mtl" append to
+  // scene.materialNames, which would leave views into it dangling (found by fuzzing).
+  const std::vector<std::string> jsonMaterialNames = scene.materialNames;
   std::vector<std::string_view> materialNames;
-  for (std::size_t i = 0; i < scene.materialNames.size(); ++i) {
-    materialIndex.emplace(scene.materialNames[i], static_cast<uint>(i));
-    materialNames.push_back(scene.materialNames[i]);
+  for (std::size_t i = 0; i < jsonMaterialNames.size(); ++i) {
+    materialIndex.emplace(jsonMaterialNames[i], static_cast<uint>(i));
+    materialNames.push_back(jsonMaterialNames[i]);
   }
 
   std::size_t total = 0;
