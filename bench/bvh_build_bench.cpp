@@ -287,6 +287,28 @@ void benchmarkMesh(const std::string& title, const std::vector<Triangle>& triang
   }
 }
 
+// --quick: only the one-thread PLOC and binned-SAH builds, alternated `runs` times; the
+// least wall time of each and their ratio (for comparing changes to the builders quickly).
+void quickMesh(const std::string& title, const std::vector<Triangle>& triangles, int runs) {
+  double best[2] = {INFINITY, INFINITY};
+  const BvhBuilder builders[2] = {BvhBuilder::kPloc, BvhBuilder::kBinnedSah};
+  double sah[2] = {0, 0};
+  for (int run = 0; run < runs; ++run) {
+    for (int b = 0; b < 2; ++b) {
+      BvhBuildOptions options;
+      options.builder = builders[b];
+      options.threads = 1;
+      std::vector<Triangle> input = triangles;
+      const auto start = Clock::now();
+      Bvh bvh = buildBvh(std::move(input), options);
+      best[b] = std::min(best[b], secondsSince(start));
+      sah[b] = bvh.sahCost;
+    }
+  }
+  std::printf("%-8s ploc %8.2f ms  sah %8.2f ms  ploc/sah %.3f  sah_cost ratio %.4f\n",
+              title.c_str(), best[0] * 1e3, best[1] * 1e3, best[0] / best[1], sah[0] / sah[1]);
+}
+
 }  // namespace
 }  // namespace pt
 
@@ -300,7 +322,17 @@ int main(int argc, char** argv) {
   app.add_option("--runs", runs, "Timed runs per measurement (the median is shown)")
       ->check(CLI::Range(1, 100));
   app.add_option("--rays", rays, "Rays per ray set")->check(CLI::Range(1, 100000000));
+  bool quick = false;
+  app.add_flag("--quick", quick, "Only one-thread PLOC and binned-SAH build times (least of runs)");
   CLI11_PARSE(app, argc, argv);
+  if (quick) {
+    pt::quickMesh("sphere", pt::uvSphere(726, 725), runs);
+    for (const auto& [name, type, file] :
+         {std::tuple{"bunny", "obj", bunny}, std::tuple{"dragon", "ply", dragon}}) {
+      if (const auto mesh = pt::loadMesh(type, file)) pt::quickMesh(name, *mesh, runs);
+    }
+    return 0;
+  }
 
   std::printf(
       "BVH build benchmark: median of %d runs; build_ms is wall time of buildBvh (or of\n"

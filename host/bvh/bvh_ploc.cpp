@@ -32,6 +32,9 @@ namespace {
 constexpr int kSkipBits = 30;
 // Neighbours looked at on either side. The paper finds quality close to saturated by r = 16
 // (its Figure 6); larger windows cost build time for little gain.
+// (Measured here: r = 8 builds about 5 % faster, with about 4 % more nodes and a 1 % higher
+// SAH cost, and primary rays traced a few per cent slower in noisy measurements, so r stays
+// at 16.)
 constexpr size_t kRadius = 16;
 // Clusters per chunk of a parallel loop.
 constexpr size_t kChunk = size_t(1) << 12;
