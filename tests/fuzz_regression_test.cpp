@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "common/check.h"
 #include "fuzz/fuzz_entry.h"
+#include "image/image.h"
 
 namespace pt {
 namespace {
@@ -42,6 +44,20 @@ TEST(FuzzRegressions, EveryFoundInputIsAcceptedOrRefusedCleanly) {
   const fs::path root = kSource / "tests" / "data" / "fuzz-regressions";
   ASSERT_TRUE(fs::is_directory(root));
   replay(root);
+}
+
+// The image fuzzer's out-of-memory: a 102-byte PNG whose IDAT chunk claims 2 GiB made
+// stb_image reserve that much before reading. The chunk walk refuses it first.
+TEST(FuzzRegressions, PngChunkLongerThanTheFileIsRefusedBeforeDecoding) {
+  const fs::path png = kSource / "tests/data/fuzz-regressions/image/idat-length-2gib.png";
+  try {
+    readImage(png);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("idat-length-2gib.png: PNG chunk '"), std::string::npos) << m;
+    EXPECT_NE(m.find("bytes, but the file ends at byte 102"), std::string::npos) << m;
+  }
 }
 
 TEST(FuzzRegressions, SeedCorporaAreAcceptedOrRefusedCleanly) {

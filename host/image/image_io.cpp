@@ -360,8 +360,31 @@ Bytes encodePng(const Image& image, const fs::path& path) {
   return png;
 }
 
+// Walks a PNG's chunks and refuses one whose length runs past the end of the file. stb_image
+// reserves memory for an IDAT chunk's declared length before it reads the data, so a
+// 100-byte file claiming a 2 GiB chunk made it allocate 2 GiB (found by fuzzing).
+void checkPngChunks(const Bytes& data, const fs::path& path) {
+  constexpr size_t kSignature = 8;
+  size_t at = kSignature;
+  while (at + 8 <= data.size()) {
+    const uint64_t length = uint64_t(data[at]) << 24 | uint64_t(data[at + 1]) << 16 |
+                            uint64_t(data[at + 2]) << 8 | uint64_t(data[at + 3]);
+    const std::string type(reinterpret_cast<const char*>(&data[at + 4]), 4);
+    if (at + 12 + length > data.size()) {
+      std::string printable;
+      for (char c : type) printable += std::isalpha(static_cast<unsigned char>(c)) ? c : '?';
+      fail(path, "PNG chunk '" + printable + "' at byte " + std::to_string(at) + " claims " +
+                     std::to_string(length) + " bytes, but the file ends at byte " +
+                     std::to_string(data.size()));
+    }
+    if (type == "IEND") return;
+    at += 12 + length;
+  }
+}
+
 Image decodePng(const Bytes& data, const fs::path& path) {
   if (data.size() > size_t(INT_MAX)) fail(path, "PNG file too large");
+  checkPngChunks(data, path);
   const int size = int(data.size());
   int width = 0, height = 0, channelsInFile = 0;
   // The header's size is checked before decoding: deflate expands at most 1032:1, so a PNG
