@@ -382,9 +382,29 @@ void checkPngChunks(const Bytes& data, const fs::path& path) {
   }
 }
 
-Image decodePng(const Bytes& data, const fs::path& path) {
-  if (data.size() > size_t(INT_MAX)) fail(path, "PNG file too large");
-  checkPngChunks(data, path);
+// The PNG without its empty IDAT chunks: they are legal, but stb_image copies from a null
+// buffer for one that comes first (undefined behaviour, found by fuzzing under UBSan).
+Bytes withoutEmptyIdat(const Bytes& data) {
+  constexpr size_t kSignature = 8;
+  Bytes out(data.begin(), data.begin() + std::ptrdiff_t(std::min(data.size(), kSignature)));
+  size_t at = kSignature;
+  while (at + 12 <= data.size()) {
+    const size_t length = size_t(data[at]) << 24 | size_t(data[at + 1]) << 16 |
+                          size_t(data[at + 2]) << 8 | size_t(data[at + 3]);
+    const size_t end = std::min(data.size(), at + 12 + length);  // checkPngChunks: in range
+    const bool emptyIdat = length == 0 && std::equal(&data[at + 4], &data[at + 8], "IDAT");
+    if (!emptyIdat)
+      out.insert(out.end(), data.begin() + std::ptrdiff_t(at), data.begin() + std::ptrdiff_t(end));
+    at = end;
+  }
+  out.insert(out.end(), data.begin() + std::ptrdiff_t(std::min(at, data.size())), data.end());
+  return out;
+}
+
+Image decodePng(const Bytes& original, const fs::path& path) {
+  if (original.size() > size_t(INT_MAX)) fail(path, "PNG file too large");
+  checkPngChunks(original, path);
+  const Bytes data = withoutEmptyIdat(original);
   const int size = int(data.size());
   int width = 0, height = 0, channelsInFile = 0;
   // The header's size is checked before decoding: deflate expands at most 1032:1, so a PNG
