@@ -8,8 +8,8 @@
 #extension GL_EXT_debug_printf : enable
 #endif
 
-#include "shared_types.h"
 #include "sampling.h"
+#include "shared_types.h"
 
 layout(local_size_x = kWorkgroupSize, local_size_y = kWorkgroupSize) in;
 

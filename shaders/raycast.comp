@@ -4,8 +4,8 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
-#include "shared_types.h"
 #include "sampling.h"
+#include "shared_types.h"
 
 layout(local_size_x = kRaycastWorkgroupSize) in;
 

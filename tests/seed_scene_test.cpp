@@ -16,8 +16,10 @@ namespace pt {
 namespace {
 
 TEST(SeedScene, BunnyAndDragonRenderAndAgreeOnBothBackends) {
-  const std::filesystem::path dragon = std::filesystem::path(PT_SOURCE_DIR) / "assets/dragon_vrip.ply";
-  ASSERT_TRUE(std::filesystem::exists(dragon)) << dragon << " is missing: run tools/fetch-assets.sh";
+  const std::filesystem::path dragon =
+      std::filesystem::path(PT_SOURCE_DIR) / "assets/dragon_vrip.ply";
+  ASSERT_TRUE(std::filesystem::exists(dragon))
+      << dragon << " is missing: run tools/fetch-assets.sh";
   const Scene scene = loadScene(test::kConfigs / "bunny-dragon.json");
   // 6 quads of the box, the bunny and the dragon (less its zero-area triangles, with a warning).
   EXPECT_GT(scene.triangles.size(), 12u + 69666u + 871000u);

@@ -360,11 +360,16 @@ Bytes encodePng(const Image& image, const fs::path& path) {
   return png;
 }
 
-// Walks a PNG's chunks and refuses one whose length runs past the end of the file. stb_image
-// reserves memory for an IDAT chunk's declared length before it reads the data, so a
-// 100-byte file claiming a 2 GiB chunk made it allocate 2 GiB (found by fuzzing).
-void checkPngChunks(const Bytes& data, const fs::path& path) {
+// One walk over a PNG's chunks before stb_image sees them (both found by fuzzing):
+//  - a chunk whose length runs past the end of the file is refused: stb_image reserves an
+//    IDAT chunk's declared length before reading it, so a 100-byte file claiming 2 GiB made
+//    it allocate 2 GiB;
+//  - empty IDAT chunks, which are legal, are dropped: stb_image copies from a null buffer
+//    for one that comes first (undefined behaviour).
+// Returns the file without its empty IDAT chunks.
+Bytes checkedPngChunks(const Bytes& data, const fs::path& path) {
   constexpr size_t kSignature = 8;
+  Bytes out(data.begin(), data.begin() + std::ptrdiff_t(std::min(data.size(), kSignature)));
   size_t at = kSignature;
   while (at + 8 <= data.size()) {
     const uint64_t length = uint64_t(data[at]) << 24 | uint64_t(data[at + 1]) << 16 |
@@ -377,25 +382,12 @@ void checkPngChunks(const Bytes& data, const fs::path& path) {
                      std::to_string(length) + " bytes, but the file ends at byte " +
                      std::to_string(data.size()));
     }
-    if (type == "IEND") return;
-    at += 12 + length;
-  }
-}
-
-// The PNG without its empty IDAT chunks: they are legal, but stb_image copies from a null
-// buffer for one that comes first (undefined behaviour, found by fuzzing under UBSan).
-Bytes withoutEmptyIdat(const Bytes& data) {
-  constexpr size_t kSignature = 8;
-  Bytes out(data.begin(), data.begin() + std::ptrdiff_t(std::min(data.size(), kSignature)));
-  size_t at = kSignature;
-  while (at + 12 <= data.size()) {
-    const size_t length = size_t(data[at]) << 24 | size_t(data[at + 1]) << 16 |
-                          size_t(data[at + 2]) << 8 | size_t(data[at + 3]);
-    const size_t end = std::min(data.size(), at + 12 + length);  // checkPngChunks: in range
-    const bool emptyIdat = length == 0 && std::equal(&data[at + 4], &data[at + 8], "IDAT");
-    if (!emptyIdat)
+    const size_t end = at + 12 + size_t(length);
+    if (!(length == 0 && type == "IDAT")) {
       out.insert(out.end(), data.begin() + std::ptrdiff_t(at), data.begin() + std::ptrdiff_t(end));
+    }
     at = end;
+    if (type == "IEND") break;
   }
   out.insert(out.end(), data.begin() + std::ptrdiff_t(std::min(at, data.size())), data.end());
   return out;
@@ -403,8 +395,7 @@ Bytes withoutEmptyIdat(const Bytes& data) {
 
 Image decodePng(const Bytes& original, const fs::path& path) {
   if (original.size() > size_t(INT_MAX)) fail(path, "PNG file too large");
-  checkPngChunks(original, path);
-  const Bytes data = withoutEmptyIdat(original);
+  const Bytes data = checkedPngChunks(original, path);
   const int size = int(data.size());
   int width = 0, height = 0, channelsInFile = 0;
   // The header's size is checked before decoding: deflate expands at most 1032:1, so a PNG

@@ -100,7 +100,8 @@ std::vector<MtlMaterial> loadMtlMaterials(const std::string& text, const std::st
     }
     if (!m.diffuse_texname.empty() || !m.specular_texname.empty() || !m.bump_texname.empty() ||
         !m.alpha_texname.empty() || !m.emissive_texname.empty()) {
-      out.warnings.push_back(prefix + "texture maps are not simulated; the constant colours are used");
+      out.warnings.push_back(prefix +
+                             "texture maps are not simulated; the constant colours are used");
     }
     result.push_back(std::move(out));
   }
