@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libglm-dev libstb-dev nlohmann-json3-dev libtinyobjloader-dev libtinyexr-dev libcli11-dev
   libgtest-dev clang libfuzzer-14-dev
-  libembree-dev embree-tools libbenchmark-dev libhwy-dev linux-perf
+  libembree-dev embree-tools libbenchmark-dev libhwy-dev
   libvulkan-dev mesa-vulkan-drivers glslang-tools spirv-tools vulkan-validationlayers vulkan-tools
   glmark2-data gnuplot-nox
 )
