@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "common/check.h"
@@ -93,8 +94,36 @@ TEST(MemoryLimit, HugeFilmIsRefusedBeforeAllocating) {
                (test::kConfigs / "cornell-box.json").string() +
                " --backend cpu --spp 1 --width 16384 --height 16384 --out " + out + " >/dev/null");
   EXPECT_EQ(r.status, kExitInputError) << r.err;
-  EXPECT_NE(r.err.find("a 16384x16384 film needs "), std::string::npos) << r.err;
+  // The line names the scene and that the size came from the options.
+  EXPECT_NE(r.err.find("cornell-box.json: with --width/--height, a 16384x16384 film needs "),
+            std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("bytes per pixel), but only "), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+#endif
+}
+
+TEST(MemoryLimit, HugeFilmFromTheSceneNamesTheScene) {
+#ifdef PT_TEST_ASAN
+  GTEST_SKIP() << "ulimit -v does not work under AddressSanitizer";
+#else
+  // The size written in the scene file (16384 is the most it accepts): refused before the BVH
+  // build under a 2 GiB address-space limit, naming the file.
+  const test::TempDir dir;
+  std::ifstream in(test::kConfigs / "cornell-box.json");
+  std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const std::string key : {"\"width\": 256", "\"height\": 256"}) {
+    const size_t at = json.find(key);
+    ASSERT_NE(at, std::string::npos) << key;
+    json.replace(at, key.size(), key.substr(0, key.size() - 3) + "16384");
+  }
+  const std::string scene = dir.write("huge.json", json).string();
+  const std::string out = (dir / "huge.exr").string();
+  const ShellRun r = runShell("ulimit -v 2097152 && " + std::string(PT_BINARY) + " render " +
+                              scene + " --backend cpu --spp 1 --out " + out + " >/dev/null");
+  EXPECT_EQ(r.status, kExitInputError) << r.err;
+  EXPECT_NE(r.err.find("huge.json: a 16384x16384 film needs "), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(std::filesystem::exists(out));
 #endif

@@ -139,6 +139,11 @@ int runRender(const RenderArgs& args) {
 
   RenderSettings settings = args.overrides.toSettings();
   settings.spp = args.spp;  // unset: the scene's
+  // A film too large for memory is refused before the BVH build and the device start-up, with
+  // the file (or the options) it came from.
+  Film::checkFitsInMemory(
+      settings.width.value_or(scene.camera.width), settings.height.value_or(scene.camera.height),
+      args.scene + (settings.width || settings.height ? ": with --width/--height, " : ": "));
   const SceneData data = prepareScene(std::move(scene), settings);
 
   const Camera& cam = data.params.camera;

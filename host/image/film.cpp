@@ -2,24 +2,30 @@
 
 #include "image/image.h"
 
+#include <algorithm>
 #include <string>
 
 #include "common/memory.h"
 
 namespace pt {
 
-Film::Film(int w, int h) : width(w), height(h) {
-  PT_CHECK(w >= 0 && h >= 0, "film size must not be negative");
-  const size_t n = size_t(w) * size_t(h);
+void Film::checkFitsInMemory(int w, int h, const std::string& what) {
   // Refused with the numbers before allocating, not killed by the OOM killer halfway. The
   // resolved Image is counted too: it is allocated while the film is alive.
   constexpr size_t kBytesPerPixel =
       sizeof(decltype(sum)::value_type) + sizeof(decltype(sampleCount)::value_type) +
       sizeof(decltype(invalidCount)::value_type) + sizeof(decltype(exact)::value_type) +
       sizeof(decltype(Image::pixels)::value_type);
-  checkFitsInMemory(uint64_t(n) * kBytesPerPixel,
-                    "a " + std::to_string(w) + "x" + std::to_string(h) + " film",
-                    std::to_string(kBytesPerPixel) + " bytes per pixel");
+  const uint64_t n = uint64_t(std::max(w, 0)) * uint64_t(std::max(h, 0));
+  pt::checkFitsInMemory(n * kBytesPerPixel,
+                        what + "a " + std::to_string(w) + "x" + std::to_string(h) + " film",
+                        std::to_string(kBytesPerPixel) + " bytes per pixel");
+}
+
+Film::Film(int w, int h) : width(w), height(h) {
+  PT_CHECK(w >= 0 && h >= 0, "film size must not be negative");
+  const size_t n = size_t(w) * size_t(h);
+  checkFitsInMemory(w, h);
   sum.assign(n, glm::dvec3(0.0));
   sampleCount.assign(n, 0);
   invalidCount.assign(n, 0);

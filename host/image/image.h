@@ -92,6 +92,12 @@ struct Film {
   Film() = default;
   Film(int w, int h);
 
+  // Throws InputError "<what>a WxH film needs N GiB (...), but only M GiB of memory is
+  // available" when a w x h film (and the image resolved from it) cannot fit in memory: the
+  // constructor checks, and a caller that knows where the size came from checks first, so that
+  // its error names the file (`what`, e.g. "scene.json: ") and nothing has been built yet.
+  static void checkFitsInMemory(int w, int h, const std::string& what = "");
+
   // Inline because it runs once per sample. Threads may call it concurrently for disjoint
   // pixels: it touches only pixel (x, y) and takes no lock.
   void add(int x, int y, glm::vec3 radiance) {
