@@ -387,6 +387,26 @@ TEST_F(ImageErrors, MalformedExrAndPngNameThePath) {
   }
 }
 
+TEST_F(ImageErrors, ExrWhoseDataWindowClaimsTooMuchIsRefusedBeforeDecoding) {
+  // A valid 4x4 ZIP-compressed EXR whose dataWindow attribute is edited to claim 8,000,000 x
+  // 1000 pixels (tinyexr accepts up to 8M per side and would allocate 96 GB): refused from the
+  // header, as more than its bytes can hold, without decoding.
+  writeImage(Image(4, 4), dir_ / "small.exr");
+  std::string bytes = readFile(dir_ / "small.exr");
+  const std::string attribute("dataWindow\0box2i\0", 17);
+  const size_t at = bytes.find(attribute);
+  ASSERT_NE(at, std::string::npos);
+  const size_t box = at + attribute.size() + 4;        // after the attribute's 4-byte size
+  const int32_t claimed[4] = {0, 0, 7999999, 999};     // min x, min y, max x, max y
+  std::memcpy(&bytes[box], claimed, sizeof(claimed));  // EXR is little-endian, like x86
+  const fs::path path = dir_ / "huge-window.exr";
+  writeBytes(path, bytes);
+  const std::string message = inputErrorOf([&] { readImage(path); });
+  expectMessageStartsWithPath(message, path);
+  EXPECT_NE(message.find("header says 8000000x1000 pixels, more than"), std::string::npos)
+      << message;
+}
+
 TEST_F(ImageErrors, UnknownExtensionNamesTheFile) {
   const Image image(2, 2);
   for (const char* name : {"x.bmp", "x.jpg", "noextension"}) {

@@ -284,6 +284,34 @@ Image decodeExr(const Bytes& data, const fs::path& path) {
            "subsampled channel '" + std::string(header.channels[c].name) + "' is not supported");
     }
   }
+  // The declared data window is checked before tinyexr allocates it, as for PNG: with no, RLE
+  // or ZIP compression the channels cannot expand more than deflate's 1032:1 (RLE: 64:1), so a
+  // header claiming more than that is corrupt; with any compression the decoded planes (4
+  // bytes per channel once halves are widened) and the float image must fit in memory.
+  {
+    const EXRBox2i& window = header.data_window;
+    const uint64_t width = uint64_t(int64_t(window.max_x) - int64_t(window.min_x) + 1);
+    const uint64_t height = uint64_t(int64_t(window.max_y) - int64_t(window.min_y) + 1);
+    if (window.max_x < window.min_x || window.max_y < window.min_y) {
+      fail(path, "EXR data window is empty");
+    }
+    uint64_t storedBytesPerPixel = 0;
+    for (int c = 0; c < header.num_channels; ++c) {
+      storedBytesPerPixel += header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF ? 2 : 4;
+    }
+    const std::string size = std::to_string(width) + "x" + std::to_string(height);
+    const int compression = header.compression_type;
+    const bool boundedRatio =
+        compression == TINYEXR_COMPRESSIONTYPE_NONE || compression == TINYEXR_COMPRESSIONTYPE_RLE ||
+        compression == TINYEXR_COMPRESSIONTYPE_ZIPS || compression == TINYEXR_COMPRESSIONTYPE_ZIP;
+    if (boundedRatio && width * height * storedBytesPerPixel / 1032 > data.size()) {
+      fail(path, "header says " + size + " pixels, more than " + std::to_string(data.size()) +
+                     " bytes of EXR can hold");
+    }
+    checkFitsInMemory(width * height * (4 * uint64_t(header.num_channels) + sizeof(glm::vec3)),
+                      path.string() + ": a " + size + " EXR",
+                      "decoded channels and the float image");
+  }
   // Half channels are widened to float while loading; float and uint are read as stored.
   for (int c = 0; c < header.num_channels; ++c) {
     if (header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) {
@@ -393,6 +421,12 @@ Bytes checkedPngChunks(const Bytes& data, const fs::path& path) {
   return out;
 }
 
+// stb_image's reason for the last failure; it may have none (a null pointer).
+std::string stbReason() {
+  const char* reason = stbi_failure_reason();
+  return reason && *reason ? reason : "corrupt or unsupported data";
+}
+
 Image decodePng(const Bytes& original, const fs::path& path) {
   if (original.size() > size_t(INT_MAX)) fail(path, "PNG file too large");
   const Bytes data = checkedPngChunks(original, path);
@@ -419,7 +453,7 @@ Image decodePng(const Bytes& original, const fs::path& path) {
   if (stbi_is_16_bit_from_memory(data.data(), size)) {
     stbi_us* pixels =
         stbi_load_16_from_memory(data.data(), size, &width, &height, &channelsInFile, 3);
-    if (!pixels) fail(path, std::string("cannot decode PNG: ") + stbi_failure_reason());
+    if (!pixels) fail(path, "cannot decode PNG: " + stbReason());
     Image image(width, height);
     for (size_t i = 0; i < image.pixels.size(); ++i) {
       for (int c = 0; c < 3; ++c) {
@@ -430,7 +464,7 @@ Image decodePng(const Bytes& original, const fs::path& path) {
     return image;
   }
   stbi_uc* pixels = stbi_load_from_memory(data.data(), size, &width, &height, &channelsInFile, 3);
-  if (!pixels) fail(path, std::string("cannot decode PNG: ") + stbi_failure_reason());
+  if (!pixels) fail(path, "cannot decode PNG: " + stbReason());
   float table[256];
   for (int v = 0; v < 256; ++v) table[v] = float(decodeSrgb(v / 255.0));
   Image image(width, height);
