@@ -2,8 +2,6 @@
 // our builders next to Embree 3's own BVH build on the same triangles in the same run, and
 // the SAH cost and CPU trace speed of our trees, on a generated UV sphere of about 1.05M
 // triangles, the Stanford bunny and the Stanford dragon.
-#include <embree3/rtcore.h>
-
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
@@ -22,48 +20,20 @@
 
 #include <unistd.h>
 
+#include "bench_util.h"
 #include "bvh/bvh.h"
 #include "bvh/traverse.h"
 #include "common/check.h"
+#include "embree_scene.h"
 #include "scene/scene.h"
 
 namespace pt {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
-
-// A UV sphere: `rings` bands of latitude, `segments` of longitude, two triangles per quad
-// and one per quad at the poles: 2 * segments * (rings - 1) triangles.
-std::vector<Triangle> uvSphere(int rings, int segments) {
-  auto vertex = [&](int ring, int segment) {
-    const double theta = kPi * double(ring) / double(rings);
-    const double phi = 2.0 * kPi * double(segment % segments) / double(segments);
-    return vec3(float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
-                float(std::sin(theta) * std::sin(phi)));
-  };
-  std::vector<Triangle> triangles;
-  auto add = [&](vec3 a, vec3 b, vec3 c) {
-    triangles.push_back(Triangle{a, 0, b, kNoEmitter, c, uint(triangles.size())});
-  };
-  for (int ring = 0; ring < rings; ++ring) {
-    for (int segment = 0; segment < segments; ++segment) {
-      const vec3 a = vertex(ring, segment), b = vertex(ring, segment + 1);
-      const vec3 c = vertex(ring + 1, segment), d = vertex(ring + 1, segment + 1);
-      if (ring > 0) add(a, c, b);
-      if (ring < rings - 1) add(b, c, d);
-    }
-  }
-  return triangles;
-}
+using bench::Clock;
+using bench::median;
+using bench::secondsSince;
+using bench::uvSphere;
 
 // The triangles of a mesh file, through the scene loader (which drops zero-area triangles);
 // nothing when the file is absent.
@@ -79,55 +49,21 @@ std::optional<std::vector<Triangle>> loadMesh(const std::string& type, const std
   return triangles;
 }
 
-// Embree's own BVH build: a scene with one triangle geometry (float3 vertices, uint3
-// indices), committed with the defaults: RTC_BUILD_QUALITY_MEDIUM (binned SAH) and Embree's
-// task system on every hardware thread.
+// Embree's own BVH build (bench/embree_scene.h): one triangle geometry, Embree's defaults.
 class EmbreeBuild {
  public:
-  EmbreeBuild() : device_(rtcNewDevice(nullptr)) {
-    PT_CHECK(device_ != nullptr, "rtcNewDevice failed");
-    rtcSetDeviceErrorFunction(
-        device_,
-        [](void*, RTCError code, const char* message) {
-          std::fprintf(stderr, "embree error %d: %s\n", int(code), message);
-        },
-        nullptr);
-  }
-  ~EmbreeBuild() { rtcReleaseDevice(device_); }
-  EmbreeBuild(const EmbreeBuild&) = delete;
-  EmbreeBuild& operator=(const EmbreeBuild&) = delete;
-
   // Seconds from creating the scene to the end of rtcCommitScene (filling the buffers
   // included, as our builders' time includes reading the triangles).
   double build(const std::vector<Triangle>& triangles) {
     const auto start = Clock::now();
-    RTCScene scene = rtcNewScene(device_);
-    RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    const size_t n = triangles.size();
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
-    auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), n));
-    for (size_t i = 0; i < n; ++i) {
-      const Triangle& t = triangles[i];
-      for (int k = 0; k < 3; ++k) {
-        vertices[9 * i + 0 + size_t(k)] = t.v0[k];
-        vertices[9 * i + 3 + size_t(k)] = t.v1[k];
-        vertices[9 * i + 6 + size_t(k)] = t.v2[k];
-        indices[3 * i + size_t(k)] = uint32_t(3 * i + size_t(k));
-      }
-    }
-    rtcCommitGeometry(geometry);
-    rtcAttachGeometry(scene, geometry);
-    rtcReleaseGeometry(geometry);
-    rtcCommitScene(scene);
+    RTCScene scene = bench::newEmbreeScene(device_.get(), triangles);
     const double seconds = secondsSince(start);
     rtcReleaseScene(scene);
     return seconds;
   }
 
  private:
-  RTCDevice device_;
+  bench::EmbreeDevice device_;
 };
 
 // Shadow rays end this far along their direction, short of the point they aim at.
