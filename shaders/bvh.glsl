@@ -1,10 +1,40 @@
-// GLSL ray queries on the flat BVH: watertight ray/triangle intersection (Woop, Benthin and
+// GLSL ray queries on the BVH: watertight ray/triangle intersection (Woop, Benthin and
 // Wald 2013), the slab test with Ize's (2013) widened far distance, and iterative traversal
 // with a fixed stack, near child first, closest-hit and any-hit. The same algorithms as
-// host/bvh/traverse.cpp, written for the GPU; the constants kMinDirection and kFarScale come
-// from sampling.h, shared with it. Expects sampling.h, the buffers `nodes` and `triangles`,
-// the globals `gLoopIterations` and `gTruncated`, and PT_WATERTIGHT (a boolean expression) to
-// be declared by the including shader.
+// host/bvh/traverse.cpp, written for the GPU on the GPU's layout of the same tree
+// (GpuBvhNode, host/vulkan/gpu_bvh.h); the constants kMinDirection and kFarScale come from
+// sampling.h, shared with it. Expects sampling.h, the texel buffers `nodeTexels` and
+// `triangleTexels`, the globals `gLoopIterations` and `gTruncated`, and PT_WATERTIGHT (a
+// boolean expression) to be declared by the including shader.
+//
+// Written for lavapipe as much as for GPUs: lavapipe runs eight invocations in the lanes of
+// one vector and runs every statement of a loop body on every iteration, both sides of each
+// branch with the lanes that did not take it masked off, so what a loop iteration costs is
+// all the code in its body, whatever each lane needs; what a fetch costs is how lavapipe
+// gathers it (see PT_BINDING_NODES in shared_types.h).
+
+// The structs from their 16-byte rows, fetched as texels (see PT_BINDING_NODES): row k
+// holds the struct's members 2k and 2k + 1, a vec3 and a 4-byte scalar, as
+// host/common/shared.h checks on the C++ side; the constructors take the members in
+// declaration order.
+GpuBvhNode loadNode(uint i) {
+  int at = int(4u * i);
+  uvec4 a = texelFetch(nodeTexels, at);
+  uvec4 b = texelFetch(nodeTexels, at + 1);
+  uvec4 c = texelFetch(nodeTexels, at + 2);
+  uvec4 d = texelFetch(nodeTexels, at + 3);
+  return GpuBvhNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
+                    uintBitsToFloat(c.xyz), c.w, uintBitsToFloat(d.xyz), d.w);
+}
+
+Triangle loadTriangle(uint i) {
+  int at = int(3u * i);
+  uvec4 a = texelFetch(triangleTexels, at);
+  uvec4 b = texelFetch(triangleTexels, at + 1);
+  uvec4 c = texelFetch(triangleTexels, at + 2);
+  return Triangle(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
+                  uintBitsToFloat(c.xyz), c.w);
+}
 
 struct RayData {
   vec3 origin;
@@ -17,7 +47,7 @@ struct RayData {
 struct HitData {
   float t;
   vec3 barycentrics;  // weights of v0, v1, v2
-  uint triangle;      // index into `triangles`
+  uint triangle;      // index into the triangle buffer (leaf order)
 };
 
 float safeInverse(float d) {
@@ -46,7 +76,11 @@ RayData prepareRay(vec3 origin, vec3 direction) {
 }
 
 // Watertight test, both faces, 0 < t < tMax. `precise` forbids fused multiply-adds, which
-// would evaluate a shared edge differently for its two triangles and open cracks.
+// would evaluate a shared edge differently for its two triangles and open cracks. The
+// rejections are combined into the returned condition rather than taken as early returns
+// (each a masked branch on lavapipe), so `hit` means something only when it returns true;
+// the values computed, and so the answer, are those of host/bvh/traverse.cpp, operation for
+// operation. The rare recomputation in double stays a branch, which GPUs skip.
 bool intersectTriangle(RayData r, Triangle tri, float tMax, out HitData hit) {
   precise vec3 a = tri.v0 - r.origin;
   precise vec3 b = tri.v1 - r.origin;
@@ -66,18 +100,17 @@ bool intersectTriangle(RayData r, Triangle tri, float tMax, out HitData hit) {
     v = float(double(ax) * double(cy) - double(ay) * double(cx));
     w = float(double(bx) * double(ay) - double(by) * double(ax));
   }
-  if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) return false;
+  bool mixed = (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
   precise float det = u + v + w;
-  if (det == 0.0) return false;
   precise float az = r.sz * a[r.kz];
   precise float bz = r.sz * b[r.kz];
   precise float cz = r.sz * c[r.kz];
   precise float t = u * az + v * bz + w * cz;
-  if (det > 0.0 ? (t <= 0.0 || t >= tMax * det) : (t >= 0.0 || t <= tMax * det)) return false;
+  bool outside = det > 0.0 ? (t <= 0.0 || t >= tMax * det) : (t >= 0.0 || t <= tMax * det);
   float invDet = 1.0 / det;
   hit.t = t * invDet;
   hit.barycentrics = vec3(u, v, w) * invDet;
-  return true;
+  return !mixed && det != 0.0 && !outside;
 }
 
 // Moller and Trumbore (1997): fewer operations, not watertight. Only for measuring what
@@ -113,66 +146,88 @@ bool intersectBox(RayData r, vec3 lo, vec3 hi, float tMax, out float tNear) {
   return enter <= exit;
 }
 
-// Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax. Every loop records how it
-// ended: one that ends other than by its own break or return was cut short by lavapipe's
-// silent loop-iteration cap, and sets gTruncated.
+// Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax. The leaves are tested in
+// the binary traversal's order (host/bvh/traverse.cpp: near child first, the left one on a
+// tie; a child pushed is visited without testing its box again), each box against the
+// closest hit found by then, so the answer is the binary traversal's: the same distance and,
+// where two hits tie, the same triangle. One loop iteration visits an interior node (one
+// fetch serves both children's boxes), then tests the leaf it chose, if any, at once, with
+// the sibling leaf when that is the next to visit, and pops the next thing to visit when
+// nothing is left here. Every loop records how it ended: one that ends other than by its own
+// break was cut short by lavapipe's silent loop-iteration cap, and sets gTruncated.
 bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData best) {
   RayData r = prepareRay(origin, direction);
   best.t = tMax;
   best.barycentrics = vec3(0.0);
   best.triangle = 0u;
   float tNear;
-  if (!intersectBox(r, nodes[0].boundsMin, nodes[0].boundsMax, tMax, tNear)) return false;
-  uint stack[kBvhStackSize];
+  // Node 0 holds the root's box and reference.
+  GpuBvhNode root = loadNode(0u);
+  if (!intersectBox(r, root.leftMin, root.leftMax, tMax, tNear)) return false;
+  // One entry more than the deepest tree pushes: the slot above the top is written on every
+  // iteration (see the push below).
+  uint stack[kBvhStackSize + 1u];
   uint stackSize = 0u;
-  uint nodeIndex = 0u;
+  uint ref = root.left;  // what to visit next: an interior node or a leaf, never 0 here
   bool found = false;
-  bool complete = false;
   for (;;) {
     gLoopIterations++;
-    BvhNode node = nodes[nodeIndex];
-    if (node.count > 0u) {
-      // Leaf: test its triangles, shrinking the search range as hits are found.
-      uint i = node.offset;
-      uint end = node.offset + node.count;
-      for (; i < end; ++i) {
-        gLoopIterations++;
-        HitData hit;
-        bool hitTriangle = PT_WATERTIGHT ? intersectTriangle(r, triangles[i], best.t, hit)
-                                         : intersectTriangleFast(r, triangles[i], best.t, hit);
-        if (hitTriangle) {
-          hit.triangle = i;
-          best = hit;
-          found = true;
-          if (anyHit) return true;
-        }
-      }
-      if (i < end) gTruncated = true;
-    } else {
-      // Interior: visit the nearer child that the ray enters, push the other.
-      uint left = nodeIndex + 1u;
-      uint right = node.offset;
+    uint near = ref;  // to go on with: an interior node, a leaf, or 0 for none
+    uint far = 0u;    // to visit after near and everything below it, or 0
+    if ((ref & kGpuBvhLeaf) == 0u) {
+      // Interior: the children that the ray enters, nearer first.
+      GpuBvhNode node = loadNode(ref);
       float tLeft, tRight;
-      bool hitLeft = intersectBox(r, nodes[left].boundsMin, nodes[left].boundsMax, best.t, tLeft);
-      bool hitRight =
-          intersectBox(r, nodes[right].boundsMin, nodes[right].boundsMax, best.t, tRight);
-      if (hitLeft && hitRight) {
-        bool leftFirst = tLeft <= tRight;
-        stack[stackSize++] = leftFirst ? right : left;
-        nodeIndex = leftFirst ? left : right;
-        continue;
-      }
-      if (hitLeft || hitRight) {
-        nodeIndex = hitLeft ? left : right;
-        continue;
-      }
+      bool hitLeft = intersectBox(r, node.leftMin, node.leftMax, best.t, tLeft);
+      bool hitRight = intersectBox(r, node.rightMin, node.rightMax, best.t, tRight);
+      bool leftFirst = hitLeft && (!hitRight || tLeft <= tRight);
+      near = hitLeft || hitRight ? (leftFirst ? node.left : node.right) : 0u;
+      far = hitLeft && hitRight ? (leftFirst ? node.right : node.left) : 0u;
     }
-    if (stackSize == 0u) {
-      complete = true;
-      break;
+    // A leaf to go on with is tested in this iteration, and so is the far child when it is a
+    // leaf too, as it is the next thing the binary traversal visits: up to two ranges of
+    // triangles. An interior far child of a leaf is visited next, without a push.
+    uint first = 0u, count = 0u, first2 = 0u, count2 = 0u;
+    if ((near & kGpuBvhLeaf) != 0u) {
+      first = (near & ~kGpuBvhLeaf) >> kGpuBvhCountBits;
+      count = near & kGpuBvhMaxLeafCount;
+      if ((far & kGpuBvhLeaf) != 0u) {
+        first2 = (far & ~kGpuBvhLeaf) >> kGpuBvhCountBits;
+        count2 = far & kGpuBvhMaxLeafCount;
+        far = 0u;
+      }
+      near = far;
+      far = 0u;
     }
-    nodeIndex = stack[--stackSize];
+    // The push, as a store on every iteration into the slot above the top, which counts only
+    // when there is something to push: lavapipe stores to a different index per lane lane by
+    // lane, with a branch on each lane's mask, and the loop's mask is far easier to predict
+    // than whether a node pushes.
+    stack[stackSize] = far;
+    if (far != 0u) stackSize++;
+    // The leaves' triangles in order, shrinking the search range as hits are found.
+    uint k = 0u;
+    for (; k < count + count2; ++k) {
+      gLoopIterations++;
+      uint i = k < count ? first + k : first2 + (k - count);
+      HitData hit;
+      bool hitTriangle = PT_WATERTIGHT ? intersectTriangle(r, loadTriangle(i), best.t, hit)
+                                       : intersectTriangleFast(r, loadTriangle(i), best.t, hit);
+      hit.triangle = i;
+      best = hitTriangle ? hit : best;
+      found = found || hitTriangle;
+      if (anyHit && found) break;
+    }
+    if (anyHit && found) break;
+    if (k < count + count2) gTruncated = true;
+    ref = near;
+    if (ref == 0u) {
+      if (stackSize == 0u) break;
+      ref = stack[--stackSize];
+    }
   }
-  if (!complete) gTruncated = true;
+  // Ended by a break: a hit found for any-hit, or nothing left. (A flag set at each break
+  // would not do: the compiler folds it to true, having seen no other way out.)
+  if (!(anyHit && found) && !(ref == 0u && stackSize == 0u)) gTruncated = true;
   return found;
 }

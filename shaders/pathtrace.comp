@@ -26,18 +26,12 @@ layout(constant_id = PT_SPEC_SAMPLER) const uint kSampler = kSpecAtRunTime;
 layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer {
   RenderParams params;
 };
-layout(std430, set = 0, binding = PT_BINDING_NODES) readonly buffer NodeBuffer {
-  BvhNode nodes[];
-};
-layout(std430, set = 0, binding = PT_BINDING_TRIANGLES) readonly buffer TriangleBuffer {
-  Triangle triangles[];
-};
-layout(std430, set = 0, binding = PT_BINDING_MATERIALS) readonly buffer MaterialBuffer {
-  Material materials[];
-};
-layout(std430, set = 0, binding = PT_BINDING_EMITTERS) readonly buffer EmitterBuffer {
-  Emitter emitters[];
-};
+// The scene's arrays, as texels (see PT_BINDING_NODES); loadNode, loadTriangle, loadMaterial
+// and loadEmitter read their structs.
+layout(set = 0, binding = PT_BINDING_NODES) uniform usamplerBuffer nodeTexels;
+layout(set = 0, binding = PT_BINDING_TRIANGLES) uniform usamplerBuffer triangleTexels;
+layout(set = 0, binding = PT_BINDING_MATERIALS) uniform usamplerBuffer materialTexels;
+layout(set = 0, binding = PT_BINDING_EMITTERS) uniform usamplerBuffer emitterTexels;
 layout(std430, set = 0, binding = PT_BINDING_ACCUM) buffer AccumBuffer {
   AccumPixel accum[];
 };
@@ -51,7 +45,8 @@ layout(push_constant) uniform Pass {
 
 // Lavapipe (Mesa 22.3) silently ends every loop once an invocation has run 65,535 loop
 // iterations (counted per SIMD group, so a lane's own count can be lower). Each loop here
-// notes how it ended; one that ended otherwise was cut short: gTruncated.
+// notes how it ended, where the compiler cannot fold the note away, and main checks after
+// every sample that the cap had not been reached; a sample cut short sets gTruncated.
 bool gTruncated = false;
 uint gLoopIterations = 0u;  // this invocation's count, for the statistics
 uint gRays = 0u;
@@ -65,6 +60,18 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
   (kSampler == kSpecAtRunTime ? params.samplerType == kSamplerSobol : kSampler == kSamplerSobol)
 #include "bvh.glsl"
 
+Material loadMaterial(uint i) {
+  int at = int(2u * i);
+  uvec4 a = texelFetch(materialTexels, at);
+  uvec4 b = texelFetch(materialTexels, at + 1);
+  return Material(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w);
+}
+
+Emitter loadEmitter(uint i) {
+  uvec4 a = texelFetch(emitterTexels, int(i));
+  return Emitter(a.x, uintBitsToFloat(a.y), uintBitsToFloat(a.z), a.w);
+}
+
 // Samples direct illumination at diffuse vertex p with shading normal n (next-event
 // estimation, pbrt's SampleLd): picks an emitter from the alias table with uChoose, a uniform
 // point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
@@ -74,8 +81,8 @@ vec3 sampleDirectLight(vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f, vec2 
                        vec2 uLight, bool misOn, uint depth) {
   // Pick an emitter from the alias table, then a uniform point on its triangle.
   uint slot = aliasTableSlot(uChoose.x, params.emitterCount);
-  Emitter emitter = emitters[aliasTablePick(slot, emitters[slot], uChoose.y)];
-  Triangle light = triangles[emitter.triangle];
+  Emitter emitter = loadEmitter(aliasTablePick(slot, loadEmitter(slot), uChoose.y));
+  Triangle light = loadTriangle(emitter.triangle);
   vec2 b = sampleTriangleBarycentrics(uLight);
   vec3 lightPoint = (1.0 - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
   vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
@@ -99,7 +106,7 @@ vec3 sampleDirectLight(vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f, vec2 
 
   float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
   float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0;
-  vec3 Le = materials[light.material].emission;
+  vec3 Le = loadMaterial(light.material).emission;
 #ifdef PT_DEBUG_PRINTF
   if (gDebug) {
     debugPrintfEXT("gpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g",
@@ -138,8 +145,8 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
       pathEnded = true;
       break;
     }
-    Triangle tri = triangles[hit.triangle];
-    Material material = materials[tri.material];
+    Triangle tri = loadTriangle(hit.triangle);
+    Material material = loadMaterial(tri.material);
     // Hit point from barycentrics (more accurate than origin + t * direction).
     vec3 p =
         hit.barycentrics.x * tri.v0 + hit.barycentrics.y * tri.v1 + hit.barycentrics.z * tri.v2;
@@ -167,7 +174,7 @@ vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
         float weight = 1.0;
         if (misOn) {
           float area = 0.5 * length(edgeCross);
-          float lightPdf = emitters[tri.emitter].pmf * hit.t * hit.t / (cosOut * area);
+          float lightPdf = loadEmitter(tri.emitter).pmf * hit.t * hit.t / (cosOut * area);
           weight = powerHeuristic(bsdfPdf, lightPdf);
         }
         L += beta * weight * Le;
@@ -253,6 +260,12 @@ void main() {
       debugPrintfEXT("gpu sample %u: L=(%g, %g, %g)", pass.sampleIndex + s, L.x, L.y, L.z);
     }
 #endif
+    // Lavapipe's cap, once reached, ends every loop after its first iteration. A loop that
+    // must run twice, to a bound the compiler cannot know, tells whether it was reached by
+    // now: a flag set on every way out of a loop cannot, as the compiler folds it to true.
+    uint canary = 0u;
+    for (uint bound = min(pass.sampleCount, 1u) + 1u; canary < bound;) canary++;
+    if (canary < 2u) gTruncated = true;
     // A path given up at the loop budget is reported, never added as if complete.
     if (gTruncated) {
       truncated++;

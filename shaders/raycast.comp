@@ -9,12 +9,8 @@
 
 layout(local_size_x = kRaycastWorkgroupSize) in;
 
-layout(std430, set = 0, binding = PT_RAYCAST_BINDING_NODES) readonly buffer NodeBuffer {
-  BvhNode nodes[];
-};
-layout(std430, set = 0, binding = PT_RAYCAST_BINDING_TRIANGLES) readonly buffer TriangleBuffer {
-  Triangle triangles[];
-};
+layout(set = 0, binding = PT_RAYCAST_BINDING_NODES) uniform usamplerBuffer nodeTexels;
+layout(set = 0, binding = PT_RAYCAST_BINDING_TRIANGLES) uniform usamplerBuffer triangleTexels;
 layout(std430, set = 0, binding = PT_RAYCAST_BINDING_QUERIES) readonly buffer QueryBuffer {
   RayQuery queries[];
 };

@@ -30,6 +30,27 @@ struct BvhNode {
   uint count;      //  4 bytes: number of triangles in a leaf, 0 for an interior node
 };                 // 32 bytes
 
+// One interior node of the GPU's copy of the BVH (host/vulkan/gpu_bvh.h): the boxes of both
+// children of a binary node, so that one fetch of 64 bytes serves its two box tests, and the
+// references of both. A reference is an interior child's GpuBvhNode index, or for a leaf
+// kGpuBvhLeaf | first triangle << kGpuBvhCountBits | triangle count (a larger leaf is split,
+// see gpu_bvh.h). The binary tree's shape, boxes and triangle order are kept: traversal
+// visits the leaves in the same order. Node 0 holds the root's box and reference as its left
+// child; its right half is unused (nothing refers to node 0, so a reference of 0 means none).
+struct GpuBvhNode {
+  vec3 leftMin;    // 12 bytes: the left child's box, lower corner
+  uint left;       //  4 bytes: reference to the left child
+  vec3 leftMax;    // 12 bytes: upper corner
+  uint right;      //  4 bytes: reference to the right child
+  vec3 rightMin;   // 12 bytes: the right child's box, lower corner
+  uint reserved0;  //  4 bytes: zero
+  vec3 rightMax;   // 12 bytes: upper corner
+  uint reserved1;  //  4 bytes: zero
+};                 // 64 bytes
+PT_CONST uint kGpuBvhLeaf = 0x80000000u;
+PT_CONST uint kGpuBvhCountBits = 4u;  // a leaf reference holds up to 15 triangles
+PT_CONST uint kGpuBvhMaxLeafCount = (1u << kGpuBvhCountBits) - 1u;
+
 // Traversal stack entries per ray. Both builders keep every tree within this depth: where a
 // split would go deeper, they split the range in balanced halves instead.
 PT_CONST uint kBvhStackSize = 64u;
@@ -108,12 +129,16 @@ struct RenderParams {
 
 // ---- Compute pipeline interface (Vulkan backend) ----------------------------------------
 
-// Descriptor bindings of set 0, all storage buffers.
+// Descriptor bindings of set 0. The scene's arrays are uniform texel buffers, read as 16-byte
+// texels (R32G32B32A32_UINT) a row of a struct at a time: lavapipe gathers a texel fetch for
+// its eight lanes at once, where a storage-buffer load with a different index per lane
+// takes a loop over the lanes with a branch per lane and component. The rest are storage
+// buffers.
 #define PT_BINDING_PARAMS 0     // RenderParams
-#define PT_BINDING_NODES 1      // BvhNode[]
-#define PT_BINDING_TRIANGLES 2  // Triangle[]
-#define PT_BINDING_MATERIALS 3  // Material[]
-#define PT_BINDING_EMITTERS 4   // Emitter[] (one dummy entry when the scene has none)
+#define PT_BINDING_NODES 1      // GpuBvhNode[], texels
+#define PT_BINDING_TRIANGLES 2  // Triangle[], texels
+#define PT_BINDING_MATERIALS 3  // Material[], texels
+#define PT_BINDING_EMITTERS 4   // Emitter[], texels (one dummy entry when the scene has none)
 #define PT_BINDING_ACCUM 5      // AccumPixel[width * height]
 #define PT_BINDING_COUNTERS 6   // DeviceCounters
 #define PT_BINDING_COUNT 7
@@ -132,7 +157,10 @@ struct RenderParams {
 #define PT_SPEC_COUNT 8
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
-PT_CONST uint kWorkgroupSize = 8u;  // workgroups of 8 x 8 pixels
+// Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever
+// the shape (16 x 16, 32 x 2 and 64 x 1 measure the same there); on a GPU, 8 x 8 gives a warp
+// of 32 a tile of 8 x 4 pixels, whose primary rays stay together.
+PT_CONST uint kWorkgroupSize = 8u;
 
 // Push constants of one dispatch (one pass): which sample index every pixel takes.
 struct PassConstants {
@@ -158,8 +186,8 @@ struct DeviceCounters {
 
 // ---- Ray queries (shaders/raycast.comp: traversal tested on its own) --------------------
 
-#define PT_RAYCAST_BINDING_NODES 0      // BvhNode[]
-#define PT_RAYCAST_BINDING_TRIANGLES 1  // Triangle[]
+#define PT_RAYCAST_BINDING_NODES 0      // GpuBvhNode[], texels
+#define PT_RAYCAST_BINDING_TRIANGLES 1  // Triangle[], texels
 #define PT_RAYCAST_BINDING_QUERIES 2    // RayQuery[]
 #define PT_RAYCAST_BINDING_RESULTS 3    // RayResult[]
 PT_CONST uint kRaycastWorkgroupSize = 64u;

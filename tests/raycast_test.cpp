@@ -1,23 +1,189 @@
-// The shader's BVH traversal (through shaders/raycast.comp) against the CPU traversal:
-// watertightness at shared edges and vertices, closest and any hit on the bunny, and
-// axis-parallel rays, all with the validation layers on.
+// The GPU's layout of the BVH (vulkan/gpu_bvh.h) against the binary tree it comes from, and
+// the shader's traversal of it (through shaders/raycast.comp) against the CPU traversal:
+// watertightness at shared edges and vertices, closest and any hit on the bunny, the
+// triangle chosen where hits tie, leaves split for the layout, and axis-parallel rays, all
+// with the validation layers on.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
 #include "bvh/traverse.h"
 #include "closed_mesh.h"
+#include "common/check.h"
 #include "render_compare.h"
 #include "scene/scene.h"
 #include "test_util.h"
+#include "vulkan/gpu_bvh.h"
 #include "vulkan/raycast.h"
 
 namespace pt {
 namespace {
 
 const ContextOptions kValidated{.validation = validationWanted()};
+
+bool contains(vec3 lo, vec3 hi, vec3 p) {
+  return all(lessThanEqual(lo, p)) && all(lessThanEqual(p, hi));
+}
+
+// Walks the GPU layout alongside the binary tree it was built from and counts what differs:
+// the shape and the boxes must be the binary tree's (a leaf of more than kGpuBvhMaxLeafCount
+// triangles split under nodes with infinite boxes), every node but node 0 referred to once,
+// every box must contain the boxes or triangles below it, every triangle must lie in one leaf
+// reference, the leaves in the binary tree's depth-first order, and GpuBvh::maxDepth must be
+// the depth the traversal stack needs.
+class LayoutCheck {
+ public:
+  LayoutCheck(const Bvh& bvh, const GpuBvh& gpu)
+      : bvh_(bvh), gpu_(gpu), references_(gpu.nodes.size(), 0) {
+    const GpuBvhNode& top = gpu.nodes.at(0);
+    boxesDiffer += top.leftMin != bvh.nodes[0].boundsMin || top.leftMax != bvh.nodes[0].boundsMax;
+    child(top.left, top.leftMin, top.leftMax, 0, 0);
+    for (size_t i = 1; i < references_.size(); ++i) badReferences += references_[i] != 1;
+    missedTriangles = bvh.triangles.size() - nextTriangle_;
+  }
+
+  size_t boxesDiffer = 0;      // a child's box is not its binary node's
+  size_t notContained = 0;     // a box or triangle sticks out of the box above it
+  size_t badReferences = 0;    // out of range, of the wrong kind, or not referred to once
+  size_t outOfOrder = 0;       // a leaf reference that does not start where the last ended
+  size_t missedTriangles = 0;  // triangles in no leaf reference
+  int maxDepth = 0;            // interior nodes on the longest path
+  size_t splitNodes = 0;       // nodes over the halves of a leaf too large for a reference
+
+ private:
+  // The reference `ref` to binary node `index`, whose box its parent holds as (lo, hi);
+  // `depth` interior nodes lie above it.
+  void child(uint ref, vec3 lo, vec3 hi, uint32_t index, int depth) {
+    const BvhNode& b = bvh_.nodes[index];
+    boxesDiffer += lo != b.boundsMin || hi != b.boundsMax;
+    if (b.count > 0) {
+      const size_t start = nextTriangle_;
+      leaf(ref, lo, hi, depth);
+      outOfOrder += start != b.offset || nextTriangle_ != size_t(b.offset) + b.count;
+      return;
+    }
+    const GpuBvhNode* n = interior(ref, depth);
+    if (!n) return;
+    notContained += !contains(lo, hi, n->leftMin) || !contains(lo, hi, n->leftMax) ||
+                    !contains(lo, hi, n->rightMin) || !contains(lo, hi, n->rightMax);
+    child(n->left, n->leftMin, n->leftMax, index + 1, depth + 1);
+    child(n->right, n->rightMin, n->rightMax, b.offset, depth + 1);
+  }
+
+  // A reference within a binary leaf of box (lo, hi): a leaf reference, or a split node.
+  void leaf(uint ref, vec3 lo, vec3 hi, int depth) {
+    if (isGpuBvhLeaf(ref)) {
+      const uint first = gpuBvhLeafFirst(ref), count = gpuBvhLeafCount(ref);
+      outOfOrder += first != nextTriangle_ || count == 0;
+      for (uint i = first; i < first + count && i < bvh_.triangles.size(); ++i) {
+        const Triangle& t = bvh_.triangles[i];
+        notContained +=
+            !contains(lo, hi, t.v0) || !contains(lo, hi, t.v1) || !contains(lo, hi, t.v2);
+      }
+      nextTriangle_ = std::min(size_t(first) + count, bvh_.triangles.size());
+      return;
+    }
+    const GpuBvhNode* n = interior(ref, depth);
+    if (!n) return;
+    ++splitNodes;
+    const vec3 inf(INFINITY);
+    boxesDiffer +=
+        n->leftMin != -inf || n->leftMax != inf || n->rightMin != -inf || n->rightMax != inf;
+    leaf(n->left, lo, hi, depth + 1);
+    leaf(n->right, lo, hi, depth + 1);
+  }
+
+  const GpuBvhNode* interior(uint ref, int depth) {
+    if (isGpuBvhLeaf(ref) || ref == 0 || ref >= gpu_.nodes.size()) {
+      ++badReferences;
+      return nullptr;
+    }
+    ++references_[ref];
+    maxDepth = std::max(maxDepth, depth + 1);
+    return &gpu_.nodes[ref];
+  }
+
+  const Bvh& bvh_;
+  const GpuBvh& gpu_;
+  std::vector<int> references_;
+  size_t nextTriangle_ = 0;
+};
+
+void expectValidLayout(const Bvh& bvh, const GpuBvh& gpu) {
+  const LayoutCheck c(bvh, gpu);
+  EXPECT_EQ(c.boxesDiffer, 0u);
+  EXPECT_EQ(c.notContained, 0u);
+  EXPECT_EQ(c.badReferences, 0u);
+  EXPECT_EQ(c.outOfOrder, 0u);
+  EXPECT_EQ(c.missedTriangles, 0u);
+  EXPECT_EQ(c.maxDepth, gpu.maxDepth);
+  EXPECT_LE(gpu.maxDepth, int(kBvhStackSize));
+}
+
+TEST(GpuBvhLayout, HoldsTheBinaryTreeEveryTriangleOnceInBoxesThatContainThem) {
+  const std::vector<Triangle> bunny = test::loadBunny();
+  for (BvhBuilder builder : {BvhBuilder::kLbvh, BvhBuilder::kBinnedSah, BvhBuilder::kPloc}) {
+    SCOPED_TRACE("builder " + std::to_string(int(builder)));
+    const Bvh bvh = buildBvh(bunny, BvhBuildOptions{.builder = builder});
+    const GpuBvh gpu = buildGpuBvh(bvh);
+    expectValidLayout(bvh, gpu);
+    // One node per binary interior node, and node 0.
+    EXPECT_EQ(gpu.nodes.size(), (bvh.nodes.size() - 1) / 2 + 1);
+  }
+  // A single leaf: node 0 refers to it directly.
+  const Bvh one = buildBvh(test::makeSphere(vec3(0.0f), 1.0f, 2, 2));
+  ASSERT_EQ(one.nodes.size(), 1u);
+  expectValidLayout(one, buildGpuBvh(one));
+}
+
+TEST(GpuBvhLayout, SplitsLeavesTooLargeForAReference) {
+  const std::vector<Triangle> sphere = test::makeSphere(vec3(0.0f), 1.0f, 40, 60);
+  for (int leafSize : {16, 40, 1000, 10000}) {
+    SCOPED_TRACE("leaf size " + std::to_string(leafSize));
+    const Bvh bvh = buildBvh(sphere, BvhBuildOptions{.maxLeafSize = leafSize});
+    const GpuBvh gpu = buildGpuBvh(bvh);
+    const LayoutCheck c(bvh, gpu);
+    EXPECT_GT(c.splitNodes, 0u);
+    expectValidLayout(bvh, gpu);
+  }
+}
+
+TEST(GpuBvhLayout, IsDeterministic) {
+  const std::vector<Triangle> bunny = test::loadBunny();
+  const GpuBvh a = buildGpuBvh(buildBvh(bunny));
+  const GpuBvh b = buildGpuBvh(buildBvh(bunny));
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(GpuBvhNode)), 0);
+  EXPECT_EQ(a.maxDepth, b.maxDepth);
+}
+
+// A binary tree of `depth` interior nodes in a chain, each with a one-triangle leaf on the
+// right, ending in a leaf of `lastLeaf` triangles (boxes: the unit cube).
+Bvh chainTree(int depth, uint32_t lastLeaf) {
+  Bvh bvh;
+  const vec3 lo(0.0f), hi(1.0f);
+  for (int i = 0; i < depth; ++i) bvh.nodes.push_back(BvhNode{lo, 0, hi, 0});
+  bvh.nodes.push_back(BvhNode{lo, 0, hi, lastLeaf});
+  uint32_t triangle = lastLeaf;
+  for (int i = depth - 1; i >= 0; --i) {  // right children in depth-first order
+    bvh.nodes[size_t(i)].offset = uint32_t(bvh.nodes.size());
+    bvh.nodes.push_back(BvhNode{lo, triangle++, hi, 1});
+  }
+  bvh.triangles.assign(triangle, Triangle{lo, 0, hi, kNoEmitter, vec3(0, 1, 0), 0});
+  bvh.maxDepth = depth;
+  return bvh;
+}
+
+TEST(GpuBvhLayout, SplitLeavesTooDeepForTheStackAreRefused) {
+  // 63 levels and a leaf of 40 triangles split twice: 65 interior levels, one too many.
+  EXPECT_THROW(buildGpuBvh(chainTree(63, 40)), InputError);
+  // Without the split, or with one split less, it fits.
+  expectValidLayout(chainTree(64, 4), buildGpuBvh(chainTree(64, 4)));
+  expectValidLayout(chainTree(62, 30), buildGpuBvh(chainTree(62, 30)));
+}
 
 TEST(GpuTraversal, WatertightAtSharedEdgesAndVertices) {
   // The CPU test's 1.26 million rays, on the device.
@@ -89,11 +255,85 @@ TEST(GpuTraversal, ClosestAndAnyHitMatchTheCpuOnTheBunny) {
     }
     const auto cpu = closestHit(bvh, ray, q.tMax);
     hits += cpu.has_value();
-    // Same arithmetic in both (no fused multiply-adds): the same distance, bit for bit.
-    if (cpu.has_value() != (gpu[i].found != 0u) || (cpu && cpu->t != gpu[i].t)) ++differ;
+    // Same arithmetic in both (no fused multiply-adds): the same distance, bit for bit, and
+    // the same triangle.
+    if (cpu.has_value() != (gpu[i].found != 0u) ||
+        (cpu && (cpu->t != gpu[i].t || cpu->triangle != gpu[i].triangle))) {
+      ++differ;
+    }
   }
   EXPECT_EQ(differ, 0u);
   EXPECT_GT(hits, 20000u);
+}
+
+// Rays through the bunny's shared vertices and edges, from inside: there, two or more
+// triangles are often hit at the same distance, and the one reported is the first the
+// traversal accepts, so the GPU must visit the leaves, and test the triangles, in the binary
+// traversal's order to report the CPU's triangle.
+TEST(GpuTraversal, TiesGoToTheTriangleTheCpuReports) {
+  const Bvh bvh = buildBvh(test::loadBunny());
+  const std::vector<RayQuery> queries =
+      test::aimedRays(bvh.triangles, test::interiorPoints(bvh, 4, 2));
+  ASSERT_GE(queries.size(), 100000u);
+  RaycastStats stats;
+  const std::vector<RayResult> gpu = traceRaysVulkan(bvh, queries, kValidated, &stats);
+  EXPECT_EQ(stats.validationErrors, 0u);
+  EXPECT_EQ(stats.truncated, 0u);
+  size_t differ = 0;
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const auto cpu = closestHit(bvh, Ray{queries[i].origin, queries[i].direction});
+    differ += cpu.has_value() != (gpu[i].found != 0u) ||
+              (cpu && (cpu->t != gpu[i].t || cpu->triangle != gpu[i].triangle));
+  }
+  EXPECT_EQ(differ, 0u);
+  // The rays do tie: every 100th one against every triangle.
+  size_t ties = 0;
+  for (size_t i = 0; i < queries.size(); i += 100) {
+    const RayPrecomputed ray(Ray{queries[i].origin, queries[i].direction});
+    float closest = INFINITY;
+    int atClosest = 0;
+    for (const Triangle& t : bvh.triangles) {
+      Hit hit;
+      if (!intersectTriangle(ray, t, INFINITY, hit)) continue;
+      atClosest = hit.t < closest ? 1 : atClosest + (hit.t == closest);
+      closest = std::min(closest, hit.t);
+    }
+    ties += atClosest > 1;
+  }
+  EXPECT_GT(ties, 100u);
+}
+
+// Leaves of up to 40 triangles, split for the layout's references (kGpuBvhMaxLeafCount):
+// the same answers as the CPU on the binary tree.
+TEST(GpuTraversal, SplitLeavesGiveTheCpusAnswers) {
+  const Bvh bvh = buildBvh(test::loadBunny(), BvhBuildOptions{.maxLeafSize = 40});
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> uni(-1.5f, 1.5f);
+  std::vector<RayQuery> queries;
+  for (int i = 0; i < 20000; ++i) {
+    const vec3 o(uni(rng), uni(rng), uni(rng));
+    const Triangle& t = bvh.triangles[size_t(i * 7919) % bvh.triangles.size()];
+    const bool shadow = i % 3 == 0;
+    queries.push_back(RayQuery{o, shadow ? std::abs(uni(rng)) : INFINITY,
+                               normalize((t.v0 + t.v1 + t.v2) / 3.0f - o), shadow ? 1u : 0u});
+  }
+  RaycastStats stats;
+  const std::vector<RayResult> gpu = traceRaysVulkan(bvh, queries, kValidated, &stats);
+  EXPECT_EQ(stats.validationErrors, 0u);
+  EXPECT_EQ(stats.truncated, 0u);
+  size_t differ = 0;
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const RayQuery& q = queries[i];
+    const Ray ray{q.origin, q.direction};
+    if (q.anyHit) {
+      differ += anyHit(bvh, ray, q.tMax) != (gpu[i].found != 0u);
+      continue;
+    }
+    const auto cpu = closestHit(bvh, ray, q.tMax);
+    differ += cpu.has_value() != (gpu[i].found != 0u) ||
+              (cpu && (cpu->t != gpu[i].t || cpu->triangle != gpu[i].triangle));
+  }
+  EXPECT_EQ(differ, 0u);
 }
 
 TEST(GpuTraversal, AxisParallelRaysInBoxFacePlanes) {

@@ -13,15 +13,31 @@
 // candidates are looked at in; merges and compaction are prefix sums over fixed chunks; the
 // top-down splits combine bins exactly (min, max, sums) and give each subtree a fixed range
 // of node ids. So the tree is the same for any thread count.
+//
+// Memory: every page a build touches for the first time costs a page fault and the kernel's
+// zeroing, and on a loaded virtual machine the faults of the old builder's arrays (250 MB
+// for the 1M-triangle sphere, the output included) took about a fifth of its time. So the
+// phases share two blocks (the Morton keys, then the clusters of the rounds, ping-ponging
+// between them, then the top levels' references in the one the last round left); the
+// per-cluster data that only merges read (triangle counts, collapsed sizes, costs) lives in
+// the inner nodes, where merges write it anyway; inner nodes keep no boxes (the
+// linearization unites them again from the triangles); and the large arrays ask for huge
+// pages (adviseHugePages).
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstring>
 #include <memory>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "bvh/bvh_build.h"
 #include "common/check.h"
+
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 namespace pt {
 namespace {
@@ -29,13 +45,16 @@ namespace {
 // The Morton order is by the top 33 bits of the codes (11 per axis, a 2048^3 grid; three
 // radix passes instead of six): the clustering looks at kRadius neighbours either way and so
 // does not need the order within a cell.
-constexpr int kSkipBits = 30;
+constexpr int kMortonBits = 33;
+constexpr int kDigitBits = 11;  // per radix pass
 // Neighbours looked at on either side. The paper finds quality close to saturated by r = 16
 // (its Figure 6); larger windows cost build time for little gain.
 // (Measured here: r = 8 builds about 5 % faster, with about 4 % more nodes and a 1 % higher
 // SAH cost, and primary rays traced a few per cent slower in noisy measurements, so r stays
 // at 16.)
 constexpr size_t kRadius = 16;
+// How many triangles ahead the passes that read them in Morton order fetch.
+constexpr size_t kPrefetch = 16;
 // Clusters per chunk of a parallel loop.
 constexpr size_t kChunk = size_t(1) << 12;
 // A round that merges fewer than count / kMinMergeShare pairs pairs neighbours 2k and 2k + 1
@@ -54,11 +73,14 @@ constexpr size_t kMinMergeShare = 16;
 constexpr size_t kClusterShare = 4;
 // Bins per axis of the top-down splits, all three axes binned.
 constexpr int kTopBins = 16;
+// Ranges of at least this many clusters are binned into two sets of bins (see binClusters).
+constexpr size_t kTopTwoBinSets = 64;
 // Smallest top-level subtree (in clusters) handed to one worker.
 constexpr size_t kTopPieceMin = 1024;
 // Top-level ranges of at most this many clusters are finished bottom-up (clusterSmall): the
 // many small ranges near the bottom would cost more to bin than to cluster exhaustively.
 constexpr size_t kTopSmall = 8;
+static_assert(kTopSmall >= 2, "splitRange needs more than two clusters");
 // The collapse's cost model: a node visit costs kCollapseTraversalCost, a triangle test
 // kCollapseTriangleCost. With the SAH's unit costs (kSahTraversalCost = kSahTriangleCost = 1)
 // the collapse keeps many leaves of one or two triangles, and the CPU traversal runs about 7 %
@@ -90,21 +112,21 @@ Box triangleBox(const Triangle& t) {
   return Box{b.lo, b.hi};
 }
 
-// What the SAH collapse and the linearization need of a cluster's subtree.
+// What the SAH collapse and the linearization need of a subtree.
 struct Summary {
   uint32_t count;  // triangles in it
   uint32_t size;   // nodes its collapsed form emits (1: it is collapsed into one leaf)
-  int height;      // depth of its deepest leaf below it, collapsed
   float cost;      // SAH cost of the collapsed form times half the area of its box
 };
 
 // A merge of two clusters. Ids below the triangle count n are triangles (by Morton rank);
-// id n + k is inner node k, created in merge order, so children have smaller ids.
+// id n + k is inner node k, created in merge order, so children have smaller ids. Its box is
+// not kept: the clusters carry their boxes while they are clustered, and the linearization
+// unites the children's boxes again as it writes the nodes (the same min and max in the same
+// order: the same box), which halves the memory the inner nodes take.
 struct Inner {
-  Box box;
   uint32_t left, right;  // the left one was first in Morton order
-  uint32_t count, size;  // as in Summary
-  int height;
+  Summary summary;
 };
 
 // Lanes through the GCC and Clang vector extensions (SSE on x86-64, NEON on ARM): the -O2
@@ -112,6 +134,7 @@ struct Inner {
 // box in four) by itself.
 using Float4 = float __attribute__((vector_size(16)));
 using Float8 = float __attribute__((vector_size(32)));
+using Int4 = int32_t __attribute__((vector_size(16)));
 using Int8 = int32_t __attribute__((vector_size(32)));
 Float4 splat4(float x) {
   return Float4{x, x, x, x};
@@ -125,64 +148,124 @@ Float4 max4(Float4 a, Float4 b) {
   return a < b ? b : a;
 }
 
-// The clusters of a round as a structure of arrays, so that the neighbour search loads eight
-// at a time. Cluster i is at i + kPadding; the padding on both sides (enough for the last
-// eight lanes too) holds infinite boxes, whose merged area is infinite: never anyone's
-// nearest neighbour.
-constexpr size_t kPadding = kRadius + 8;
-// (The arrays are not value-initialised: every entry is written before it is read.)
-struct Clusters {
-  std::unique_ptr<float[]> lo[3], hi[3];
-  std::unique_ptr<uint32_t[]> id;
-  std::unique_ptr<Summary[]> summary;
+// A box in lanes x, y, z of two vectors, lane 3 left as loaded, for the loops that unite
+// many boxes: min4 and max4 are glm's min and max lane by lane, so these are the same boxes
+// as unite and triangleBox make.
+struct Box4 {
+  Float4 lo, hi;
+};
+Box4 unite4(const Box4& a, const Box4& b) {
+  return Box4{min4(a.lo, b.lo), max4(a.hi, b.hi)};
+}
+float halfArea4(const Box4& b) {
+  const Float4 d = b.hi - b.lo;
+  return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+}
+// (Each vertex of a Triangle is the first 12 bytes of a 16-byte row.)
+static_assert(offsetof(Triangle, v1) == 16 && offsetof(Triangle, v2) == 32);
+Box4 triangleBox4(const Triangle& t) {
+  Float4 v0, v1, v2;
+  std::memcpy(&v0, &t.v0, sizeof v0);
+  std::memcpy(&v1, &t.v1, sizeof v1);
+  std::memcpy(&v2, &t.v2, sizeof v2);
+  const Float4 lo = min4(min4(min4(splat4(INFINITY), v0), v1), v2);
+  const Float4 hi = max4(max4(max4(splat4(-INFINITY), v0), v1), v2);
+  return Box4{lo, hi};
+}
 
-  explicit Clusters(size_t n)
-      : id(std::make_unique_for_overwrite<uint32_t[]>(n)),
-        summary(std::make_unique_for_overwrite<Summary[]>(n)) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::make_unique_for_overwrite<float[]>(n + 2 * kPadding);
-      hi[a] = std::make_unique_for_overwrite<float[]>(n + 2 * kPadding);
-      std::fill_n(lo[a].get(), kPadding, -INFINITY);
-      std::fill_n(hi[a].get(), kPadding, INFINITY);
-    }
-    pad(n);
+// Asks the kernel to back [p, p + bytes) with huge pages (Linux's transparent huge pages,
+// where they are enabled for regions that ask: the usual "madvise" setting) before the
+// range is first touched. A build writes its arrays once and soon frees them, and the first
+// touch of each 4 KiB page is a page fault: 35 000 to 40 000 of them for the 1M-triangle
+// sphere, 50 to 100 ms of kernel time on the loaded test machine; with 2 MiB pages, 3 000
+// and 15 to 25 ms. (A hint: nothing changes where the kernel does not take it.)
+void adviseHugePages([[maybe_unused]] const void* p, [[maybe_unused]] size_t bytes) {
+#ifdef __linux__
+  constexpr uintptr_t kHugePage = uintptr_t(1) << 21;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(p) + kHugePage - 1) & ~(kHugePage - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(kHugePage - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#endif
+}
+
+// Memory that the phases of a build hand on to each other: arrays of trivial types at byte
+// offsets of one allocation, not initialised.
+class Block {
+ public:
+  explicit Block(size_t bytes)
+      : words_(std::make_unique_for_overwrite<uint64_t[]>((bytes + 7) / 8)) {
+    adviseHugePages(words_.get(), bytes);
   }
-  Box box(size_t i) const {
-    const size_t p = i + kPadding;
-    return Box{vec3(lo[0][p], lo[1][p], lo[2][p]), vec3(hi[0][p], hi[1][p], hi[2][p])};
+  // `count` objects of type T from byte `offset` on (a multiple of alignof(T)), their
+  // lifetimes begun, their values undefined until written.
+  template <typename T>
+  T* array(size_t offset, size_t count) const {
+    static_assert(std::is_trivially_default_constructible_v<T> && alignof(T) <= 8);
+    T* const first = reinterpret_cast<T*>(reinterpret_cast<std::byte*>(words_.get()) + offset);
+    std::uninitialized_default_construct_n(first, count);
+    return first;
   }
-  void set(size_t i, const Box& b, uint32_t clusterId, const Summary& s) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a][i + kPadding] = b.lo[a];
-      hi[a][i + kPadding] = b.hi[a];
+
+ private:
+  std::unique_ptr<uint64_t[]> words_;
+};
+
+// The clusters of a round in a Block: their boxes as a structure of arrays, so that the
+// neighbour search loads eight at a time, and their ids. Cluster i is at i + kPadding of each
+// box array; the padding on both sides (enough for the last eight lanes too) holds infinite
+// boxes, whose merged area is infinite: never anyone's nearest neighbour. The pointers are
+// at cluster 0 (the loops keep them in registers, which they could not do with members of a
+// class that the stores might alias).
+constexpr size_t kPadding = kRadius + 8;
+struct ClusterArrays {
+  float *lx, *ly, *lz, *hx, *hy, *hz;
+  uint32_t* id;
+
+  // Bytes for `n` clusters.
+  static size_t bytes(size_t n) { return 6 * (n + 2 * kPadding) * sizeof(float) + n * 4; }
+  // The arrays for `n` clusters in `block`, padded in front.
+  ClusterArrays(const Block& block, size_t n) {
+    float* rows[6];
+    for (size_t r = 0; r < 6; ++r) {
+      rows[r] = block.array<float>(r * (n + 2 * kPadding) * sizeof(float), n + 2 * kPadding);
+      std::fill_n(rows[r], kPadding, r < 3 ? -INFINITY : INFINITY);
+      rows[r] += kPadding;
     }
+    lx = rows[0], ly = rows[1], lz = rows[2], hx = rows[3], hy = rows[4], hz = rows[5];
+    id = block.array<uint32_t>(6 * (n + 2 * kPadding) * sizeof(float), n);
+  }
+  Box box(size_t i) const { return Box{vec3(lx[i], ly[i], lz[i]), vec3(hx[i], hy[i], hz[i])}; }
+  void set(size_t i, const Box& b, uint32_t clusterId) const {
+    lx[i] = b.lo.x, ly[i] = b.lo.y, lz[i] = b.lo.z;
+    hx[i] = b.hi.x, hy[i] = b.hi.y, hz[i] = b.hi.z;
     id[i] = clusterId;
-    summary[i] = s;
   }
   // Pads after the first `count` clusters.
-  void pad(size_t count) {
-    for (int a = 0; a < 3; ++a) {
-      std::fill_n(lo[a].get() + count + kPadding, kPadding, -INFINITY);
-      std::fill_n(hi[a].get() + count + kPadding, kPadding, INFINITY);
-    }
+  void pad(size_t count) const {
+    for (float* row : {lx, ly, lz}) std::fill_n(row + count, kPadding, -INFINITY);
+    for (float* row : {hx, hy, hz}) std::fill_n(row + count, kPadding, INFINITY);
   }
 };
 
-// neighbour[i] for i in [begin, end): the cluster j within kRadius places of i with the least
-// area of the merged box, the lower index on a tie; i itself when every area is infinite or
-// NaN. Eight clusters at a time, one per lane; the candidates are offered from the lowest
-// index up, so "strictly less" keeps the lower index on ties. This loop is most of the build
-// time, so it is also compiled for AVX2 (picked at load time where the CPU has it): eight
-// lanes in one register instead of two; the arithmetic, and so the tree, is the same. (No
-// helper function takes or returns 32-byte vectors by value: that would change its calling
-// convention between the two versions.)
-__attribute__((target_clones("avx2", "default"))) void findNeighbours(const Clusters& c,
+// found[i - begin] for i in [begin, end): the cluster j within kRadius places of i with the
+// least area of the merged box, the lower index on a tie; i itself when every area is
+// infinite or NaN. Eight clusters at a time, one per lane. Each pair's area is computed once,
+// by its first cluster (j = i + 1 .. i + kRadius), and offered to both: to i at once, and
+// to j from a ring of the last blocks' areas, where the areas of j's pairs with j - kRadius
+// .. j - 1 lie side by side. (The min and max of two numbers do not depend on their order,
+// so it is the area j would compute, NaN coordinates aside: this halves the search's work.)
+// The candidates before i are offered from the lowest index up, as are those after it, and
+// those after win only when strictly less, so "strictly less" keeps the lower index on ties.
+// This loop is much of the build time, so it is also compiled for AVX2 (picked at load time
+// where the CPU has it): eight lanes in one register instead of two; the arithmetic, and so
+// the tree, is the same. (No helper function takes or returns 32-byte vectors by value: that
+// would change its calling convention between the two versions.)
+__attribute__((target_clones("avx2", "default"))) void findNeighbours(const ClusterArrays& c,
                                                                       size_t begin, size_t end,
-                                                                      uint32_t* neighbour) {
-  const float *lx = c.lo[0].get(), *ly = c.lo[1].get(), *lz = c.lo[2].get();
-  const float *hx = c.hi[0].get(), *hy = c.hi[1].get(), *hz = c.hi[2].get();
-  // The boxes of the clusters at positions q .. q + 7, lane by lane.
-  auto load = [&](size_t q, Float8& x0, Float8& y0, Float8& z0, Float8& x1, Float8& y1,
+                                                                      uint32_t* found) {
+  const float *lx = c.lx, *ly = c.ly, *lz = c.lz, *hx = c.hx, *hy = c.hy, *hz = c.hz;
+  // The boxes of the clusters q .. q + 7, lane by lane.
+  auto load = [&](ptrdiff_t q, Float8& x0, Float8& y0, Float8& z0, Float8& x1, Float8& y1,
                   Float8& z1) {
     std::memcpy(&x0, lx + q, sizeof x0);
     std::memcpy(&y0, ly + q, sizeof y0);
@@ -191,33 +274,194 @@ __attribute__((target_clones("avx2", "default"))) void findNeighbours(const Clus
     std::memcpy(&y1, hy + q, sizeof y1);
     std::memcpy(&z1, hz + q, sizeof z1);
   };
+  static_assert(kRadius % 8 == 0);
+  constexpr size_t kBehind = kRadius / 8;  // blocks of eight that reach into a block
+  constexpr size_t kSlots = kBehind + 2;   // with the current one, and room to wrap around
+  // ring[k - 1][8 * slot + lane]: the area of cluster i + lane's pair with i + lane + k for
+  // the block i in that slot, every block stored twice, kSlots slots apart, so that the
+  // areas of any kBehind + 1 successive blocks lie side by side.
+  alignas(32) float ring[kRadius][16 * kSlots];
   const Int8 laneOffsets = {0, 1, 2, 3, 4, 5, 6, 7};
-  for (size_t i = begin; i < end; i += 8) {
-    const size_t p = i + kPadding;  // cluster i's position in the padded arrays
+  const Float8 infinity = {INFINITY, INFINITY, INFINITY, INFINITY,
+                           INFINITY, INFINITY, INFINITY, INFINITY};
+  // The first kBehind blocks, before `begin`, only fill the ring (clusters before 0 are
+  // padding: infinite areas).
+  size_t block = 0;
+  for (ptrdiff_t i = ptrdiff_t(begin) - ptrdiff_t(kRadius); i < ptrdiff_t(end); i += 8, ++block) {
     Float8 x0, y0, z0, x1, y1, z1;
-    load(p, x0, y0, z0, x1, y1, z1);
-    Float8 bestArea = {INFINITY, INFINITY, INFINITY, INFINITY,
-                       INFINITY, INFINITY, INFINITY, INFINITY};
-    Int8 best = laneOffsets + int32_t(i);
-    // Offers the clusters at positions q .. q + 7, indices j .. j + 7.
-    auto offer = [&](size_t q, int32_t j) {
+    load(i, x0, y0, z0, x1, y1, z1);
+    Float8 afterArea = infinity;
+    Int8 after = laneOffsets + int32_t(i);
+    const size_t slot = 8 * (block % kSlots);
+#pragma GCC unroll 16
+    for (size_t k = 1; k <= kRadius; ++k) {
       Float8 qx0, qy0, qz0, qx1, qy1, qz1;
-      load(q, qx0, qy0, qz0, qx1, qy1, qz1);
+      load(i + ptrdiff_t(k), qx0, qy0, qz0, qx1, qy1, qz1);
       // max(a, b) - min(a, b) per axis as a < b ? b : a and b < a ? b : a (maxps, minps).
       const Float8 dx = (x1 < qx1 ? qx1 : x1) - (qx0 < x0 ? qx0 : x0);
       const Float8 dy = (y1 < qy1 ? qy1 : y1) - (qy0 < y0 ? qy0 : y0);
       const Float8 dz = (z1 < qz1 ? qz1 : z1) - (qz0 < z0 ? qz0 : z0);
       const Float8 area = dx * dy + dy * dz + dz * dx;
-      const Int8 better = area < bestArea;
-      bestArea = better ? area : bestArea;
-      best = better ? laneOffsets + j : best;
-    };
-    for (size_t k = kRadius; k > 0; --k) offer(p - k, int32_t(i - k));
-    for (size_t k = 1; k <= kRadius; ++k) offer(p + k, int32_t(i + k));
-    for (size_t lane = 0; lane < 8 && i + lane < end; ++lane) {
-      neighbour[i + lane] = uint32_t(best[lane]);
+      std::memcpy(&ring[k - 1][slot], &area, sizeof area);
+      std::memcpy(&ring[k - 1][slot + 8 * kSlots], &area, sizeof area);
+      const Int8 better = area < afterArea;
+      afterArea = better ? area : afterArea;
+      after = better ? laneOffsets + int32_t(i + ptrdiff_t(k)) : after;
+    }
+    if (i < ptrdiff_t(begin)) continue;
+    // The pairs with the kRadius clusters before, from the blocks kBehind back on.
+    const size_t first = 8 * ((block - kBehind) % kSlots);
+    Float8 beforeArea = infinity;
+    Int8 before = laneOffsets + int32_t(i);
+#pragma GCC unroll 16
+    for (size_t k = kRadius; k > 0; --k) {
+      Float8 area;
+      std::memcpy(&area, &ring[k - 1][first + kRadius - k], sizeof area);
+      const Int8 better = area < beforeArea;
+      beforeArea = better ? area : beforeArea;
+      before = better ? laneOffsets + int32_t(i - ptrdiff_t(k)) : before;
+    }
+    const Int8 best = afterArea < beforeArea ? after : before;
+    if (size_t(i) + 8 <= end) {
+      std::memcpy(&found[size_t(i) - begin], &best, sizeof best);
+    } else {
+      for (size_t lane = 0; size_t(i) + lane < end; ++lane) {
+        found[size_t(i) - begin + lane] = uint32_t(best[lane]);
+      }
     }
   }
+}
+
+// kSpread11[x]: the 11 bits of x spread out so that bit i moves to bit 3i.
+constexpr std::array<uint32_t, 2048> kSpread11 = [] {
+  std::array<uint32_t, 2048> table{};
+  for (uint32_t x = 0; x < table.size(); ++x) {
+    for (uint32_t bit = 0; bit < 11; ++bit) table[x] |= (x >> bit & 1u) << 3 * bit;
+  }
+  return table;
+}();
+
+// The Morton code of a point in [0, 1]^3 (lanes x, y, z) by the top 11 bits of each axis'
+// 21-bit cell, as mortonCode63(point) >> 30 (bvh.cpp) computes it: cells clamped in float,
+// NaN to 0; the bits interleaved z y x from the top.
+uint64_t mortonCode33(Float4 unitPoint) {
+  constexpr float kCells = float(1 << 21);
+  auto quantize = [](float x) {
+    const float cell = std::clamp(x * kCells, 0.0f, kCells - 1.0f);
+    return cell == cell ? uint64_t(kSpread11[uint32_t(cell) >> 10]) : 0;
+  };
+  return quantize(unitPoint[0]) | quantize(unitPoint[1]) << 1 | quantize(unitPoint[2]) << 2;
+}
+
+// A cluster left by the rounds, as the top levels' splits see and move it: its box, lo and
+// -hi (see AxisBins), each in the first 12 bytes of a 16-byte row whose last 4 (its index,
+// its triangle count) are masked off when the row is loaded. 32 bytes, so that a split moves
+// two per cache line.
+struct TopRef {
+  float lo[3];
+  uint32_t cluster;  // its index in the clusters of the last round
+  float negHi[3];
+  uint32_t count;  // triangles
+};
+Float4 topRow(const float* row) {
+  Int4 bits;
+  std::memcpy(&bits, row, sizeof bits);
+  return Float4(bits & Int4{-1, -1, -1, 0});
+}
+Float4 topLo(const TopRef& r) {
+  return topRow(r.lo);
+}
+Float4 topHi(const TopRef& r) {
+  return -topRow(r.negHi);
+}
+// The centre, doubled: lo + hi (x - (-y) is x + y, to the bit).
+Float4 topCenter(const TopRef& r) {
+  return topRow(r.lo) - topRow(r.negHi);
+}
+
+// The bins of one axis of a top-level split; the first binCount of them are cleared before
+// use. A bin's box is lo in lanes 0 to 2 and -hi in lanes 4 to 6: one 8-lane min grows both
+// (min(-a, -b) is -max(a, b), to the bit and in which operand it keeps on ties and NaN).
+struct AxisBins {
+  // (32-byte vectors are only 16-byte aligned where AVX is not enabled, but the AVX2 version
+  // of binClusters stores them as aligned.)
+  alignas(32) Float8 box[kTopBins];
+  uint64_t count[kTopBins];  // triangles in the low 32 bits, clusters in the high 32
+};
+using Bins = std::array<AxisBins, 3>;
+// Grows bin box `acc` by `b` (see AxisBins), as two 4-lane halves: the rest of the top
+// levels is compiled without AVX.
+[[gnu::always_inline]] inline void grow8(Float8& acc, const Float8& b) {
+  Float4 x[2], y[2];
+  std::memcpy(x, &acc, sizeof x);
+  std::memcpy(y, &b, sizeof y);
+  x[0] = min4(x[0], y[0]), x[1] = min4(x[1], y[1]);
+  std::memcpy(&acc, x, sizeof x);
+}
+
+// Bins the clusters refs[begin, end) on all three axes (centres from `lo` on, `scale` bins
+// per unit), noting each one's bins in binIndex. In long ranges even and odd positions fill
+// separate bins, merged at the end: runs of clusters in one bin would otherwise wait for
+// each other's updates. Short ones (most of them) fill one set: there clearing and merging a
+// second would cost more than the waits. Much of the top levels' time, so also compiled for
+// AVX2 (picked at load time, below), where a bin grows by one 8-lane min instead of two
+// 4-lane ones; the same arithmetic. (Without AVX the 8-lane min would be done lane by lane.)
+template <bool kAvx2>
+[[gnu::always_inline]] inline void binClustersIn(const TopRef* refs, size_t begin, size_t end,
+                                                 Float4 lo, Float4 scale, int binCount, Bins& bins,
+                                                 std::array<uint8_t, 3>* binIndex) {
+  const Float8 empty = {INFINITY, INFINITY, INFINITY, INFINITY,
+                        INFINITY, INFINITY, INFINITY, INFINITY};
+  const Int8 mask = {-1, -1, -1, 0, -1, -1, -1, 0};
+  const float lastBin = float(binCount - 1);
+  Bins odd;
+  const bool twoSets = end - begin >= kTopTwoBinSets;
+  for (Bins* b : {&bins, &odd}) {
+    if (b == &odd && !twoSets) break;
+    for (AxisBins& axis : *b) {
+      std::fill_n(axis.box, binCount, empty);
+      std::fill_n(axis.count, binCount, 0u);
+    }
+  }
+  for (size_t i = begin; i < end; ++i) {
+    const TopRef& cluster = refs[i];
+    Bins& target = twoSets && i % 2 ? odd : bins;
+    Int8 bits;
+    std::memcpy(&bits, &cluster, sizeof bits);
+    const Float8 box = Float8(bits & mask);
+    const Float4 x = (topCenter(cluster) - lo) * scale;
+    const uint64_t count = cluster.count | uint64_t(1) << 32;
+#pragma GCC unroll 3
+    for (size_t a = 0; a < 3; ++a) {
+      // std::min(lastBin, x) is lastBin for a NaN x, so the conversion stays defined.
+      const int k = int(std::min(lastBin, x[a]));
+      binIndex[i][a] = uint8_t(k);
+      Float8& bin = target[a].box[k];
+      if constexpr (kAvx2) {
+        bin = box < bin ? box : bin;
+      } else {
+        grow8(bin, box);
+      }
+      target[a].count[k] += count;
+    }
+  }
+  if (!twoSets) return;
+  for (size_t a = 0; a < 3; ++a) {
+    for (int k = 0; k < binCount; ++k) {
+      grow8(bins[a].box[k], odd[a].box[k]);
+      bins[a].count[k] += odd[a].count[k];
+    }
+  }
+}
+__attribute__((target("default"))) void binClusters(const TopRef* refs, size_t begin, size_t end,
+                                                    Float4 lo, Float4 scale, int binCount,
+                                                    Bins& bins, std::array<uint8_t, 3>* binIndex) {
+  binClustersIn<false>(refs, begin, end, lo, scale, binCount, bins, binIndex);
+}
+__attribute__((target("avx2"))) void binClusters(const TopRef* refs, size_t begin, size_t end,
+                                                 Float4 lo, Float4 scale, int binCount, Bins& bins,
+                                                 std::array<uint8_t, 3>* binIndex) {
+  binClustersIn<true>(refs, begin, end, lo, scale, binCount, bins, binIndex);
 }
 
 class PlocBuilder {
@@ -228,63 +472,200 @@ class PlocBuilder {
         n_(triangles.size()),
         leafSize_(leafSize),
         depthLimit_(depthLimit),
-        workers_(workers) {}
+        workers_(workers),
+        blocks_{Block(ClusterArrays::bytes(n_)), Block(ClusterArrays::bytes(n_))} {}
 
   Bvh build() {
-    order_ = sortByMorton(triangles_, kSkipBits, workers_).order;
-    const uint32_t root = cluster();
-    return linearize(root);
+    const uint64_t* keys = mortonKeys();
+    return linearize(cluster(keys));
   }
 
  private:
-  // ---- Clustering ------------------------------------------------------------------------
+  // ---- Morton order ----------------------------------------------------------------------
 
-  // Runs the rounds of nearest-neighbour merging; returns the root's id.
-  uint32_t cluster() {
-    Clusters clusters(n_), next(n_);
-    const auto neighbour = std::make_unique_for_overwrite<uint32_t[]>(n_);
-    workers_.forChunks(n_, kChunk, [&](size_t begin, size_t end) {
+  // The centroid (v0 + v1 + v2) * (1 / 3) as sortByMorton (bvh.cpp) computes it, in lanes
+  // x, y, z.
+  static Float4 centroid(const Triangle& t) {
+    Float4 v0, v1, v2;
+    std::memcpy(&v0, &t.v0, sizeof v0);
+    std::memcpy(&v1, &t.v1, sizeof v1);
+    std::memcpy(&v2, &t.v2, sizeof v2);
+    return (v0 + v1 + v2) * splat4(1.0f / 3.0f);
+  }
+
+  // The triangles in Morton order of their centroids, normalised to the centroids' bounding
+  // box, as sortByMorton (bvh.cpp) orders them with skipBits 30 (its codes, its stable
+  // order), here with 8 bytes a triangle: keys code << 31 | triangle index, in block 1.
+  // Returns the sorted keys. A stable LSD radix sort by the code, kDigitBits a pass: each
+  // worker counts the digits of its own slice, the counts become output offsets bucket by
+  // bucket and, within a bucket, slice by slice (earlier slices first, which keeps the sort
+  // stable), and each worker scatters its slice. A pass in which every code has the same
+  // digit would move nothing and is skipped.
+  const uint64_t* mortonKeys() {
+    const size_t n = n_;
+    std::vector<Box4> chunkBounds((n + kChunk - 1) / kChunk);
+    workers_.forChunks(n, kChunk, [&](size_t begin, size_t end) {
+      Box4 b{splat4(INFINITY), splat4(-INFINITY)};
       for (size_t i = begin; i < end; ++i) {
-        const Box box = triangleBox(triangles_[order_[i]]);
-        clusters.set(i, box, uint32_t(i), Summary{1, 1, 0, kCollapseTriangleCost * halfArea(box)});
+        const Float4 c = centroid(triangles_[i]);
+        b = Box4{min4(b.lo, c), max4(b.hi, c)};
+      }
+      chunkBounds[begin / kChunk] = b;
+    });
+    Box4 bounds{splat4(INFINITY), splat4(-INFINITY)};
+    for (const Box4& b : chunkBounds) bounds = unite4(bounds, b);
+    const Float4 extent = bounds.hi - bounds.lo;
+    // A flat axis (all centroids in one plane) gets scale 0 instead of a division by zero.
+    Float4 scale = splat4(0.0f);
+    for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0 ? 1 / extent[a] : 0;
+
+    constexpr size_t kBuckets = size_t(1) << kDigitBits;
+    constexpr int kFirstShift = 64 - kMortonBits;
+    static_assert(kMortonBits % kDigitBits == 0 && kFirstShift >= 31);
+    uint64_t* keys = blocks_[1].array<uint64_t>(0, n);
+    uint64_t* sorted = blocks_[1].array<uint64_t>(n * sizeof(uint64_t), n);
+    const int slices = n < kChunk ? 1 : workers_.count();
+    auto sliceBegin = [&](int s) { return n * size_t(s) / size_t(slices); };
+    auto forSlices = [&](const auto& body) {
+      if (slices == 1) {
+        body(0);
+      } else {
+        workers_.run([&](int worker) { body(worker); });
+      }
+    };
+    std::vector<size_t> offsets(size_t(slices) * kBuckets);  // [slice][bucket]
+    // The keys, in load order, and the counts of the first pass's digits.
+    // (The loops take their bounds and pointers in locals: their 8-byte stores could
+    // otherwise change the captured sizes, as far as the compiler knows.)
+    forSlices([&](int s) {
+      size_t* const counts = &offsets[size_t(s) * kBuckets];
+      uint64_t* const out = keys;
+      const Triangle* const triangles = triangles_.data();
+      const size_t sliceEnd = sliceBegin(s + 1);
+      std::fill(counts, counts + kBuckets, 0);
+      for (size_t i = sliceBegin(s); i < sliceEnd; ++i) {
+        const uint64_t code = mortonCode33((centroid(triangles[i]) - bounds.lo) * scale);
+        out[i] = code << kFirstShift | i;
+        counts[code & (kBuckets - 1)]++;
       }
     });
+    for (int shift = kFirstShift; shift < 64; shift += kDigitBits) {
+      if (shift != kFirstShift) {
+        forSlices([&](int s) {
+          size_t* const counts = &offsets[size_t(s) * kBuckets];
+          const uint64_t* const in = keys;
+          const int digit = shift;
+          const size_t sliceEnd = sliceBegin(s + 1);
+          std::fill(counts, counts + kBuckets, 0);
+          for (size_t i = sliceBegin(s); i < sliceEnd; ++i) {
+            counts[(in[i] >> digit) & (kBuckets - 1)]++;
+          }
+        });
+      }
+      size_t sum = 0;
+      bool oneBucket = false;
+      for (size_t b = 0; b < kBuckets; ++b) {
+        const size_t bucketStart = sum;
+        for (int s = 0; s < slices; ++s) {
+          sum += std::exchange(offsets[size_t(s) * kBuckets + b], sum);
+        }
+        oneBucket |= sum - bucketStart == n;
+      }
+      if (oneBucket) continue;
+      forSlices([&](int s) {
+        size_t* const next = &offsets[size_t(s) * kBuckets];
+        const uint64_t* const in = keys;
+        uint64_t* const out = sorted;
+        const int digit = shift;
+        const size_t sliceEnd = sliceBegin(s + 1);
+        for (size_t i = sliceBegin(s); i < sliceEnd; ++i) {
+          out[next[(in[i] >> digit) & (kBuckets - 1)]++] = in[i];
+        }
+      });
+      std::swap(keys, sorted);
+    }
+    return keys;
+  }
+
+  // ---- Clustering ------------------------------------------------------------------------
+
+  // Runs the rounds of nearest-neighbour merging over the triangles in the order of the
+  // Morton keys; returns the root's id.
+  uint32_t cluster(const uint64_t* keys) {
+    // The first round's clusters: the triangles' boxes, in block 0; the order for the
+    // linearization.
+    const ClusterArrays triangleClusters(blocks_[0], n_);
+    order_ = std::make_unique_for_overwrite<uint32_t[]>(n_);
+    adviseHugePages(order_.get(), n_ * sizeof(uint32_t));
+    workers_.forChunks(n_, kChunk, [&](size_t begin, size_t end) {
+      const ClusterArrays& c = triangleClusters;
+      uint32_t* const order = order_.get();
+      for (size_t i = begin; i < end; ++i) {
+        // The triangles are read in Morton order, all over memory: fetch ahead.
+        if (i + kPrefetch < end) prefetchTriangle(uint32_t(keys[i + kPrefetch]) & kIndexMask);
+        order[i] = uint32_t(keys[i]) & kIndexMask;
+        c.set(i, triangleBox(triangles_[order[i]]), uint32_t(i));
+      }
+    });
+    triangleClusters.pad(n_);
+    // The keys are done with: block 1 holds the next round's clusters.
+    const ClusterArrays clusters[2] = {triangleClusters, ClusterArrays(blocks_[1], n_)};
     // Not value-initialised: every entry is written before it is read.
-    inner_.reset(new Inner[n_ - 1]);
+    inner_ = std::make_unique_for_overwrite<Inner[]>(n_ - 1);
+    adviseHugePages(inner_.get(), (n_ - 1) * sizeof(Inner));
+    // Per cluster of a round: the offset to its partner in a merge (0: none), from -kRadius
+    // to kRadius.
+    static_assert(kRadius <= 127);
+    const auto partner = std::make_unique_for_overwrite<int8_t[]>(n_);
+    int current = 0;
     size_t count = n_;
     uint32_t created = 0;  // inner nodes so far
     std::vector<uint32_t> merges, survivors;
     // The rounds stop at n / kClusterShare clusters (see kClusterShare).
     const size_t target = std::max<size_t>(1, n_ / kClusterShare);
     while (count > target) {
+      const ClusterArrays &from = clusters[current], &to = clusters[1 - current];
       const size_t chunks = (count + kChunk - 1) / kChunk;
       merges.assign(chunks, 0);
       survivors.assign(chunks, 0);
+      // Each chunk finds the neighbours of its clusters and of the kRadius on either side
+      // (those its clusters can pair with), so that it can tell the mutual pairs at once,
+      // without waiting for the other chunks.
       workers_.forChunks(count, kChunk, [&](size_t begin, size_t end) {
-        findNeighbours(clusters, begin, end, neighbour.get());
-      });
-      auto tally = [&](size_t begin, size_t end) {
+        const size_t first = begin > kRadius ? begin - kRadius : 0;
+        const size_t last = std::min(count, end + kRadius);
+        std::array<uint32_t, kChunk + 2 * kRadius> found;
+        findNeighbours(from, first, last, found.data());
+        // (Pointers in locals: the compiler must assume that byte stores change anything
+        // else in memory.)
+        int8_t* const partners = partner.get();
         uint32_t m = 0, s = 0;
         for (size_t i = begin; i < end; ++i) {
-          const uint32_t j = neighbour[i];
-          const bool mutual = j != i && neighbour[j] == i;
+          const uint32_t j = found[i - first];
+          const bool mutual = j != i && found[j - first] == i;
           m += mutual && i < j;
           s += !mutual || i < j;
+          partners[i] = int8_t(mutual ? int(j) - int(i) : 0);
         }
         merges[begin / kChunk] = m;
         survivors[begin / kChunk] = s;
-      };
-      workers_.forChunks(count, kChunk, tally);
+      });
       size_t merged = 0;
       for (uint32_t m : merges) merged += m;
       if (merged < std::max<size_t>(1, count / kMinMergeShare)) {
         // Too little progress: merge clusters 2k and 2k + 1 this round.
         workers_.forChunks(count, kChunk, [&](size_t begin, size_t end) {
+          int8_t* const partners = partner.get();
+          uint32_t m = 0, s = 0;
           for (size_t i = begin; i < end; ++i) {
-            neighbour[i] = uint32_t((i ^ 1) < count ? i ^ 1 : i);
+            const bool paired = (i ^ 1) < count;
+            m += paired && i % 2 == 0;
+            s += !paired || i % 2 == 0;
+            partners[i] = int8_t(!paired ? 0 : i % 2 ? -1 : 1);
           }
+          merges[begin / kChunk] = m;
+          survivors[begin / kChunk] = s;
         });
-        workers_.forChunks(count, kChunk, tally);
       }
       // Exclusive prefix sums: where each chunk's new nodes and survivors go.
       uint32_t nodeSum = created, outSum = 0;
@@ -293,175 +674,260 @@ class PlocBuilder {
         outSum += std::exchange(survivors[c], outSum);
       }
       workers_.forChunks(count, kChunk, [&](size_t begin, size_t end) {
-        uint32_t node = merges[begin / kChunk];
-        uint32_t out = survivors[begin / kChunk];
-        for (size_t i = begin; i < end; ++i) {
-          const uint32_t j = neighbour[i];
-          const bool mutual = j != i && neighbour[j] == i;
-          if (!mutual) {
-            next.set(out++, clusters.box(i), clusters.id[i], clusters.summary[i]);
-          } else if (i < j) {
-            Inner& parent = inner_[node];
-            parent.left = clusters.id[i];
-            parent.right = clusters.id[j];
-            parent.box = unite(clusters.box(i), clusters.box(j));
-            const Summary s = merge(parent, clusters.summary[i], clusters.summary[j]);
-            next.set(out++, parent.box, uint32_t(n_) + node++, s);
-          }
-        }
+        compact(from, to, partner.get(), begin, end, count, merges[begin / kChunk],
+                survivors[begin / kChunk]);
       });
       created = nodeSum;
       count = outSum;
-      next.pad(count);
-      std::swap(clusters, next);
+      to.pad(count);
+      current = 1 - current;
     }
-    if (count == 1) return clusters.id[0];
-    return buildTop(clusters, count, created);
+    if (count == 1) return clusters[current].id[0];
+    // The other block is free now: it holds the top levels' state.
+    return buildTop(clusters[current], count, created, blocks_[1 - current]);
+  }
+
+  // Moves the clusters [begin, end) of `from` that do not merge to `to` from position `out`
+  // on, in order, and makes the merges, as inner nodes from `node` on, in their place.
+  // (Everything in arguments and locals, so that the loop keeps it in registers.)
+  void compact(const ClusterArrays from, const ClusterArrays to, const int8_t* const partner,
+               size_t begin, size_t end, size_t count, uint32_t node, uint32_t out) const {
+    Inner* const inner = inner_.get();
+    const uint32_t n = uint32_t(n_);
+    auto summaryOf = [&](uint32_t id, const Box& box) {
+      return id < n ? Summary{1, 1, kCollapseTriangleCost * halfArea(box)} : inner[id - n].summary;
+    };
+    for (size_t i = begin; i < end; ++i) {
+      // A merge reads its children's summaries from nodes made rounds ago, by now out of
+      // the caches: fetch ahead those of the clusters that will merge.
+      if (i + kPrefetch < count && partner[i + kPrefetch] != 0) {
+        const uint32_t ahead = from.id[i + kPrefetch];
+        if (ahead >= n) __builtin_prefetch(&inner[ahead - n].summary);
+      }
+      const int offset = partner[i];
+      if (offset == 0) {
+        to.set(out++, from.box(i), from.id[i]);
+      } else if (offset > 0) {  // the pair's first cluster makes the merge
+        const size_t j = i + size_t(offset);
+        const Box left = from.box(i), right = from.box(j), box = unite(left, right);
+        Inner& parent = inner[node];
+        parent.left = from.id[i];
+        parent.right = from.id[j];
+        parent.summary =
+            merge(halfArea(box), summaryOf(parent.left, left), summaryOf(parent.right, right));
+        to.set(out++, box, n + node++);
+      }
+    }
+  }
+
+  static constexpr uint32_t kIndexMask = 0x7fffffffu;
+
+  void prefetchTriangle(uint32_t index) const {
+    const char* t = reinterpret_cast<const char*>(&triangles_[index]);
+    __builtin_prefetch(t);
+    __builtin_prefetch(t + sizeof(Triangle) - 1);
+  }
+
+  // The summary of cluster `id` with box `box`: a triangle's is its own.
+  Summary summaryOf(uint32_t id, const Box& box) const {
+    return id < n_ ? Summary{1, 1, kCollapseTriangleCost * halfArea(box)} : inner_[id - n_].summary;
   }
 
   // Subtree sizes by id; a triangle is a leaf of its own.
-  uint32_t countOf(uint32_t id) const { return id < n_ ? 1u : inner_[id - n_].count; }
-  uint32_t sizeOf(uint32_t id) const { return id < n_ ? 1u : inner_[id - n_].size; }
-  int heightOf(uint32_t id) const { return id < n_ ? 0 : inner_[id - n_].height; }
+  uint32_t countOf(uint32_t id) const { return id < n_ ? 1u : inner_[id - n_].summary.count; }
+  uint32_t sizeOf(uint32_t id) const { return id < n_ ? 1u : inner_[id - n_].summary.size; }
 
-  // Completes `parent` (box and children set) from its children's summaries, deciding the
-  // SAH collapse bottom-up as the tree is made: a subtree of at most leafSize triangles
+  // The summary of a merge of half area `area` of subtrees summarised by `l` and `r`, deciding
+  // the SAH collapse bottom-up as the tree is made: a subtree of at most leafSize triangles
   // becomes one leaf when that costs no more than keeping its best split (costs times area:
   // a leaf costs count * Ci * A, a split Ct * A plus its children's).
-  Summary merge(Inner& parent, const Summary& l, const Summary& r) const {
-    const float area = halfArea(parent.box);
+  Summary merge(float area, const Summary& l, const Summary& r) const {
     const uint32_t count = l.count + r.count;
     const float splitCost = kCollapseTraversalCost * area + l.cost + r.cost;
     const float leafCost = kCollapseTriangleCost * float(count) * area;
-    const Summary s =
-        count <= leafSize_ && leafCost <= splitCost
-            ? Summary{count, 1, 0, leafCost}
-            : Summary{count, 1 + l.size + r.size, 1 + std::max(l.height, r.height), splitCost};
-    parent.count = s.count;
-    parent.size = s.size;
-    parent.height = s.height;
-    return s;
+    return count <= leafSize_ && leafCost <= splitCost
+               ? Summary{count, 1, leafCost}
+               : Summary{count, 1 + l.size + r.size, splitCost};
   }
 
   // ---- Top levels ------------------------------------------------------------------------
 
-  // A cluster left by the rounds, as the top-down splits see and move it.
-  struct TopRef {
-    Float4 lo, hi;     // its box in lanes x, y, z
-    uint32_t cluster;  // its index in the clusters of the last round
-    uint32_t count;    // triangles
+  // The bounds of the clusters' centres (doubled: lo + hi) in lanes x, y, z.
+  struct CenterBounds {
+    Float4 lo = splat4(INFINITY), hi = splat4(-INFINITY);
+    void grow(Float4 center) {
+      lo = min4(lo, center);
+      hi = max4(hi, center);
+    }
+    void grow(const CenterBounds& b) {
+      lo = min4(lo, b.lo);
+      hi = max4(hi, b.hi);
+    }
   };
-  // The bins of one axis; the first binCount of them are cleared before use.
-  struct AxisBins {
-    Float4 lo[kTopBins], hi[kTopBins];
-    uint32_t count[kTopBins];  // triangles
-  };
-  using Bins = std::array<AxisBins, 3>;
   // What a subtree of the top levels hands its parent.
   struct TopRoot {
     uint32_t id;
-    Box box;
+    Box4 box;
     Summary summary;
+  };
+  // A range of clusters to split: refs_[buffer][first, last), its centres within `bounds`.
+  struct TopRange {
+    size_t first, last;
+    int buffer;
+    CenterBounds bounds;
   };
 
   // Builds the levels above the `count` clusters top-down with binned SAH (Wald 2007), in
   // parallel over subtrees as in the LBVH; returns the root's id. A subtree over m clusters
   // owns the m - 1 inner ids from its `base` (its root last, after its children's), so the
   // ids do not depend on the order the subtrees are built in.
-  uint32_t buildTop(const Clusters& clusters, size_t count, uint32_t base) {
-    refs_ = std::make_unique_for_overwrite<TopRef[]>(count);
-    scratch_ = std::make_unique_for_overwrite<TopRef[]>(count);
-    binIndex_ = std::make_unique_for_overwrite<std::array<uint8_t, 3>[]>(count);
+  uint32_t buildTop(const ClusterArrays& clusters, size_t count, uint32_t base,
+                    const Block& block) {
     topClusters_ = &clusters;
+    static_assert(sizeof(TopRef) % alignof(Summary) == 0);
+    refs_[0] = block.array<TopRef>(0, count);
+    refs_[1] = block.array<TopRef>(count * sizeof(TopRef), count);
+    topSummaries_ = block.array<Summary>(2 * count * sizeof(TopRef), count);
+    binIndex_ = block.array<std::array<uint8_t, 3>>(
+        2 * count * sizeof(TopRef) + count * sizeof(Summary), count);
+    std::vector<CenterBounds> chunkBounds((count + kChunk - 1) / kChunk);
     workers_.forChunks(count, kChunk, [&](size_t begin, size_t end) {
+      CenterBounds bounds;
       for (size_t i = begin; i < end; ++i) {
+        // The clusters' summaries are in nodes made in any round: fetch ahead.
+        if (i + kPrefetch < end && clusters.id[i + kPrefetch] >= n_) {
+          __builtin_prefetch(&inner_[clusters.id[i + kPrefetch] - n_].summary);
+        }
         const Box box = clusters.box(i);
-        refs_[i] = TopRef{Float4{box.lo.x, box.lo.y, box.lo.z, 0.0f},
-                          Float4{box.hi.x, box.hi.y, box.hi.z, 0.0f}, uint32_t(i),
-                          clusters.summary[i].count};
+        topSummaries_[i] = summaryOf(clusters.id[i], box);
+        TopRef& ref = refs_[0][i];
+        ref = TopRef{{box.lo.x, box.lo.y, box.lo.z},
+                     uint32_t(i),
+                     {-box.hi.x, -box.hi.y, -box.hi.z},
+                     topSummaries_[i].count};
+        bounds.grow(topCenter(ref));
       }
+      chunkBounds[begin / kChunk] = bounds;
     });
+    TopRange all{0, count, 0, {}};
+    for (const CenterBounds& b : chunkBounds) all.bounds.grow(b);
     pieceSize_ = workers_.count() == 1
                      ? count
                      : std::max<size_t>(kTopPieceMin, count / size_t(8 * workers_.count()));
     plan_.clear();
-    cut(0, count, base);
+    cut(all, base);
     std::vector<uint32_t> pieces;
     for (uint32_t i = 0; i < plan_.size(); ++i) {
       if (plan_[i].piece) pieces.push_back(i);
     }
     workers_.forChunks(pieces.size(), 1, [&](size_t p, size_t) {
       TopItem& item = plan_[pieces[p]];
-      item.root = buildTopSerial(item.first, item.last, item.base);
+      item.root = buildTopSerial(item.range, item.base);
     });
     for (size_t i = plan_.size(); i-- > 0;) {
       TopItem& item = plan_[i];
       if (!item.piece) {
-        item.root = join(item.base + uint32_t(item.last - item.first) - 2, plan_[i + 1].root,
-                         plan_[item.right].root);
+        item.root = join(item.base + uint32_t(item.range.last - item.range.first) - 2,
+                         plan_[i + 1].root, plan_[item.right].root);
       }
     }
     return plan_[0].root.id;
   }
 
   struct TopItem {
-    size_t first, last;  // clusters refs_[first, last)
+    TopRange range;
     uint32_t base;
     bool piece;          // built whole by one worker; else split here
     uint32_t right = 0;  // a split's right child in plan_ (the left one follows it)
     TopRoot root{};
   };
 
-  // Plans the top levels over refs_[first, last) depth first, splitting (binning in
+  // Plans the top levels over `range` depth first, splitting (binning and partitioning in
   // parallel) until the ranges are small enough to share out.
-  void cut(size_t first, size_t last, uint32_t base) {
+  void cut(const TopRange& range, uint32_t base) {
     const uint32_t item = uint32_t(plan_.size());
-    const size_t m = last - first;
-    plan_.push_back(TopItem{first, last, base, m <= pieceSize_ || m == 1});
+    const size_t m = range.last - range.first;
+    plan_.push_back(TopItem{range, base, m <= pieceSize_ || m == 1});
     if (plan_[item].piece) return;
-    const size_t middle = splitRange(first, last, true);
-    cut(first, middle, base);
+    TopRange left, right;
+    splitRange(range, true, left, right);
+    cut(left, base);
     plan_[item].right = uint32_t(plan_.size());
-    cut(middle, last, base + uint32_t(middle - first) - 1);
+    cut(right, base + uint32_t(left.last - left.first) - 1);
   }
 
-  TopRoot buildTopSerial(size_t first, size_t last, uint32_t base) {
-    if (last - first <= kTopSmall) return clusterSmall(first, last, base);
-    const size_t middle = splitRange(first, last, false);
-    const TopRoot left = buildTopSerial(first, middle, base);
-    const TopRoot right = buildTopSerial(middle, last, base + uint32_t(middle - first) - 1);
-    return join(base + uint32_t(last - first) - 2, left, right);
+  TopRoot buildTopSerial(const TopRange& range, uint32_t base) {
+    if (range.last - range.first <= kTopSmall) return clusterSmall(range, base);
+    TopRange left, right;
+    splitRange(range, false, left, right);
+    const TopRoot l = buildTopSerial(left, base);
+    const TopRoot r = buildTopSerial(right, base + uint32_t(left.last - left.first) - 1);
+    return join(base + uint32_t(range.last - range.first) - 2, l, r);
   }
 
   // Finishes a range of at most kTopSmall clusters as the rounds would, had they a window
   // over all of it: merging the pair whose merged box has the least area until one is left.
   // On a tie the pair with fewer triangles merges (equal boxes make a balanced tree, not a
   // chain), then the first in range order. The last merge, the root, gets the last id.
-  TopRoot clusterSmall(size_t first, size_t last, uint32_t base) {
-    std::array<TopRoot, kTopSmall> part;
-    size_t m = last - first;
+  // The areas of all pairs are computed once and then only those of each new merge.
+  TopRoot clusterSmall(const TopRange& range, uint32_t base) {
+    std::array<TopRoot, kTopSmall> part;   // by slot
+    std::array<uint8_t, kTopSmall> order;  // the slots still there, in range order
+    // By slots, either way round: the pairs' areas and triangle counts as one number that
+    // orders them as the comparison above does (see pairKey).
+    std::array<std::array<uint64_t, kTopSmall>, kTopSmall> keys;
+    size_t m = range.last - range.first;
     for (size_t k = 0; k < m; ++k) {
-      const uint32_t c = refs_[first + k].cluster;
-      part[k] = TopRoot{topClusters_->id[c], topClusters_->box(c), topClusters_->summary[c]};
+      const TopRef& ref = refs_[range.buffer][range.first + k];
+      part[k] = TopRoot{topClusters_->id[ref.cluster], Box4{topLo(ref), topHi(ref)},
+                        topSummaries_[ref.cluster]};
+      order[k] = uint8_t(k);
+    }
+    // (The boxes are united in range order, as a merge would unite them.)
+    auto key = [&](size_t first, size_t second) {
+      return pairKey(halfArea4(unite4(part[first].box, part[second].box)),
+                     part[first].summary.count + part[second].summary.count);
+    };
+    for (size_t a = 0; a + 1 < m; ++a) {
+      for (size_t b = a + 1; b < m; ++b) keys[a][b] = keys[b][a] = key(a, b);
     }
     for (; m > 1; --m) {
-      size_t bestA = 0, bestB = 1;
-      float bestArea = INFINITY;
-      uint32_t bestCount = UINT32_MAX;
+      // The first least key (without branches: which pair wins is as good as random).
+      uint64_t bestKey = UINT64_MAX;
+      size_t best = 1;  // a * kTopSmall + b; the first pair when every area is NaN
       for (size_t a = 0; a + 1 < m; ++a) {
+        const auto& row = keys[order[a]];
         for (size_t b = a + 1; b < m; ++b) {
-          const float area = halfArea(unite(part[a].box, part[b].box));
-          const uint32_t count = part[a].summary.count + part[b].summary.count;
-          if (area < bestArea || (area == bestArea && count < bestCount)) {
-            bestArea = area, bestCount = count, bestA = a, bestB = b;
-          }
+          const uint64_t k = row[order[b]];
+          const bool better = k < bestKey;
+          bestKey = better ? k : bestKey;
+          best = better ? a * kTopSmall + b : best;
         }
       }
-      part[bestA] = join(base++, part[bestA], part[bestB]);
-      std::copy(part.begin() + ptrdiff_t(bestB) + 1, part.begin() + ptrdiff_t(m),
-                part.begin() + ptrdiff_t(bestB));
+      const size_t bestA = best / kTopSmall, bestB = best % kTopSmall;
+      const size_t slot = order[bestA];
+      part[slot] = join(base++, part[slot], part[order[bestB]]);
+      std::copy(order.begin() + ptrdiff_t(bestB) + 1, order.begin() + ptrdiff_t(m),
+                order.begin() + ptrdiff_t(bestB));
+      for (size_t k = 0; k + 1 < m; ++k) {
+        const size_t other = order[k];
+        if (k == bestA) continue;
+        keys[slot][other] = keys[other][slot] = k < bestA ? key(other, slot) : key(slot, other);
+      }
     }
-    return part[0];
+    return part[order[0]];
+  }
+
+  // A pair of clusterSmall as one number: lesser when its area is less, or equal with fewer
+  // triangles, as floats compare (-0 is 0); NaN areas are never lesser than anything.
+  static uint64_t pairKey(float area, uint32_t count) {
+    const float a = area + 0.0f;  // -0 + 0 is +0
+    if (a != a) return UINT64_MAX;
+    uint32_t bits;
+    std::memcpy(&bits, &a, sizeof bits);
+    // Floats ordered as unsigned integers: negative ones (not areas, but still) reversed.
+    bits = bits & 0x80000000u ? ~bits : bits | 0x80000000u;
+    return uint64_t(bits) << 32 | count;
   }
 
   // Makes inner node `node` the parent of two subtrees.
@@ -469,151 +935,155 @@ class PlocBuilder {
     Inner& parent = inner_[node];
     parent.left = left.id;
     parent.right = right.id;
-    parent.box = unite(left.box, right.box);
-    return TopRoot{uint32_t(n_) + node, parent.box, merge(parent, left.summary, right.summary)};
+    const Box4 box = unite4(left.box, right.box);
+    parent.summary = merge(halfArea4(box), left.summary, right.summary);
+    return TopRoot{uint32_t(n_) + node, box, parent.summary};
   }
 
-  // Splits refs_[first, last) (at least two clusters) where the binned SAH says, keeping
-  // Morton order on each side; returns where the right side starts. A range of m clusters
-  // gets min(m, kTopBins) bins per axis: most ranges are small. With `parallel`, the bounds
-  // and bins are gathered by chunks on all workers (exact merges: min, max, sums).
-  size_t splitRange(size_t first, size_t last, bool parallel) {
-    const size_t m = last - first;
-    if (m == 2) return first + 1;
+  // Splits `range` (more than two clusters) where the binned SAH says, keeping Morton order
+  // on each side, into `left` and `right`. A range of m clusters gets min(m, kTopBins) bins
+  // per axis: most ranges are small. The clusters move to the other buffer, left side first
+  // (each side's size is known from the bins, so one pass moves every cluster once), and the
+  // pass gathers each side's centre bounds for its own split. With `parallel`, the bins are
+  // gathered and the clusters moved by chunks on all workers (the bins merge exactly: min,
+  // max, sums; each chunk's clusters go where the counts of the chunks before it say).
+  void splitRange(const TopRange& range, bool parallel, TopRange& left, TopRange& right) {
+    const size_t first = range.first, last = range.last, m = last - first;
     parallel = parallel && m > kChunk;
     const size_t parts = parallel ? (m + kChunk - 1) / kChunk : 1;
     auto forParts = [&](auto&& body) {
       workers_.forChunks(m, kChunk,
                          [&](size_t b, size_t e) { body(b / kChunk, first + b, first + e); });
     };
-    // Bounds of the centres (doubled: lo + hi).
-    Float4 lo, hi;
-    if (parallel) {
-      std::vector<std::array<Float4, 2>> partBounds(parts);
-      forParts([&](size_t part, size_t b, size_t e) { partBounds[part] = centerBounds(b, e); });
-      lo = partBounds[0][0], hi = partBounds[0][1];
-      for (const auto& [partLo, partHi] : partBounds) lo = min4(lo, partLo), hi = max4(hi, partHi);
-    } else {
-      const auto bounds = centerBounds(first, last);
-      lo = bounds[0], hi = bounds[1];
-    }
+    const Float4 lo = range.bounds.lo, hi = range.bounds.hi;
     const int binCount = int(std::min<size_t>(m, kTopBins));
     Float4 scale = splat4(0.0f);
     for (int a = 0; a < 3; ++a) {
       const float extent = hi[a] - lo[a];
       if (extent > 0.0f) scale[a] = float(binCount) / extent;
     }
+    const TopRef* from = refs_[range.buffer];
     Bins bins;
+    std::vector<Bins> partBins(parallel ? parts : 0);
     if (parallel) {
-      std::vector<Bins> partBins(parts);
       forParts([&](size_t part, size_t b, size_t e) {
-        binRange(b, e, lo, scale, binCount, partBins[part]);
+        binClusters(from, b, e, lo, scale, binCount, partBins[part], binIndex_);
       });
       bins = partBins[0];
       for (size_t p = 1; p < parts; ++p) {
         for (size_t a = 0; a < 3; ++a) {
           for (int k = 0; k < binCount; ++k) {
-            bins[a].lo[k] = min4(bins[a].lo[k], partBins[p][a].lo[k]);
-            bins[a].hi[k] = max4(bins[a].hi[k], partBins[p][a].hi[k]);
+            grow8(bins[a].box[k], partBins[p][a].box[k]);
             bins[a].count[k] += partBins[p][a].count[k];
           }
         }
       }
     } else {
-      binRange(first, last, lo, scale, binCount, bins);
+      binClusters(from, first, last, lo, scale, binCount, bins, binIndex_);
     }
     // Sweep each axis for the least area(left) * count(left) + area(right) * count(right).
     uint32_t total = 0;
-    for (int k = 0; k < binCount; ++k) total += bins[0].count[k];
-    auto area = [](Float4 lo, Float4 hi) {
-      const Float4 d = hi - lo;
+    for (int k = 0; k < binCount; ++k) total += uint32_t(bins[0].count[k]);
+    // (hi is -(-hi), to the bit.)
+    auto area = [](const Float8& box) {
+      Float4 lo, negHi;
+      std::memcpy(&lo, &box, sizeof lo);
+      std::memcpy(&negHi, reinterpret_cast<const char*>(&box) + sizeof lo, sizeof negHi);
+      const Float4 d = -negHi - lo;
       return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
     };
+    const Float8 empty = {INFINITY, INFINITY, INFINITY, INFINITY,
+                          INFINITY, INFINITY, INFINITY, INFINITY};
     int bestAxis = -1, bestBin = 0;
     float bestCost = INFINITY;
     for (int a = 0; a < 3; ++a) {
       if (scale[a] == 0.0f) continue;
       const AxisBins& axis = bins[size_t(a)];
       std::array<float, kTopBins> rightCost;
-      Float4 accLo = splat4(INFINITY), accHi = splat4(-INFINITY);
+      Float8 acc = empty;
       uint32_t count = 0;
+      // An empty bin changes neither side: a split after it costs what the split before it
+      // costs, so it is skipped (the first of equal costs wins anyway), and the cost of the
+      // right side from it on is the one from the next bin on.
       for (int k = binCount - 1; k > 0; --k) {
-        accLo = min4(accLo, axis.lo[k]);
-        accHi = max4(accHi, axis.hi[k]);
-        count += axis.count[k];
-        rightCost[size_t(k)] = area(accLo, accHi) * float(count);
+        if (axis.count[k] == 0 && k < binCount - 1) {
+          rightCost[size_t(k)] = rightCost[size_t(k) + 1];
+          continue;
+        }
+        grow8(acc, axis.box[k]);
+        count += uint32_t(axis.count[k]);
+        rightCost[size_t(k)] = area(acc) * float(count);
       }
-      accLo = splat4(INFINITY), accHi = splat4(-INFINITY);
+      acc = empty;
       count = 0;
       for (int k = 1; k < binCount; ++k) {
-        accLo = min4(accLo, axis.lo[k - 1]);
-        accHi = max4(accHi, axis.hi[k - 1]);
-        count += axis.count[k - 1];
+        if (axis.count[k - 1] == 0) continue;
+        grow8(acc, axis.box[k - 1]);
+        count += uint32_t(axis.count[k - 1]);
         if (count == 0 || count == total) continue;
-        const float cost = area(accLo, accHi) * float(count) + rightCost[size_t(k)];
+        const float cost = area(acc) * float(count) + rightCost[size_t(k)];
         if (cost < bestCost) bestCost = cost, bestAxis = a, bestBin = k;
       }
     }
-    // No split separates the centres (all in one bin on every axis): halve in Morton order.
-    if (bestAxis < 0) return first + m / 2;
-    // Stable partition through the same range of scratch_ (workers own disjoint ranges), so
-    // that each side stays in Morton order.
-    size_t left = first, right = first;
-    for (size_t i = first; i < last; ++i) {
-      if (binIndex_[i][size_t(bestAxis)] < bestBin) {
-        refs_[left++] = refs_[i];
+    if (bestAxis < 0) {
+      // No split separates the centres (all in one bin on every axis): halve in Morton
+      // order, in place.
+      left = TopRange{first, first + m / 2, range.buffer, centerBounds(from, first, first + m / 2)};
+      right = TopRange{first + m / 2, last, range.buffer, centerBounds(from, first + m / 2, last)};
+      return;
+    }
+    auto leftClusters = [&](const Bins& b) {
+      size_t sum = 0;
+      for (int k = 0; k < bestBin; ++k) sum += size_t(b[size_t(bestAxis)].count[k] >> 32);
+      return sum;
+    };
+    const size_t middle = first + leftClusters(bins);
+    PT_CHECK(middle > first && middle < last);
+    const int to = 1 - range.buffer;
+    left = TopRange{first, middle, to, {}};
+    right = TopRange{middle, last, to, {}};
+    if (parallel) {
+      std::vector<std::array<CenterBounds, 2>> partBounds(parts);
+      std::vector<size_t> leftStart(parts), rightStart(parts);
+      for (size_t p = 0, l = first, r = middle; p < parts; ++p) {
+        leftStart[p] = l, rightStart[p] = r;
+        const size_t leftHere = leftClusters(partBins[p]);
+        l += leftHere;
+        r += std::min(m, (p + 1) * kChunk) - p * kChunk - leftHere;
+      }
+      forParts([&](size_t part, size_t b, size_t e) {
+        partition(from, b, e, bestAxis, bestBin, to, leftStart[part], rightStart[part],
+                  partBounds[part]);
+      });
+      for (const auto& [l, r] : partBounds) left.bounds.grow(l), right.bounds.grow(r);
+    } else {
+      std::array<CenterBounds, 2> bounds;
+      partition(from, first, last, bestAxis, bestBin, to, first, middle, bounds);
+      left.bounds = bounds[0], right.bounds = bounds[1];
+    }
+  }
+
+  CenterBounds centerBounds(const TopRef* refs, size_t begin, size_t end) const {
+    CenterBounds bounds;
+    for (size_t i = begin; i < end; ++i) bounds.grow(topCenter(refs[i]));
+    return bounds;
+  }
+
+  // Moves the clusters refs[begin, end) to buffer `to`, those left of the split to
+  // positions from `left` on and the others from `right` on, in order; gathers each side's
+  // centre bounds.
+  void partition(const TopRef* refs, size_t begin, size_t end, int axis, int bin, int to,
+                 size_t left, size_t right, std::array<CenterBounds, 2>& bounds) {
+    TopRef* out = refs_[to];
+    for (size_t i = begin; i < end; ++i) {
+      const TopRef& cluster = refs[i];
+      const Float4 center = topCenter(cluster);
+      if (binIndex_[i][size_t(axis)] < bin) {
+        out[left++] = cluster;
+        bounds[0].grow(center);
       } else {
-        scratch_[right++] = refs_[i];
-      }
-    }
-    std::copy(scratch_.get() + first, scratch_.get() + right, refs_.get() + left);
-    PT_CHECK(left > first && left < last);
-    return left;
-  }
-
-  std::array<Float4, 2> centerBounds(size_t begin, size_t end) const {
-    Float4 lo = splat4(INFINITY), hi = splat4(-INFINITY);
-    for (size_t i = begin; i < end; ++i) {
-      const TopRef& c = refs_[i];
-      const Float4 center = c.lo + c.hi;
-      lo = min4(lo, center);
-      hi = max4(hi, center);
-    }
-    return {lo, hi};
-  }
-
-  // Bins the clusters refs_[begin, end) on all three axes, noting each one's bins. Even and
-  // odd positions fill separate bins, merged at the end: runs of clusters in one bin would
-  // otherwise wait for each other's updates.
-  void binRange(size_t begin, size_t end, Float4 lo, Float4 scale, int binCount, Bins& bins) {
-    Bins odd;
-    for (Bins* b : {&bins, &odd}) {
-      for (AxisBins& axis : *b) {
-        std::fill_n(axis.lo, binCount, splat4(INFINITY));
-        std::fill_n(axis.hi, binCount, splat4(-INFINITY));
-        std::fill_n(axis.count, binCount, 0u);
-      }
-    }
-    const float lastBin = float(binCount - 1);
-    for (size_t i = begin; i < end; ++i) {
-      const TopRef& cluster = refs_[i];
-      const Float4 x = (cluster.lo + cluster.hi - lo) * scale;
-      Bins& target = i % 2 ? odd : bins;
-      for (size_t a = 0; a < 3; ++a) {
-        // std::min(lastBin, x) is lastBin for a NaN x, so the conversion stays defined.
-        const int k = int(std::min(lastBin, x[a]));
-        binIndex_[i][a] = uint8_t(k);
-        AxisBins& axis = target[a];
-        axis.lo[k] = min4(axis.lo[k], cluster.lo);
-        axis.hi[k] = max4(axis.hi[k], cluster.hi);
-        axis.count[k] += cluster.count;
-      }
-    }
-    for (size_t a = 0; a < 3; ++a) {
-      for (int k = 0; k < binCount; ++k) {
-        bins[a].lo[k] = min4(bins[a].lo[k], odd[a].lo[k]);
-        bins[a].hi[k] = max4(bins[a].hi[k], odd[a].hi[k]);
-        bins[a].count[k] += odd[a].count[k];
+        out[right++] = cluster;
+        bounds[1].grow(center);
       }
     }
   }
@@ -622,65 +1092,171 @@ class PlocBuilder {
 
   Bvh linearize(uint32_t root) {
     Bvh bvh;
+    bvh.triangles.reserve(n_);
+    adviseHugePages(bvh.triangles.data(), n_ * sizeof(Triangle));
     bvh.triangles.resize(n_);
-    if (heightOf(root) <= depthLimit_) {
-      bvh.nodes.resize(sizeOf(root));
-      nodes_ = bvh.nodes.data();
-      out_ = bvh.triangles.data();
-      std::vector<Piece> pieces;
-      place(root, 0, 0, &pieces);
-      workers_.forChunks(pieces.size(), 1, [&](size_t p, size_t) {
-        place(pieces[p].id, pieces[p].position, pieces[p].first, nullptr);
-      });
-      bvh.maxDepth = heightOf(root);
-    } else {
-      bvh.maxDepth = 0;
-      out_ = bvh.triangles.data();
-      placeWithinStack(root, 0, 0, bvh.nodes, bvh.maxDepth);
+    out_ = bvh.triangles.data();
+    bvh.nodes.reserve(sizeOf(root));
+    adviseHugePages(bvh.nodes.data(), sizeOf(root) * sizeof(BvhNode));
+    bvh.nodes.resize(sizeOf(root));
+    nodes_ = bvh.nodes.data();
+    std::vector<Piece> pieces;
+    int maxDepth = plan(root, 0, 0, 0, pieces);
+    std::vector<int> pieceDepths(pieces.size());
+    workers_.forChunks(pieces.size(), 1, [&](size_t p, size_t) {
+      pieceDepths[p] = place(pieces[p].id, pieces[p].position, pieces[p].first, pieces[p].depth);
+    });
+    for (int depth : pieceDepths) maxDepth = std::max(maxDepth, depth);
+    if (maxDepth <= depthLimit_) {
+      uniteAbovePieces(root, 0);
+      bvh.maxDepth = maxDepth;
+      return bvh;
     }
+    // Too deep for the traversal stack (rare): start over within it, with every inner node's
+    // height and box at hand (children have smaller ids than their parents).
+    heights_ = std::make_unique_for_overwrite<int[]>(n_ - 1);
+    boxes_ = std::make_unique_for_overwrite<Box[]>(n_ - 1);
+    for (size_t k = 0; k + 1 < n_; ++k) {
+      const Inner& node = inner_[k];
+      heights_[k] =
+          node.summary.size == 1 ? 0 : 1 + std::max(heightOf(node.left), heightOf(node.right));
+      boxes_[k] = unite(boxOf(node.left), boxOf(node.right));
+    }
+    bvh.nodes.clear();
+    bvh.maxDepth = 0;
+    placeWithinStack(root, 0, 0, bvh.nodes, bvh.maxDepth);
     return bvh;
   }
 
   struct Piece {
     uint32_t id, position, first;
+    int depth;
   };
 
-  // Writes the collapsed subtree of `id` with its root at nodes_[position] and its triangles
-  // from out_[first] on, depth first, left child first. With `pieces`, subtrees of at most
-  // kPieceSize triangles are listed there for the workers instead of written.
-  void place(uint32_t id, uint32_t position, uint32_t first, std::vector<Piece>* pieces) {
-    if (id < n_) {
-      const Triangle& t = triangles_[order_[id]];
-      const Bounds b = triangleBounds(t);
-      nodes_[position] = BvhNode{b.lo, first, b.hi, 1u};
-      out_[first] = t;
-      return;
+  // The top of the collapsed tree of `id`, at `depth`, with its root at nodes_[position] and
+  // its triangles from out_[first] on: lists the subtrees of at most kPieceSize triangles
+  // (and the leaves above them) in `pieces` for the workers to place, and notes the right
+  // children of the inner nodes above them (their boxes are left to uniteAbovePieces).
+  // Returns the depth of the deepest leaf above the pieces (or of one below depthLimit_:
+  // then the tree is too deep and not all listed).
+  int plan(uint32_t id, uint32_t position, uint32_t first, int depth, std::vector<Piece>& pieces) {
+    if (depth > depthLimit_) return depth;
+    if (!aboveThePieces(id)) {
+      pieces.push_back(Piece{id, position, first, depth});
+      return depth;
     }
     const Inner& node = inner_[id - n_];
-    if (node.size == 1) {  // collapsed into a leaf
-      nodes_[position] = BvhNode{node.box.lo, first, node.box.hi, node.count};
-      gather(id, first);
-      return;
-    }
-    if (pieces && node.count <= kPieceSize) {
-      pieces->push_back(Piece{id, position, first});
-      return;
-    }
     const uint32_t right = position + 1 + sizeOf(node.left);
-    nodes_[position] = BvhNode{node.box.lo, right, node.box.hi, 0u};
-    place(node.left, position + 1, first, pieces);
-    place(node.right, right, first + countOf(node.left), pieces);
+    nodes_[position] = BvhNode{vec3(0.0f), right, vec3(0.0f), 0u};
+    const int leftDepth = plan(node.left, position + 1, first, depth + 1, pieces);
+    return std::max(leftDepth,
+                    plan(node.right, right, first + countOf(node.left), depth + 1, pieces));
   }
 
-  // The triangles of the subtree of `id`, in depth-first order, to out_[first] on.
-  uint32_t gather(uint32_t id, uint32_t first) {
+  bool aboveThePieces(uint32_t id) const {
+    return id >= n_ && inner_[id - n_].summary.size > 1 &&
+           inner_[id - n_].summary.count > kPieceSize;
+  }
+
+  // The boxes of the inner nodes above the pieces, once the pieces are written.
+  Box uniteAbovePieces(uint32_t id, uint32_t position) {
+    BvhNode& out = nodes_[position];
+    if (aboveThePieces(id)) {
+      const Inner& node = inner_[id - n_];
+      const Box box = unite(uniteAbovePieces(node.left, position + 1),
+                            uniteAbovePieces(node.right, out.offset));
+      out.boundsMin = box.lo;
+      out.boundsMax = box.hi;
+    }
+    return Box{out.boundsMin, out.boundsMax};
+  }
+
+  // Writes the collapsed subtree of `id`, at `depth` in the tree, with its root at
+  // nodes_[position] and its triangles from out_[first] on, depth first, left child first;
+  // returns the depth of its deepest leaf. First the triangles, then the nodes over them.
+  int place(uint32_t id, uint32_t position, uint32_t first, int depth) {
+    copyTriangles(id, first);
+    return placeNodes(id, position, first, depth).depth;
+  }
+
+  // The triangles of the subtree of `id` in depth-first order, to out_[first] on. They lie
+  // all over memory: the ranks are listed first, so that the copies can fetch ahead.
+  void copyTriangles(uint32_t id, uint32_t first) {
+    std::vector<uint32_t> ranks;
+    ranks.reserve(countOf(id));
+    listRanks(id, ranks);
+    const size_t count = ranks.size();
+    for (size_t k = 0; k < count; ++k) {
+      if (k + kPrefetch < count) prefetchTriangle(order_[ranks[k + kPrefetch]]);
+      out_[first + k] = triangles_[order_[ranks[k]]];
+    }
+  }
+
+  void listRanks(uint32_t id, std::vector<uint32_t>& ranks) const {
     if (id < n_) {
-      out_[first] = triangles_[order_[id]];
-      return first + 1;
+      ranks.push_back(id);
+      return;
     }
     const Inner& node = inner_[id - n_];
-    return gather(node.right, gather(node.left, first));
+    if (node.right >= n_) __builtin_prefetch(&inner_[node.right - n_]);
+    listRanks(node.left, ranks);
+    listRanks(node.right, ranks);
   }
+
+  // What placeNodes hands its caller: the subtree's box (Box4) and the depth of its deepest
+  // leaf.
+  struct Placed {
+    Box4 box;
+    int depth;
+  };
+
+  // The nodes of place, over the triangles already in out_.
+  Placed placeNodes(uint32_t id, uint32_t position, uint32_t first, int depth) {
+    if (id < n_) {
+      const Box4 box = triangleBox4(out_[first]);
+      writeNode(position, box, first, 1);
+      return Placed{box, depth};
+    }
+    const Inner& node = inner_[id - n_];
+    if (node.summary.size == 1) {  // collapsed into a leaf
+      uint32_t next = first;
+      const Box4 box = leafBox(id, next);
+      writeNode(position, box, first, node.summary.count);
+      return Placed{box, depth};
+    }
+    const uint32_t right = position + 1 + sizeOf(node.left);
+    const Placed l = placeNodes(node.left, position + 1, first, depth + 1);
+    const Placed r = placeNodes(node.right, right, first + countOf(node.left), depth + 1);
+    const Box4 box = unite4(l.box, r.box);
+    writeNode(position, box, right, 0);
+    return Placed{box, std::max(l.depth, r.depth)};
+  }
+
+  // The box of the subtree of `id`, its triangles in out_ from `first` on (`first` moves past
+  // them), united as the merges united them.
+  Box4 leafBox(uint32_t id, uint32_t& first) const {
+    if (id < n_) return triangleBox4(out_[first++]);
+    const Inner& node = inner_[id - n_];
+    const Box4 left = leafBox(node.left, first);
+    return unite4(left, leafBox(node.right, first));
+  }
+
+  void writeNode(uint32_t position, const Box4& box, uint32_t offset, uint32_t count) {
+    Int4 lo = Int4(box.lo), hi = Int4(box.hi);  // (bit casts)
+    lo[3] = int32_t(offset);
+    hi[3] = int32_t(count);
+    static_assert(sizeof(BvhNode) == sizeof lo + sizeof hi);
+    std::memcpy(reinterpret_cast<char*>(&nodes_[position]), &lo, sizeof lo);
+    std::memcpy(reinterpret_cast<char*>(&nodes_[position]) + sizeof lo, &hi, sizeof hi);
+  }
+
+  // The box of `id` (boxes_ is set).
+  Box boxOf(uint32_t id) const {
+    return id < n_ ? triangleBox(triangles_[order_[id]]) : boxes_[id - n_];
+  }
+
+  // The depth of the deepest leaf below `id` in its collapsed form (heights_ is set).
+  int heightOf(uint32_t id) const { return id < n_ ? 0 : heights_[id - n_]; }
 
   // The rare tree deeper than the traversal stack (top-down splits that peel one cluster off
   // at a time, as nested boxes can make them): serially,
@@ -694,7 +1270,7 @@ class PlocBuilder {
       const size_t position = nodes.size();
       nodes.resize(position + sizeOf(id));
       nodes_ = nodes.data();
-      place(id, uint32_t(position), first, nullptr);
+      place(id, uint32_t(position), first, depth);
       maxDepth = std::max(maxDepth, depth + heightOf(id));
       return;
     }
@@ -705,14 +1281,15 @@ class PlocBuilder {
     };
     if (fits(leftCount) && fits(rightCount)) {
       const size_t position = nodes.size();
-      nodes.push_back(BvhNode{node.box.lo, 0u, node.box.hi, 0u});
+      const Box& box = boxes_[id - n_];
+      nodes.push_back(BvhNode{box.lo, 0u, box.hi, 0u});
       maxDepth = std::max(maxDepth, depth);
       placeWithinStack(node.left, depth + 1, first, nodes, maxDepth);
       nodes[position].offset = uint32_t(nodes.size());
       placeWithinStack(node.right, depth + 1, first + leftCount, nodes, maxDepth);
       return;
     }
-    gather(id, first);
+    copyTriangles(id, first);
     auto middle = [](size_t begin, size_t end, int) { return begin + (end - begin) / 2; };
     RangeEmitter<decltype(middle)> emitter(out_, leafSize_, middle, nodes);
     emitter.emit(first, first + leftCount + rightCount, depth);
@@ -724,13 +1301,20 @@ class PlocBuilder {
   const size_t leafSize_;
   const int depthLimit_;  // deepest leaf allowed: kBvhStackSize, less in tests
   Workers& workers_;
+  // Scratch memory: the Morton keys, the clusters of the rounds, the top levels' state.
+  Block blocks_[2];
   std::unique_ptr<uint32_t[]> order_;  // Morton rank -> input index
   std::unique_ptr<Inner[]> inner_;
-  // The top levels' state: the clusters left by the rounds, their order (permuted by the
-  // splits), the plan of the subtrees shared out, and their size.
-  const Clusters* topClusters_ = nullptr;
-  std::unique_ptr<TopRef[]> refs_, scratch_;
-  std::unique_ptr<std::array<uint8_t, 3>[]> binIndex_;  // by position in refs_: bin per axis
+  // By inner node, only for a tree too deep for the stack: heights and boxes.
+  std::unique_ptr<int[]> heights_;
+  std::unique_ptr<Box[]> boxes_;
+  // The top levels' state: the clusters left by the rounds, the references to them that the
+  // splits move between two buffers, their bins by position, the plan of the subtrees shared
+  // out, and their size.
+  const ClusterArrays* topClusters_ = nullptr;
+  TopRef* refs_[2] = {nullptr, nullptr};
+  Summary* topSummaries_ = nullptr;             // by cluster
+  std::array<uint8_t, 3>* binIndex_ = nullptr;  // by position: bin per axis
   std::vector<TopItem> plan_;
   size_t pieceSize_ = 0;
   BvhNode* nodes_ = nullptr;

@@ -15,6 +15,12 @@ static_assert(sizeof(BvhNode) == 32);
 static_assert(offsetof(BvhNode, boundsMin) == 0 && offsetof(BvhNode, offset) == 12);
 static_assert(offsetof(BvhNode, boundsMax) == 16 && offsetof(BvhNode, count) == 28);
 
+static_assert(sizeof(GpuBvhNode) == 64);
+static_assert(offsetof(GpuBvhNode, leftMin) == 0 && offsetof(GpuBvhNode, left) == 12);
+static_assert(offsetof(GpuBvhNode, leftMax) == 16 && offsetof(GpuBvhNode, right) == 28);
+static_assert(offsetof(GpuBvhNode, rightMin) == 32 && offsetof(GpuBvhNode, reserved0) == 44);
+static_assert(offsetof(GpuBvhNode, rightMax) == 48 && offsetof(GpuBvhNode, reserved1) == 60);
+
 static_assert(sizeof(Triangle) == 48);
 static_assert(offsetof(Triangle, v0) == 0 && offsetof(Triangle, material) == 12);
 static_assert(offsetof(Triangle, v1) == 16 && offsetof(Triangle, emitter) == 28);

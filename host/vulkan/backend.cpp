@@ -12,6 +12,7 @@
 #include "pathtrace_debug_spv.h"  // kPathtraceDebugSpv: the same shader with debugPrintfEXT
 #include "pathtrace_spv.h"        // kPathtraceSpv: SPIR-V compiled at build time
 #include "vulkan/context.h"
+#include "vulkan/gpu_bvh.h"
 #include "vulkan/resources.h"
 
 namespace pt {
@@ -31,6 +32,7 @@ struct SpecData {
 // accumulation and the counters are copied back through.
 struct RenderBuffers {
   std::vector<Buffer> bound;
+  std::vector<bool> texels;  // by binding: read as texels (a uniform texel buffer)
   Buffer readback;
   vk::DeviceSize accumSize = 0;
 
@@ -48,18 +50,20 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   // An empty emitter table still needs a valid binding: one zeroed entry the shader never reads.
   const std::vector<Emitter> emitters =
       scene.emitters.empty() ? std::vector<Emitter>{Emitter{}} : scene.emitters;
+  const GpuBvh bvh = buildGpuBvh(scene.bvh);
   struct Upload {
     const char* what;
     const void* data;
     vk::DeviceSize size;
+    bool texels;  // read as texels (a uniform texel buffer), else a storage buffer
   };
   // In PT_BINDING_* order, followed by the accumulation and the counters.
   const Upload uploads[] = {
-      {"parameter", &scene.params, sizeof(RenderParams)},
-      {"BVH node", scene.bvh.nodes.data(), scene.bvh.nodes.size() * sizeof(BvhNode)},
-      {"triangle", scene.bvh.triangles.data(), scene.bvh.triangles.size() * sizeof(Triangle)},
-      {"material", scene.materials.data(), scene.materials.size() * sizeof(Material)},
-      {"emitter", emitters.data(), emitters.size() * sizeof(Emitter)},
+      {"parameter", &scene.params, sizeof(RenderParams), false},
+      {"BVH node", bvh.nodes.data(), bvh.nodes.size() * sizeof(GpuBvhNode), true},
+      {"triangle", scene.bvh.triangles.data(), scene.bvh.triangles.size() * sizeof(Triangle), true},
+      {"material", scene.materials.data(), scene.materials.size() * sizeof(Material), true},
+      {"emitter", emitters.data(), emitters.size() * sizeof(Emitter), true},
   };
   static_assert(PT_BINDING_PARAMS == 0 && PT_BINDING_NODES == 1 && PT_BINDING_TRIANGLES == 2 &&
                 PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 && PT_BINDING_ACCUM == 5 &&
@@ -67,19 +71,28 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   static_assert(std::size(uploads) + 2 == PT_BINDING_COUNT, "every binding is a buffer");
 
   // Every size is checked before anything is allocated: a scene too large for the device is
-  // refused with the numbers (lavapipe allows 128 MiB per storage buffer).
+  // refused with the numbers. Every buffer is held to the storage-buffer limit (lavapipe
+  // allows 128 MiB), the scene's arrays as well, as before they were read as texels, and
+  // those to the texel-buffer limit besides.
   RenderBuffers buffers;
   buffers.accumSize = vk::DeviceSize(cam.width) * cam.height * sizeof(AccumPixel);
   checkRange(ctx, "accumulation", buffers.accumSize);
-  for (const Upload& u : uploads) checkRange(ctx, u.what, u.size);
+  for (const Upload& u : uploads) {
+    checkRange(ctx, u.what, u.size);
+    if (u.texels) checkTexelRange(ctx, u.what, u.size);
+  }
   vk::DeviceSize stagingSize = 0;
   for (const Upload& u : uploads) {
-    buffers.bound.push_back(makeBuffer(ctx, u.size, U::eStorageBuffer | U::eTransferDst, false));
+    const auto usage = u.texels ? U::eUniformTexelBuffer : U::eStorageBuffer;
+    buffers.bound.push_back(makeBuffer(ctx, u.size, usage | U::eTransferDst, false));
+    if (u.texels) makeTexelView(ctx, buffers.bound.back());
+    buffers.texels.push_back(u.texels);
     stagingSize += u.size;
   }
   const auto readWrite = U::eStorageBuffer | U::eTransferSrc | U::eTransferDst;
   buffers.bound.push_back(makeBuffer(ctx, buffers.accumSize, readWrite, false));
   buffers.bound.push_back(makeBuffer(ctx, sizeof(DeviceCounters), readWrite, false));
+  buffers.texels.resize(buffers.bound.size(), false);
   buffers.readback =
       makeBuffer(ctx, buffers.accumSize + sizeof(DeviceCounters), U::eTransferDst, true);
 
@@ -114,8 +127,10 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));
   }
   const vk::SpecializationInfo specInfo(entries, vk::ArrayProxyNoTemporaries<const SpecData>(spec));
-  std::vector<const Buffer*> bound;
-  for (const Buffer& b : buffers.bound) bound.push_back(&b);
+  std::vector<Binding> bound;
+  for (size_t i = 0; i < buffers.bound.size(); ++i) {
+    bound.push_back(Binding{&buffers.bound[i], buffers.texels[i]});
+  }
   const std::span<const uint32_t> spirv = options.context.debugPrintf
                                               ? std::span<const uint32_t>(kPathtraceDebugSpv)
                                               : std::span<const uint32_t>(kPathtraceSpv);

@@ -5,6 +5,7 @@
 
 #include "common/check.h"
 #include "raycast_spv.h"  // kRaycastSpv: shaders/raycast.comp
+#include "vulkan/gpu_bvh.h"
 #include "vulkan/resources.h"
 
 namespace pt {
@@ -14,20 +15,29 @@ std::vector<RayResult> traceRaysVulkan(const Bvh& bvh, const std::vector<RayQuer
   std::vector<RayResult> results(queries.size());
   if (queries.empty()) return results;
   VulkanContext ctx(options);
+  const GpuBvh gpu = buildGpuBvh(bvh);
   using U = vk::BufferUsageFlagBits;
   const vk::DeviceSize sizes[] = {
-      bvh.nodes.size() * sizeof(BvhNode), bvh.triangles.size() * sizeof(Triangle),
+      gpu.nodes.size() * sizeof(GpuBvhNode), bvh.triangles.size() * sizeof(Triangle),
       queries.size() * sizeof(RayQuery), queries.size() * sizeof(RayResult)};
   const char* names[] = {"BVH node", "triangle", "ray query", "ray result"};
-  const void* data[] = {bvh.nodes.data(), bvh.triangles.data(), queries.data()};
-  // Host-visible buffers throughout: this is a test tool, not a hot path.
-  std::vector<Buffer> buffers;
+  const void* data[] = {gpu.nodes.data(), bvh.triangles.data(), queries.data()};
+  // The nodes and the triangles are read as texels, as in the path tracer (shared_types.h).
+  const bool texels[] = {true, true, false, false};
   for (int i = 0; i < 4; ++i) {
     checkRange(ctx, names[i], sizes[i]);
-    buffers.push_back(makeBuffer(ctx, sizes[i], U::eStorageBuffer, /*hostVisible=*/true));
+    if (texels[i]) checkTexelRange(ctx, names[i], sizes[i]);
+  }
+  // Host-visible buffers throughout: this is a test tool, not a hot path.
+  std::vector<Buffer> buffers;
+  std::vector<Binding> bound;
+  for (int i = 0; i < 4; ++i) {
+    const auto usage = texels[i] ? U::eUniformTexelBuffer : U::eStorageBuffer;
+    buffers.push_back(makeBuffer(ctx, sizes[i], usage, /*hostVisible=*/true));
+    if (texels[i]) makeTexelView(ctx, buffers[i]);
     if (i < 3) std::memcpy(buffers[i].mapped, data[i], sizes[i]);
   }
-  const std::vector<const Buffer*> bound = {&buffers[0], &buffers[1], &buffers[2], &buffers[3]};
+  for (int i = 0; i < 4; ++i) bound.push_back(Binding{&buffers[i], texels[i]});
   const ComputeProgram program = makeComputeProgram(ctx, kRaycastSpv, bound, sizeof(uint32_t));
 
   const uint64_t groups = (queries.size() + kRaycastWorkgroupSize - 1) / kRaycastWorkgroupSize;

@@ -35,6 +35,22 @@ Buffer makeBuffer(const VulkanContext& ctx, vk::DeviceSize size, vk::BufferUsage
   return b;
 }
 
+void makeTexelView(const VulkanContext& ctx, Buffer& b) {
+  PT_CHECK(b.size % 16 == 0, "a texel view needs a whole number of 16-byte texels");
+  b.texels = vk::raii::BufferView(
+      ctx.device,
+      vk::BufferViewCreateInfo({}, *b.buffer, vk::Format::eR32G32B32A32Uint, 0, VK_WHOLE_SIZE));
+}
+
+void checkTexelRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size) {
+  const vk::DeviceSize texels = size / 16;
+  if (texels > ctx.limits.maxTexelBufferElements) {
+    throw InputError("scene too large for " + ctx.info().name + ": the " + what + " buffer is " +
+                     std::to_string(texels) + " texels, the device's maxTexelBufferElements is " +
+                     std::to_string(ctx.limits.maxTexelBufferElements));
+  }
+}
+
 void checkRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size) {
   if (size > ctx.limits.maxStorageBufferRange) {
     throw InputError("scene too large for " + ctx.info().name + ": the " + what + " buffer is " +
@@ -50,18 +66,22 @@ void barrier(const vk::raii::CommandBuffer& cmd, vk::PipelineStageFlags src,
 }
 
 ComputeProgram makeComputeProgram(const VulkanContext& ctx, std::span<const uint32_t> spirv,
-                                  const std::vector<const Buffer*>& buffers,
-                                  uint32_t pushConstantSize,
+                                  const std::vector<Binding>& bindings, uint32_t pushConstantSize,
                                   const vk::SpecializationInfo* specialization) {
   ComputeProgram p;
-  const uint32_t n = uint32_t(buffers.size());
-  std::vector<vk::DescriptorSetLayoutBinding> bindings;
+  const uint32_t n = uint32_t(bindings.size());
+  auto type = [&](uint32_t b) {
+    return bindings[b].texels ? vk::DescriptorType::eUniformTexelBuffer
+                              : vk::DescriptorType::eStorageBuffer;
+  };
+  std::vector<vk::DescriptorSetLayoutBinding> layoutBindings;
+  uint32_t texelCount = 0;
   for (uint32_t b = 0; b < n; ++b) {
-    bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1,
-                          vk::ShaderStageFlagBits::eCompute);
+    layoutBindings.emplace_back(b, type(b), 1, vk::ShaderStageFlagBits::eCompute);
+    texelCount += bindings[b].texels ? 1 : 0;
   }
-  p.setLayout =
-      vk::raii::DescriptorSetLayout(ctx.device, vk::DescriptorSetLayoutCreateInfo({}, bindings));
+  p.setLayout = vk::raii::DescriptorSetLayout(
+      ctx.device, vk::DescriptorSetLayoutCreateInfo({}, layoutBindings));
   const vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, pushConstantSize);
   p.layout =
       vk::raii::PipelineLayout(ctx.device, vk::PipelineLayoutCreateInfo({}, *p.setLayout, push));
@@ -72,17 +92,30 @@ ComputeProgram makeComputeProgram(const VulkanContext& ctx, std::span<const uint
   p.pipeline =
       vk::raii::Pipeline(ctx.device, nullptr, vk::ComputePipelineCreateInfo({}, stage, *p.layout));
 
-  const vk::DescriptorPoolSize poolSize(vk::DescriptorType::eStorageBuffer, n);
+  std::vector<vk::DescriptorPoolSize> poolSizes;
+  if (n > texelCount) poolSizes.emplace_back(vk::DescriptorType::eStorageBuffer, n - texelCount);
+  if (texelCount > 0) poolSizes.emplace_back(vk::DescriptorType::eUniformTexelBuffer, texelCount);
   p.pool = vk::raii::DescriptorPool(
       ctx.device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
-                                               1, poolSize));
+                                               1, poolSizes));
   vk::raii::DescriptorSets sets(ctx.device, vk::DescriptorSetAllocateInfo(*p.pool, *p.setLayout));
   p.set = std::move(sets.front());
   std::vector<vk::DescriptorBufferInfo> infos;
-  for (const Buffer* b : buffers) infos.emplace_back(*b->buffer, 0, b->size);
+  std::vector<vk::BufferView> views;
+  infos.reserve(n);
+  views.reserve(n);
+  for (const Binding& b : bindings) {
+    infos.emplace_back(*b.buffer->buffer, 0, b.buffer->size);
+    views.push_back(b.texels ? *b.buffer->texels : vk::BufferView{});
+  }
   std::vector<vk::WriteDescriptorSet> writes;
   for (uint32_t b = 0; b < n; ++b) {
-    writes.emplace_back(*p.set, b, 0, vk::DescriptorType::eStorageBuffer, nullptr, infos[b]);
+    if (bindings[b].texels) {
+      PT_CHECK(*bindings[b].buffer->texels, "a texel binding needs makeTexelView");
+      writes.emplace_back(*p.set, b, 0, 1, type(b), nullptr, nullptr, &views[b]);
+    } else {
+      writes.emplace_back(*p.set, b, 0, 1, type(b), nullptr, &infos[b]);
+    }
   }
   ctx.device.updateDescriptorSets(writes, {});
   return p;

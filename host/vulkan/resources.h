@@ -14,11 +14,21 @@ struct Buffer {
   vk::raii::DeviceMemory memory{nullptr};
   vk::DeviceSize size = 0;
   void* mapped = nullptr;  // host-visible buffers only
+  // The buffer as 16-byte texels (R32G32B32A32_UINT), for a uniform texel buffer binding;
+  // only where makeTexelView made one (the buffer needs eUniformTexelBuffer usage).
+  vk::raii::BufferView texels{nullptr};
 };
 
 // A buffer in device-local memory, or host-visible coherent memory mapped for its lifetime.
 Buffer makeBuffer(const VulkanContext& ctx, vk::DeviceSize size, vk::BufferUsageFlags usage,
                   bool hostVisible);
+
+// Makes b.texels, the whole buffer (a whole number of texels) as 16-byte texels.
+void makeTexelView(const VulkanContext& ctx, Buffer& b);
+
+// A texel buffer of more 16-byte texels than the device allows is refused with the numbers
+// (InputError), like checkRange.
+void checkTexelRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size);
 
 // Storage buffers larger than the device allows would be silently cut short (lavapipe's
 // maxStorageBufferRange is 128 MiB): refuse them with the numbers instead (InputError).
@@ -28,7 +38,14 @@ void checkRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size)
 void barrier(const vk::raii::CommandBuffer& cmd, vk::PipelineStageFlags src,
              vk::AccessFlags srcAccess, vk::PipelineStageFlags dst, vk::AccessFlags dstAccess);
 
-// A compute pipeline whose set 0 binds `buffers` as storage buffers 0, 1, ..., with a push
+// One binding of set 0: a buffer read as a storage buffer, or through its texel view as a
+// uniform texel buffer.
+struct Binding {
+  const Buffer* buffer;
+  bool texels = false;
+};
+
+// A compute pipeline whose set 0 binds `bindings` as bindings 0, 1, ..., with a push
 // constant block of pushConstantSize bytes. Members in creation order: C++ destroys them in
 // reverse, the set before its pool, the pipeline before its layouts.
 struct ComputeProgram {
@@ -43,8 +60,7 @@ struct ComputeProgram {
 };
 
 ComputeProgram makeComputeProgram(const VulkanContext& ctx, std::span<const uint32_t> spirv,
-                                  const std::vector<const Buffer*>& buffers,
-                                  uint32_t pushConstantSize,
+                                  const std::vector<Binding>& bindings, uint32_t pushConstantSize,
                                   const vk::SpecializationInfo* specialization = nullptr);
 
 // One command buffer, recorded and submitted synchronously, again and again.
