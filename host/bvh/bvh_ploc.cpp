@@ -189,25 +189,29 @@ void adviseHugePages([[maybe_unused]] const void* p, [[maybe_unused]] size_t byt
 }
 
 // Memory that the phases of a build hand on to each other: arrays of trivial types at byte
-// offsets of one allocation, not initialised.
+// offsets of one allocation (its own, or memory lent to it), not initialised.
 class Block {
  public:
   explicit Block(size_t bytes)
-      : words_(std::make_unique_for_overwrite<uint64_t[]>((bytes + 7) / 8)) {
-    adviseHugePages(words_.get(), bytes);
+      : owned_(std::make_unique_for_overwrite<uint64_t[]>((bytes + 7) / 8)),
+        base_(reinterpret_cast<std::byte*>(owned_.get())) {
+    adviseHugePages(base_, bytes);
   }
+  // Over `memory` (8-byte aligned), which outlives the block.
+  explicit Block(std::byte* memory) : base_(memory) {}
   // `count` objects of type T from byte `offset` on (a multiple of alignof(T)), their
   // lifetimes begun, their values undefined until written.
   template <typename T>
   T* array(size_t offset, size_t count) const {
     static_assert(std::is_trivially_default_constructible_v<T> && alignof(T) <= 8);
-    T* const first = reinterpret_cast<T*>(reinterpret_cast<std::byte*>(words_.get()) + offset);
+    T* const first = reinterpret_cast<T*>(base_ + offset);
     std::uninitialized_default_construct_n(first, count);
     return first;
   }
 
  private:
-  std::unique_ptr<uint64_t[]> words_;
+  std::unique_ptr<uint64_t[]> owned_;
+  std::byte* base_;
 };
 
 // The clusters of a round in a Block: their boxes as a structure of arrays, so that the
@@ -473,7 +477,7 @@ class PlocBuilder {
         leafSize_(leafSize),
         depthLimit_(depthLimit),
         workers_(workers),
-        blocks_{Block(ClusterArrays::bytes(n_)), Block(ClusterArrays::bytes(n_))} {}
+        blocks_{Block(ClusterArrays::bytes(n_)), outputBlock()} {}
 
   Bvh build() {
     const uint64_t* keys = mortonKeys();
@@ -481,6 +485,18 @@ class PlocBuilder {
   }
 
  private:
+  // Block 1 in the memory of the output triangles, where it fits (from 58 triangles on): the
+  // scratch arrays are dead by the time the linearization writes the triangles there (as new
+  // objects: std::construct_at), and the pages are touched once instead of twice.
+  Block outputBlock() {
+    bvh_.triangles.reserve(n_);
+    adviseHugePages(bvh_.triangles.data(), n_ * sizeof(Triangle));
+    bvh_.triangles.resize(n_);
+    static_assert(alignof(Triangle) >= 4 && __STDCPP_DEFAULT_NEW_ALIGNMENT__ >= 8);
+    if (n_ * sizeof(Triangle) < ClusterArrays::bytes(n_)) return Block(ClusterArrays::bytes(n_));
+    return Block(reinterpret_cast<std::byte*>(bvh_.triangles.data()));
+  }
+
   // ---- Morton order ----------------------------------------------------------------------
 
   // The centroid (v0 + v1 + v2) * (1 / 3) as sortByMorton (bvh.cpp) computes it, in lanes
@@ -1091,10 +1107,7 @@ class PlocBuilder {
   // ---- Linearization ---------------------------------------------------------------------
 
   Bvh linearize(uint32_t root) {
-    Bvh bvh;
-    bvh.triangles.reserve(n_);
-    adviseHugePages(bvh.triangles.data(), n_ * sizeof(Triangle));
-    bvh.triangles.resize(n_);
+    Bvh bvh = std::move(bvh_);
     out_ = bvh.triangles.data();
     bvh.nodes.reserve(sizeOf(root));
     adviseHugePages(bvh.nodes.data(), sizeOf(root) * sizeof(BvhNode));
@@ -1188,7 +1201,7 @@ class PlocBuilder {
     const size_t count = ranks.size();
     for (size_t k = 0; k < count; ++k) {
       if (k + kPrefetch < count) prefetchTriangle(order_[ranks[k + kPrefetch]]);
-      out_[first + k] = triangles_[order_[ranks[k]]];
+      std::construct_at(out_ + first + k, triangles_[order_[ranks[k]]]);
     }
   }
 
@@ -1301,6 +1314,7 @@ class PlocBuilder {
   const size_t leafSize_;
   const int depthLimit_;  // deepest leaf allowed: kBvhStackSize, less in tests
   Workers& workers_;
+  Bvh bvh_;  // the tree being built; its triangles' memory lent to block 1 until linearize
   // Scratch memory: the Morton keys, the clusters of the rounds, the top levels' state.
   Block blocks_[2];
   std::unique_ptr<uint32_t[]> order_;  // Morton rank -> input index
