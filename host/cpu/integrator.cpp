@@ -60,7 +60,7 @@ vec3 sampleDirectLight(const SceneData& scene, vec3 p, vec3 n, float magnitude, 
   const vec3 to =
       offsetRayOrigin(lightPoint, lightNormal, triangleMagnitude(light.v0, light.v1, light.v2));
   ++rays;
-  if (anyHit(scene.bvh, Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
+  if (anyHit(scene.wideBvh(), Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
 
   const float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
   const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
@@ -103,7 +103,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
   for (uint depth = 0;;) {
     // Find the closest surface along the ray; the background is black.
     ++rays;
-    const std::optional<Hit> hit = closestHit(bvh, ray, INFINITY, test);
+    const std::optional<Hit> hit = closestHit(scene.wideBvh(), ray, INFINITY, test);
     if (!hit) break;
     const Triangle& tri = bvh.triangles[hit->triangle];
     const Material& material = scene.materials[tri.material];
@@ -193,6 +193,8 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
 CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film) {
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
+  const auto callStart = std::chrono::steady_clock::now();
+  scene.wideBvh();  // built here on a first render: set-up, not render time
   const auto start = std::chrono::steady_clock::now();
   CpuRenderStats stats;
   stats.threads = options.threads > 0 ? options.threads : availableCpus();
@@ -309,7 +311,8 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
   stats.rays = totalRays;
   stats.invalidSamples = film.totalInvalid();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  stats.wallSeconds = stats.seconds;
+  stats.wallSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - callStart).count();
   return stats;
 }
 

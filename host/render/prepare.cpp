@@ -7,6 +7,11 @@
 
 namespace pt {
 
+const WideBvh& LazyWideBvh::get(const Bvh& bvh) const {
+  std::call_once(state_->once, [&] { state_->wide = buildWideBvh(bvh); });
+  return state_->wide;
+}
+
 std::string EffectSet::toString() const {
   std::string s;
   auto add = [&s](bool on, std::string_view name) {

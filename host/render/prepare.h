@@ -1,15 +1,18 @@
 // Scene -> the flat arrays both backends read: the BVH (nodes, triangles in leaf order),
 // materials, the emitter alias table and the per-render parameters, plus the set of
 // effects the scene calls for. The Vulkan backend uploads exactly these arrays; the CPU
-// reference traverses them in place.
+// reference reads them in place, but for the BVH, which it traverses in a four-wide copy.
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "bvh/bvh.h"
+#include "bvh/wide_bvh.h"
 #include "scene/scene.h"
 
 namespace pt {
@@ -42,6 +45,30 @@ struct EffectSet {
   std::string toString() const;  // e.g. "diffuse+mirror+nee+mis+rr" (+"fast-isect", "sobol")
 };
 
+// The CPU reference's wide copy of a BVH (wide_bvh.h), built on first use, once, by whichever
+// thread asks first: the Vulkan backend never asks, and does not pay for it. A copy of the
+// holder starts empty and builds its own, so it never describes another BVH than its owner's.
+class LazyWideBvh {
+ public:
+  LazyWideBvh() : state_(std::make_unique<State>()) {}
+  LazyWideBvh(const LazyWideBvh&) : LazyWideBvh() {}
+  LazyWideBvh(LazyWideBvh&&) noexcept = default;
+  LazyWideBvh& operator=(const LazyWideBvh&) {
+    state_ = std::make_unique<State>();
+    return *this;
+  }
+  LazyWideBvh& operator=(LazyWideBvh&&) noexcept = default;
+
+  const WideBvh& get(const Bvh& bvh) const;
+
+ private:
+  struct State {
+    std::once_flag once;
+    WideBvh wide;
+  };
+  std::unique_ptr<State> state_;
+};
+
 struct SceneData {
   Bvh bvh;
   std::vector<Material> materials;
@@ -50,6 +77,11 @@ struct SceneData {
   int spp = 0;
   EffectSet effects;
   vec3 shift{0.0f};  // subtracted from every coordinate of a scene far from the origin
+  LazyWideBvh wide;  // of bvh; through wideBvh()
+
+  // The BVH the CPU reference traverses: bvh collapsed to four-wide nodes, with the same
+  // answers to every query (wide_bvh.h). Built on the first call.
+  const WideBvh& wideBvh() const { return wide.get(bvh); }
 };
 
 // Takes the scene by value: pass it with std::move when it is not needed afterwards, so that

@@ -1,0 +1,87 @@
+// The CPU reference's copy of the BVH for SIMD traversal: every three levels of the binary
+// tree become one node of eight children whose boxes are tested together, and the leaves'
+// triangles are repacked four to a packet in the structure-of-arrays layout that the
+// four-lane watertight test loads directly. The GPU keeps the binary tree (Bvh); this one
+// is built from it, after it, for the CPU backend only.
+//
+// A query gives exactly the binary traversal's answer (traverse.h), not just an equally
+// valid one: same hit distance, same triangle, same barycentrics, bit for bit, because
+//  - the triangle and box tests perform the same float operations in the same order (no
+//    fused multiply-add), lane by lane, with the same double-precision recomputation of an
+//    edge function that comes out exactly 0;
+//  - the leaves are visited in the binary traversal's order: near child first at every
+//    binary node, the left one on a tie. A node holds the descendants three levels below a
+//    binary node N, lane i being N's child (i >> 2 & 1), its child (i >> 1 & 1), its child
+//    (i & 1): so lanes 0-3 lie under N's left child, lanes 0-1 under that child's left child,
+//    and so on. The entry distance of each binary node in between, which decides the order,
+//    follows from the per-axis slab distances of its lanes: a parent's box is the union of
+//    its children's, and the slab distance of the union is the minimum of theirs (rounding
+//    is monotonic);
+//  - within a leaf, the triangles are accepted in order against the shrinking closest
+//    distance, as the scalar loop does.
+// Where two triangles lie at the same distance, which one is reported depends on the order
+// they are found in; keeping the order keeps the answer, and the images' bits.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "bvh/bvh.h"
+#include "bvh/traverse.h"
+
+namespace pt {
+
+inline constexpr int kWideLanes = 8;    // children per node
+inline constexpr int kPacketLanes = 4;  // triangles per packet
+
+// Eight children's boxes and references. An interior child is the index of its WideNode; a
+// leaf child is kWideLeaf | the index of its first packet, with its packet count alongside.
+// A binary leaf less than three levels below N takes the first lane of the lanes under it;
+// the others are unused: kWideEmpty, with an inverted box (lo = +inf, hi = -inf) that no ray
+// enters.
+struct alignas(64) WideNode {
+  float bounds[6][kWideLanes];       // lo.x, lo.y, lo.z, hi.x, hi.y, hi.z of each child
+  uint32_t child[kWideLanes];        // see above
+  uint32_t packetCount[kWideLanes];  // leaf: its packets (>= 1); else 0
+};                                   // 256 bytes: four cache lines
+inline constexpr uint32_t kWideLeaf = 0x80000000u;
+inline constexpr uint32_t kWideEmpty = 0xFFFFFFFFu;
+
+// Up to four consecutive triangles of one leaf, vertex coordinates by lane. Lanes past
+// `count` repeat the last triangle (so every lane computes on real coordinates) and are
+// never reported.
+struct alignas(16) TrianglePacket {
+  float v[3][3][kPacketLanes];  // v[vertex][axis][lane]
+  uint32_t first;               // Bvh::triangles index of lane 0; lane i holds first + i
+  uint32_t count;               // 1 to 4 lanes in use
+  uint32_t reserved[2];
+};  // 160 bytes
+
+struct WideBvh {
+  std::vector<WideNode> nodes;  // nodes[0] is the root: the binary root's descendants
+  std::vector<TrianglePacket> packets;
+  vec3 rootMin{0.0f}, rootMax{0.0f};  // the binary root's box
+  int maxDepth = 0;                   // deepest wide node below the root (root = 0)
+  double buildSeconds = 0.0;          // of buildWideBvh (after the binary build)
+};
+
+// Collapses a built binary BVH. The result refers to bvh.triangles by index (Hit::triangle)
+// but holds copies of the vertices, so it does not depend on bvh's lifetime.
+WideBvh buildWideBvh(const Bvh& bvh);
+
+// The same queries as on the binary Bvh (traverse.h), with the same answers. Boxes are
+// tested eight at a time and triangles four at a time, with x86-64 vector instructions
+// chosen at run time (AVX2, else SSE4 or SSSE3 in halves, else one lane at a time);
+// Moller-Trumbore runs lane by lane.
+std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax = INFINITY,
+                              Intersection test = Intersection::kWatertight);
+bool anyHit(const WideBvh& bvh, const Ray& ray, float tMax,
+            Intersection test = Intersection::kWatertight);
+
+// The instruction sets (Highway target bits, best first) that the queries above are compiled
+// for and this CPU runs; the queries use the first. For tests, which make them use each in
+// turn with hwy::SetSupportedTargetsForTest.
+std::vector<int64_t> wideTraversalTargets();
+
+}  // namespace pt

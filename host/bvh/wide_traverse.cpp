@@ -1,0 +1,519 @@
+// Traversal of the wide BVH (wide_bvh.h): eight box tests and four triangle tests at a
+// time. Compiled once per x86 instruction set that Highway targets here (AVX2, SSE4, SSSE3
+// and its one-lane fallback: foreach_target.h includes this file once for each) and
+// dispatched at run time to the best the CPU has, so that a build for baseline x86-64 still
+// runs vector code where the CPU has it. AVX2 tests a node's eight boxes in one 256-bit
+// vector, SSE4 and SSSE3 in two 128-bit halves; the four-lane triangle test uses 128-bit
+// vectors everywhere.
+//
+// Exactness: each lane performs the operations of intersectBox and intersectTriangle
+// (traverse.cpp) in their order, with the same comparisons, negated where the scalar code
+// rejects (so that a NaN goes the same way). There are no fused multiply-adds: Highway's
+// Mul and Add are separate instructions, and ptcore is compiled with -ffp-contract=off.
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+// AVX-512 is no faster here than AVX2 (measured with 128-bit triangle tests); leaving it
+// out saves a compilation of this file.
+#ifndef HWY_DISABLED_TARGETS
+#define HWY_DISABLED_TARGETS (HWY_AVX3 | HWY_AVX3_DL)
+#endif
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "bvh/wide_traverse.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include "bvh/wide_bvh.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace pt {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// A node of depth k below the root waits with at most seven siblings per level above it.
+constexpr uint32_t kWideStackSize = 7 * (kBvhStackSize / 3 + 1);
+
+// What a node's slab test gives the traversal.
+struct ChildLanes {
+  uint32_t hit;             // bit i: the ray enters child i's box within the range
+  float enter[kWideLanes];  // entry distances (tNear of intersectBox)
+  // With two or more hits (closest hit only), the binary traversal's order (wide_bvh.h):
+  // bit i of each says whether child i comes second at that level, for its pair (lanes
+  // 2k, 2k + 1: the children of one binary node), its half of a quad (the two pairs under
+  // one binary node) and its quad (lanes 0-3 and 4-7, under N's two children). The nearer
+  // comes first, the left one on a tie, as in traverse.cpp.
+  uint32_t pairSecond = 0, quadSecond = 0, topSecond = 0;
+  // Sort key of child i: its position in that order.
+  uint32_t key(int i) const {
+    return (topSecond >> i & 1u) << 2 | (quadSecond >> i & 1u) << 1 | (pairSecond >> i & 1u);
+  }
+};
+
+// Which lanes come second when the comparisons `partnerLess` (the other group's entry
+// distance below this one's) and `partnerLessEqual` are known for every lane: a group that
+// is the left one (its lanes in `leftLanes`) comes second if the right one is nearer, the
+// right one unless the left one is farther.
+constexpr uint32_t comesSecond(uint32_t partnerLess, uint32_t partnerLessEqual,
+                               uint32_t leftLanes) {
+  return (partnerLess & leftLanes) | (partnerLessEqual & ~leftLanes & 0xFFu);
+}
+
+#if HWY_TARGET == HWY_SCALAR
+
+// Highway's one-lane fallback, for CPUs without SSSE3 (and in place of its four-lane
+// emulation, which it disables under GCC < 12.3): the lanes one after another, with the
+// same operations.
+
+struct RayLanes {
+  explicit RayLanes(const RayPrecomputed& r) : ray(r) {}
+  const RayPrecomputed& ray;
+};
+
+template <bool kOrder>
+ChildLanes intersectBoxes(const WideNode& node, const RayLanes& lanes, float tMax) {
+  const RayPrecomputed& r = lanes.ray;
+  ChildLanes box{};
+  float tMin[3][kWideLanes];
+  for (int i = 0; i < kWideLanes; ++i) {
+    float tFar[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      // The near plane's distance is min(t0, t1) of intersectBox for a box with lo <= hi
+      // (see RayLanes below); an unused lane's inverted box never hits.
+      const bool positive = r.invDirection[axis] > 0.0f;
+      const float nearPlane = node.bounds[positive ? axis : axis + 3][i];
+      const float farPlane = node.bounds[positive ? axis + 3 : axis][i];
+      tMin[axis][i] = (nearPlane - r.origin[axis]) * r.invDirection[axis];
+      tFar[axis] = (farPlane - r.origin[axis]) * r.invDirection[axis];
+    }
+    box.enter[i] = std::max(std::max(tMin[0][i], tMin[1][i]), std::max(tMin[2][i], 0.0f));
+    const float exit = std::min(std::min(tFar[0], tFar[1]), std::min(tFar[2], tMax)) * kFarScale;
+    if (box.enter[i] <= exit) box.hit |= 1u << i;
+  }
+  if constexpr (kOrder) {
+    // Entry distances of the binary nodes over each pair and each quad of lanes.
+    auto groupEnter = [&](int first, int count) {
+      float m[3];
+      for (int axis = 0; axis < 3; ++axis) {
+        m[axis] = *std::min_element(tMin[axis] + first, tMin[axis] + first + count);
+      }
+      return std::max(std::max(m[0], m[1]), std::max(m[2], 0.0f));
+    };
+    uint32_t less[3] = {0, 0, 0}, lessEqual[3] = {0, 0, 0};
+    for (int level = 0; level < 3; ++level) {
+      const int size = 1 << level;  // lanes per group: 1, 2, 4
+      for (int i = 0; i < kWideLanes; ++i) {
+        const float mine = groupEnter(i & ~(size - 1), size);
+        const float partner = groupEnter((i ^ size) & ~(size - 1), size);
+        less[level] |= (partner < mine ? 1u : 0u) << i;
+        lessEqual[level] |= (partner <= mine ? 1u : 0u) << i;
+      }
+    }
+    box.pairSecond = comesSecond(less[0], lessEqual[0], 0x55u);
+    box.quadSecond = comesSecond(less[1], lessEqual[1], 0x33u);
+    box.topSecond = comesSecond(less[2], lessEqual[2], 0x0Fu);
+  }
+  return box;
+}
+
+template <bool kAnyHit>
+bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket, uint32_t packetCount,
+                             const RayLanes& lanes, float& closest, Hit& best) {
+  bool found = false;
+  for (uint32_t p = firstPacket; p < firstPacket + packetCount; ++p) {
+    const TrianglePacket& packet = bvh.packets[p];
+    for (uint32_t i = 0; i < packet.count; ++i) {
+      Triangle tri{};
+      tri.v0 = vec3(packet.v[0][0][i], packet.v[0][1][i], packet.v[0][2][i]);
+      tri.v1 = vec3(packet.v[1][0][i], packet.v[1][1][i], packet.v[1][2][i]);
+      tri.v2 = vec3(packet.v[2][0][i], packet.v[2][1][i], packet.v[2][2][i]);
+      Hit hit;
+      if (intersectTriangle(lanes.ray, tri, closest, hit)) {
+        hit.triangle = packet.first + i;
+        best = hit;
+        closest = hit.t;
+        found = true;
+        if constexpr (kAnyHit) return true;
+      }
+    }
+  }
+  return found;
+}
+
+#else  // vector instructions
+
+// Boxes: eight lanes in one vector where the target has 256-bit vectors, else two halves.
+constexpr int kBoxParts = HWY_MAX_BYTES >= 32 ? 1 : 2;
+constexpr int kBoxPartLanes = kWideLanes / kBoxParts;
+using DB = hn::FixedTag<float, kBoxPartLanes>;
+using VB = hn::Vec<DB>;
+// Triangles: four lanes.
+using D = hn::FixedTag<float, kPacketLanes>;
+using V = hn::Vec<D>;
+using M = hn::Mask<D>;
+
+// Bit i: lane i of the mask (at most eight lanes).
+template <class Tag>
+HWY_INLINE uint32_t laneBits(Tag d, hn::Mask<Tag> m) {
+  uint8_t bits = 0;
+  hn::StoreMaskBits(d, m, &bits);
+  return bits;
+}
+
+// The ray's constants, broadcast to every lane, and where the rows it reads lie.
+struct RayLanes {
+  explicit RayLanes(const RayPrecomputed& r) {
+    const int k[3] = {r.kx, r.ky, r.kz};
+    for (int axis = 0; axis < 3; ++axis) {
+      origin[axis] = hn::Set(DB(), r.origin[axis]);
+      invDirection[axis] = hn::Set(DB(), r.invDirection[axis]);
+      // The slab distances min(t0, t1) and max(t0, t1) are the near and the far plane's: for
+      // a positive 1/d the lower plane's distance is the smaller (rounding is monotonic),
+      // for a negative one the upper's. 1/d is never 0; its sign is the direction's.
+      const bool positive = r.invDirection[axis] > 0.0f;
+      nearRow[axis] = kWideLanes * (positive ? axis : axis + 3);
+      farRow[axis] = kWideLanes * (positive ? axis + 3 : axis);
+      shearRow[axis] = kPacketLanes * k[axis];
+      shearOrigin[axis] = hn::Set(D(), r.origin[k[axis]]);
+    }
+    sx = hn::Set(D(), r.sx);
+    sy = hn::Set(D(), r.sy);
+    sz = hn::Set(D(), r.sz);
+    farScale = hn::Set(DB(), kFarScale);
+  }
+  VB origin[3], invDirection[3];
+  size_t nearRow[3], farRow[3];  // offsets into WideNode::bounds, in floats
+  size_t shearRow[3];            // offsets of axes kx, ky, kz into a vertex of a packet
+  V shearOrigin[3];              // origin[kx], origin[ky], origin[kz]
+  V sx, sy, sz;
+  VB farScale;
+};
+
+// Lane for lane, the values of the other quad (lanes 4-7 for lanes 0-3 and back).
+HWY_INLINE VB otherQuad(const VB (&quads)[kBoxParts], int part) {
+#if HWY_MAX_BYTES >= 32
+  return hn::SwapAdjacentBlocks(quads[part]);
+#else
+  return quads[1 - part];
+#endif
+}
+
+// The slab test of intersectBox on the eight children at once. Unused lanes hold an
+// inverted box (lo = +inf, hi = -inf): its near planes are at +inf, so it never hits and
+// leaves the minima over its group to the other lanes. (The short loops over parts, axes
+// and levels are unrolled by pragma: GCC at -O2 would otherwise keep the arrays of vectors
+// in memory, which measured a third slower.)
+template <bool kOrder>
+HWY_INLINE ChildLanes intersectBoxes(const WideNode& node, const RayLanes& ray, float tMax) {
+  const DB d;
+  const VB zero = hn::Zero(d);
+  VB tMin[kBoxParts][3], enter[kBoxParts];
+  ChildLanes box;
+  box.hit = 0;
+#pragma GCC unroll 2
+  for (int p = 0; p < kBoxParts; ++p) {
+    const float* bounds = node.bounds[0] + p * kBoxPartLanes;
+    VB tFar[3];
+#pragma GCC unroll 3
+    for (int axis = 0; axis < 3; ++axis) {
+      tMin[p][axis] = hn::Mul(hn::Sub(hn::Load(d, bounds + ray.nearRow[axis]), ray.origin[axis]),
+                              ray.invDirection[axis]);
+      tFar[axis] = hn::Mul(hn::Sub(hn::Load(d, bounds + ray.farRow[axis]), ray.origin[axis]),
+                           ray.invDirection[axis]);
+    }
+    enter[p] = hn::Max(hn::Max(tMin[p][0], tMin[p][1]), hn::Max(tMin[p][2], zero));
+    const VB exit = hn::Mul(hn::Min(hn::Min(tFar[0], tFar[1]), hn::Min(tFar[2], hn::Set(d, tMax))),
+                            ray.farScale);
+    box.hit |= laneBits(d, hn::Le(enter[p], exit)) << (p * kBoxPartLanes);
+    hn::StoreU(enter[p], d, box.enter + p * kBoxPartLanes);
+  }
+  if constexpr (kOrder) {
+    if ((box.hit & (box.hit - 1u)) != 0) {  // only a choice needs the order
+      // Entry distances of the binary nodes over each pair and each quad of lanes: the
+      // per-axis minima over the group, clamped as intersectBox clamps.
+      VB pairEnter[kBoxParts], quadEnter[kBoxParts];
+#pragma GCC unroll 2
+      for (int p = 0; p < kBoxParts; ++p) {
+        VB pairMin[3], quadMin[3];
+#pragma GCC unroll 3
+        for (int axis = 0; axis < 3; ++axis) {
+          pairMin[axis] = hn::Min(tMin[p][axis], hn::Shuffle2301(tMin[p][axis]));
+          quadMin[axis] = hn::Min(pairMin[axis], hn::Shuffle1032(pairMin[axis]));
+        }
+        pairEnter[p] = hn::Max(hn::Max(pairMin[0], pairMin[1]), hn::Max(pairMin[2], zero));
+        quadEnter[p] = hn::Max(hn::Max(quadMin[0], quadMin[1]), hn::Max(quadMin[2], zero));
+      }
+      // Each lane's group (the lane itself, its pair, its quad) against the partner group.
+      uint32_t less[3] = {0, 0, 0}, lessEqual[3] = {0, 0, 0};
+#pragma GCC unroll 2
+      for (int p = 0; p < kBoxParts; ++p) {
+        const VB mine[3] = {enter[p], pairEnter[p], quadEnter[p]};
+        const VB partner[3] = {hn::Shuffle2301(enter[p]), hn::Shuffle1032(pairEnter[p]),
+                               otherQuad(quadEnter, p)};
+#pragma GCC unroll 3
+        for (int level = 0; level < 3; ++level) {
+          less[level] |= laneBits(d, hn::Lt(partner[level], mine[level])) << (p * kBoxPartLanes);
+          lessEqual[level] |= laneBits(d, hn::Le(partner[level], mine[level]))
+                              << (p * kBoxPartLanes);
+        }
+      }
+      box.pairSecond = comesSecond(less[0], lessEqual[0], 0x55u);
+      box.quadSecond = comesSecond(less[1], lessEqual[1], 0x33u);
+      box.topSecond = comesSecond(less[2], lessEqual[2], 0x0Fu);
+    }
+  }
+  return box;
+}
+
+// Recomputes, in double precision as intersectTriangle does, the edge functions of the
+// lanes where one came out exactly 0.
+HWY_NOINLINE void recomputeEdgesInDouble(uint32_t lanes, V ax, V ay, V bx, V by, V cx, V cy, V& u,
+                                         V& v, V& w) {
+  const D d;
+  alignas(16) float a[2][kPacketLanes], b[2][kPacketLanes], c[2][kPacketLanes];
+  alignas(16) float uu[kPacketLanes], vv[kPacketLanes], ww[kPacketLanes];
+  hn::Store(ax, d, a[0]);
+  hn::Store(ay, d, a[1]);
+  hn::Store(bx, d, b[0]);
+  hn::Store(by, d, b[1]);
+  hn::Store(cx, d, c[0]);
+  hn::Store(cy, d, c[1]);
+  hn::Store(u, d, uu);
+  hn::Store(v, d, vv);
+  hn::Store(w, d, ww);
+  for (int i = 0; i < kPacketLanes; ++i) {
+    if (!(lanes >> i & 1u)) continue;
+    uu[i] = float(double(c[0][i]) * double(b[1][i]) - double(c[1][i]) * double(b[0][i]));
+    vv[i] = float(double(a[0][i]) * double(c[1][i]) - double(a[1][i]) * double(c[0][i]));
+    ww[i] = float(double(b[0][i]) * double(a[1][i]) - double(b[1][i]) * double(a[0][i]));
+  }
+  u = hn::Load(d, uu);
+  v = hn::Load(d, vv);
+  w = hn::Load(d, ww);
+}
+
+// The watertight test (intersectTriangle) on the triangles of one leaf, its packets in
+// order. Each packet's lanes are tested against the closest distance so far, then the
+// accepted ones are taken in lane order against the closest distance as it shrinks, as the
+// scalar loop takes them: a lane that fails against the larger distance fails against a
+// smaller one too (tMax * det is monotonic in tMax), so the result is the scalar loop's.
+template <bool kAnyHit>
+HWY_INLINE bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket,
+                                        uint32_t packetCount, const RayLanes& ray, float& closest,
+                                        Hit& best) {
+  const D d;
+  const V zero = hn::Zero(d);
+  bool found = false;
+  for (uint32_t p = firstPacket; p < firstPacket + packetCount; ++p) {
+    const TrianglePacket& packet = bvh.packets[p];
+    // Vertices relative to the origin, sheared so the ray becomes the +z axis.
+    const float* v0 = packet.v[0][0];
+    const float* v1 = packet.v[1][0];
+    const float* v2 = packet.v[2][0];
+    const V akz = hn::Sub(hn::Load(d, v0 + ray.shearRow[2]), ray.shearOrigin[2]);
+    const V bkz = hn::Sub(hn::Load(d, v1 + ray.shearRow[2]), ray.shearOrigin[2]);
+    const V ckz = hn::Sub(hn::Load(d, v2 + ray.shearRow[2]), ray.shearOrigin[2]);
+    const V ax = hn::Sub(hn::Sub(hn::Load(d, v0 + ray.shearRow[0]), ray.shearOrigin[0]),
+                         hn::Mul(ray.sx, akz));
+    const V ay = hn::Sub(hn::Sub(hn::Load(d, v0 + ray.shearRow[1]), ray.shearOrigin[1]),
+                         hn::Mul(ray.sy, akz));
+    const V bx = hn::Sub(hn::Sub(hn::Load(d, v1 + ray.shearRow[0]), ray.shearOrigin[0]),
+                         hn::Mul(ray.sx, bkz));
+    const V by = hn::Sub(hn::Sub(hn::Load(d, v1 + ray.shearRow[1]), ray.shearOrigin[1]),
+                         hn::Mul(ray.sy, bkz));
+    const V cx = hn::Sub(hn::Sub(hn::Load(d, v2 + ray.shearRow[0]), ray.shearOrigin[0]),
+                         hn::Mul(ray.sx, ckz));
+    const V cy = hn::Sub(hn::Sub(hn::Load(d, v2 + ray.shearRow[1]), ray.shearOrigin[1]),
+                         hn::Mul(ray.sy, ckz));
+    // Scaled barycentrics: 2D edge functions of the projected edges against the origin.
+    V u = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
+    V v = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
+    V w = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
+    const uint32_t zeroEdge =
+        laneBits(d, hn::Or(hn::Or(hn::Eq(u, zero), hn::Eq(v, zero)), hn::Eq(w, zero)));
+    if (zeroEdge != 0) recomputeEdgesInDouble(zeroEdge, ax, ay, bx, by, cx, cy, u, v, w);
+    // Rejections, as intersectTriangle makes them: mixed signs, det == 0, t out of range.
+    const M negative = hn::Or(hn::Or(hn::Lt(u, zero), hn::Lt(v, zero)), hn::Lt(w, zero));
+    const M positive = hn::Or(hn::Or(hn::Gt(u, zero), hn::Gt(v, zero)), hn::Gt(w, zero));
+    const V det = hn::Add(hn::Add(u, v), w);
+    // Scaled hit distance; compared against the range scaled by det.
+    const V az = hn::Mul(ray.sz, akz);
+    const V bz = hn::Mul(ray.sz, bkz);
+    const V cz = hn::Mul(ray.sz, ckz);
+    const V t = hn::Add(hn::Add(hn::Mul(u, az), hn::Mul(v, bz)), hn::Mul(w, cz));
+    const V range = hn::Mul(hn::Set(d, closest), det);
+    const M detPositive = hn::Gt(det, zero);
+    const M outPositive = hn::Or(hn::Le(t, zero), hn::Ge(t, range));
+    const M outNegative = hn::Or(hn::Ge(t, zero), hn::Le(t, range));
+    const M reject =
+        hn::Or(hn::Or(hn::And(negative, positive), hn::Eq(det, zero)),
+               hn::Or(hn::And(detPositive, outPositive), hn::AndNot(detPositive, outNegative)));
+    const uint32_t accepted = laneBits(d, hn::Not(reject)) & ((1u << packet.count) - 1u);
+    if (accepted == 0) continue;
+    if constexpr (kAnyHit) return true;
+    alignas(16) float tl[kPacketLanes], dl[kPacketLanes], ul[kPacketLanes], vl[kPacketLanes],
+        wl[kPacketLanes];
+    hn::Store(t, d, tl);
+    hn::Store(det, d, dl);
+    hn::Store(u, d, ul);
+    hn::Store(v, d, vl);
+    hn::Store(w, d, wl);
+    for (uint32_t rest = accepted; rest != 0; rest &= rest - 1u) {
+      const int i = std::countr_zero(rest);
+      const float laneRange = closest * dl[i];
+      if (dl[i] > 0.0f ? (tl[i] <= 0.0f || tl[i] >= laneRange)
+                       : (tl[i] >= 0.0f || tl[i] <= laneRange)) {
+        continue;
+      }
+      const float invDet = 1.0f / dl[i];
+      best.t = tl[i] * invDet;
+      best.barycentrics = vec3(ul[i], vl[i], wl[i]) * invDet;
+      best.triangle = packet.first + uint32_t(i);
+      closest = best.t;
+      found = true;
+    }
+  }
+  return found;
+}
+
+#endif  // HWY_TARGET == HWY_SCALAR
+
+// Moller-Trumbore (intersectTriangleFast) lane by lane: only for measuring what the
+// watertight test costs, so it is left scalar.
+template <bool kAnyHit>
+HWY_NOINLINE bool intersectLeafFast(const WideBvh& bvh, uint32_t firstPacket, uint32_t packetCount,
+                                    const RayPrecomputed& ray, float& closest, Hit& best) {
+  bool found = false;
+  for (uint32_t p = firstPacket; p < firstPacket + packetCount; ++p) {
+    const TrianglePacket& packet = bvh.packets[p];
+    for (uint32_t i = 0; i < packet.count; ++i) {
+      Triangle tri{};
+      tri.v0 = vec3(packet.v[0][0][i], packet.v[0][1][i], packet.v[0][2][i]);
+      tri.v1 = vec3(packet.v[1][0][i], packet.v[1][1][i], packet.v[1][2][i]);
+      tri.v2 = vec3(packet.v[2][0][i], packet.v[2][1][i], packet.v[2][2][i]);
+      Hit hit;
+      if (intersectTriangleFast(ray, tri, closest, hit)) {
+        hit.triangle = packet.first + i;
+        best = hit;
+        closest = hit.t;
+        found = true;
+        if constexpr (kAnyHit) return true;
+      }
+    }
+  }
+  return found;
+}
+
+// One loop for both query kinds, as in traverse.cpp, over references to nodes and leaves.
+// The children that the ray enters go on the stack in the binary order (any-hit queries,
+// which stop at the first hit wherever it is, take them as they come), the first on top,
+// and the first is taken off at once; a lone child is visited without the stack. A child
+// taken off the stack is skipped when its entry distance lies beyond the range, which has
+// shrunk since its box was tested: a box test now would miss it.
+template <bool kAnyHit, bool kWatertight>
+bool traverse(const WideBvh& bvh, const Ray& ray, float tMax, Hit& best) {
+  // No test of the root's box: a ray that misses it misses every box inside it.
+  const RayPrecomputed r(ray);
+  const RayLanes lanes(r);
+  struct Entry {
+    uint32_t child, packetCount;
+    float enter;
+  };
+  Entry stack[kWideStackSize];
+  uint32_t stackSize = 0;
+  bool found = false;
+  float closest = tMax;
+  float cull = closest * kFarScale;  // entry distances beyond it: a box test would miss
+  Entry next{0u, 0u, 0.0f};          // the root node
+  for (;;) {
+    if (!(next.child & kWideLeaf)) {
+      const WideNode& node = bvh.nodes[next.child];
+      const ChildLanes box = intersectBoxes</*kOrder=*/!kAnyHit>(node, lanes, closest);
+      if (box.hit != 0) {
+        // The children hit, by their place in the order (their lane, for any-hit queries).
+        uint8_t byKey[kWideLanes];
+        uint32_t keys = 0;
+        for (uint32_t rest = box.hit; rest != 0; rest &= rest - 1u) {
+          const int i = std::countr_zero(rest);
+          const uint32_t key = kAnyHit ? uint32_t(i) : box.key(i);
+          byKey[key] = uint8_t(i);
+          keys |= 1u << key;
+        }
+        // All but the first onto the stack, the last first; the first is next.
+        for (; (keys & (keys - 1u)) != 0; keys &= ~(0x80000000u >> std::countl_zero(keys))) {
+          const int i = byKey[31 - std::countl_zero(keys)];
+          stack[stackSize++] = Entry{node.child[i], node.packetCount[i], box.enter[i]};
+        }
+        const int i = byKey[std::countr_zero(keys)];
+        next = Entry{node.child[i], node.packetCount[i], box.enter[i]};
+        continue;
+      }
+    } else {
+      const uint32_t first = next.child & ~kWideLeaf;
+      const bool hit =
+          kWatertight
+              ? intersectLeafWatertight<kAnyHit>(bvh, first, next.packetCount, lanes, closest, best)
+              : intersectLeafFast<kAnyHit>(bvh, first, next.packetCount, r, closest, best);
+      if (hit) {
+        if constexpr (kAnyHit) return true;
+        found = true;
+        cull = closest * kFarScale;
+      }
+    }
+    // Take the next child off the stack.
+    do {
+      if (stackSize == 0) return found;
+      next = stack[--stackSize];
+    } while (!kAnyHit && next.enter > cull);
+  }
+}
+
+bool closestHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, Hit& hit) {
+  return traverse</*kAnyHit=*/false, true>(bvh, ray, tMax, hit);
+}
+bool closestHitFast(const WideBvh& bvh, const Ray& ray, float tMax, Hit& hit) {
+  return traverse</*kAnyHit=*/false, false>(bvh, ray, tMax, hit);
+}
+bool anyHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, Hit& hit) {
+  return traverse</*kAnyHit=*/true, true>(bvh, ray, tMax, hit);
+}
+bool anyHitFast(const WideBvh& bvh, const Ray& ray, float tMax, Hit& hit) {
+  return traverse</*kAnyHit=*/true, false>(bvh, ray, tMax, hit);
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace pt
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace pt {
+
+HWY_EXPORT(closestHitWatertight);
+HWY_EXPORT(closestHitFast);
+HWY_EXPORT(anyHitWatertight);
+HWY_EXPORT(anyHitFast);
+
+std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test) {
+  Hit hit;
+  const bool found = test == Intersection::kWatertight
+                         ? HWY_DYNAMIC_DISPATCH(closestHitWatertight)(bvh, ray, tMax, hit)
+                         : HWY_DYNAMIC_DISPATCH(closestHitFast)(bvh, ray, tMax, hit);
+  if (found) return hit;
+  return std::nullopt;
+}
+
+bool anyHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test) {
+  Hit hit;
+  return test == Intersection::kWatertight
+             ? HWY_DYNAMIC_DISPATCH(anyHitWatertight)(bvh, ray, tMax, hit)
+             : HWY_DYNAMIC_DISPATCH(anyHitFast)(bvh, ray, tMax, hit);
+}
+
+std::vector<int64_t> wideTraversalTargets() {
+  return hwy::SupportedAndGeneratedTargets();
+}
+
+}  // namespace pt
+#endif  // HWY_ONCE
