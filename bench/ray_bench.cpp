@@ -10,7 +10,8 @@
 //   shadow   from every primary hit to a point on an emitter picked from the alias table, as
 //            the integrator's next-event estimation traces them, when both sides face each
 //            other (any hit, t in (0, 1)).
-// Backends (kBackends below): our CPU traversal over the renderer's BVH, the GPU ray-query
+// Backends (kBackends below): our CPU traversal over the renderer's BVH (binary, and the
+// 8-wide tree collapsed from it that the CPU renderer uses), the GPU ray-query
 // shader on the chosen Vulkan device (host/vulkan/raycast.h), and Embree 3 (rtcIntersect1 and
 // rtcOccluded1 over Embree's own BVH) where it was found at build time.
 //
@@ -312,6 +313,12 @@ std::unique_ptr<TraversalBackend> makeCpuBackend(const BenchScene& scene, const 
   return treeBackend(tree, scene.data.bvh, o.threads);
 }
 
+// The wide tree the CPU renderer traverses (wide_bvh.h), collapsed from the same BVH.
+std::unique_ptr<TraversalBackend> makeWideBackend(const BenchScene& scene, const Options& o) {
+  const std::shared_ptr<const WideBvh> tree(std::shared_ptr<const void>(), &scene.data.wideBvh());
+  return treeBackend(tree, scene.data.bvh, o.threads);
+}
+
 // A GPU backend that traces a whole batch of RayQuery in one call of `trace` (results in
 // Bvh::triangles indices), such as traceRaysVulkan, which sets up a Vulkan context, compiles
 // the shader, uploads the BVH and the rays into host-visible buffers, dispatches and reads
@@ -465,7 +472,9 @@ struct BackendEntry {
 };
 
 const std::vector<BackendEntry> kBackends = {
-    {"cpu", "CPU traversal (host/bvh/traverse.h) over the renderer's BVH", makeCpuBackend},
+    {"cpu", "CPU binary traversal (host/bvh/traverse.h) over the renderer's BVH", makeCpuBackend},
+    {"cpu-wide", "CPU 8-wide SIMD traversal (host/bvh/wide_bvh.h), what the CPU renderer uses",
+     makeWideBackend},
     {"vulkan", "GPU ray-query shader (shaders/raycast.comp) via traceRaysVulkan",
      makeVulkanBackend},
 #ifdef PT_HAVE_EMBREE
@@ -866,7 +875,7 @@ int run(Options& o) {
         name.c_str());
     for (size_t i = agreement.size() - sets.size(); i < agreement.size(); ++i) {
       for (const Comparison& c : agreement[i].second) {
-        std::printf("  %-22s %-7s vs %-7s %8zu / %zu\n", agreement[i].first.c_str(), c.a.c_str(),
+        std::printf("  %-22s %-8s vs %-8s %8zu / %zu\n", agreement[i].first.c_str(), c.a.c_str(),
                     c.b.c_str(), c.differ, c.compared);
         for (const std::string& e : c.examples) std::printf("      %s\n", e.c_str());
       }
@@ -885,7 +894,7 @@ int run(Options& o) {
     std::printf("%-14s %-8s %9s", "scene", "type", "rays");
     for (const std::string& n : names) std::printf(" %10s", n.c_str());
     for (const std::string& n : names) {
-      if (n != kReference) std::printf(" %13s", (n + "/" + kReference).c_str());
+      if (n != kReference) std::printf(" %15s", (n + "/" + kReference).c_str());
     }
     std::printf("\n");
     for (const SummaryRow& row : summary) {
@@ -903,9 +912,9 @@ int run(Options& o) {
         if (n == kReference) continue;
         const auto it = row.mraysPerSecond.find(n);
         if (it == row.mraysPerSecond.end() || ref == row.mraysPerSecond.end()) {
-          std::printf(" %13s", "-");
+          std::printf(" %15s", "-");
         } else {
-          std::printf(" %13.3f", it->second / ref->second);
+          std::printf(" %15.3f", it->second / ref->second);
         }
       }
       std::printf("\n");

@@ -8,6 +8,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <thread>
@@ -384,6 +385,40 @@ TEST(WideBvh, AxisParallelRaysInFacePlanes) {
     EXPECT_FALSE(closestHit(wide, outside).has_value());
     EXPECT_FALSE(anyHit(wide, outside, INFINITY));
   });
+}
+
+TEST(WideBvh, DegenerateRaysAsTheBinaryTraversal) {
+  // Zero, NaN and infinite components in the direction or the origin, and huge origins: the
+  // answer is the binary traversal's (for NaN rays: nothing, turned away at the root box).
+  const std::vector<Triangle> sphere = test::makeSphere(vec3(0.5f, -0.25f, 2.0f), 1.0f, 12, 16);
+  const Bvh bvh = buildBvh(sphere, BvhBuildOptions{2});
+  const WideBvh wide = buildWideBvh(bvh);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = INFINITY;
+  const vec3 origins[] = {vec3(0.5f, -0.25f, 2.0f), vec3(0.5f, -0.25f, -3.0f), vec3(0.0f),
+                          vec3(nan, 0, 0),          vec3(0, inf, 0),           vec3(-inf, 0, 1),
+                          vec3(1e30f, 0, 0),        vec3(0.5f, -0.25f, -1e30f)};
+  const vec3 directions[] = {vec3(0, 0, 1),        vec3(0, 0, -1),     vec3(0.0f),
+                             vec3(nan, 0, 1),      vec3(0, nan, 0),    vec3(inf, 0, 1),
+                             vec3(0, -inf, 0),     vec3(1e-38f, 0, 1), vec3(1, 1, 1e-40f),
+                             vec3(-0.0f, -0.0f, 1)};
+  std::vector<Ray> rays;
+  for (const vec3& o : origins) {
+    for (const vec3& d : directions) rays.push_back(Ray{o, d});
+  }
+  // And from random points inside, with one component NaN or infinite (where NaN enters only
+  // the y or z slab, the scalar box test passes over it, and every triangle reached takes
+  // the ray at t = NaN), or a direction too short to have one.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> uni(-0.5f, 0.5f);
+  for (int i = 0; i < 3000; ++i) {
+    vec3 d(uni(rng), uni(rng), uni(rng));
+    d[i % 3] = i % 2 ? nan : (i % 4 ? inf : -inf);
+    if (i % 5 == 0) d = vec3(uni(rng), uni(rng), uni(rng)) * 1e-31f;
+    rays.push_back(Ray{vec3(0.5f, -0.25f, 2.0f) + vec3(uni(rng), uni(rng), uni(rng)), d});
+  }
+  const std::vector<float> tMax(rays.size(), 5.0f);
+  forEachTarget([&] { EXPECT_EQ(countDifferences(bvh, wide, rays, tMax), 0); });
 }
 
 // How many of the rays meet, in some triangle of the mesh, an edge function that comes out

@@ -17,8 +17,17 @@
 //    follows from the per-axis slab distances of its lanes: a parent's box is the union of
 //    its children's, and the slab distance of the union is the minimum of theirs (rounding
 //    is monotonic);
+//  - the boxes of the binary levels in between go untested: that may visit leaves the
+//    binary traversal skips, but their triangles are rejected by the range at that point,
+//    as the box tests of traverse.cpp only skip what the triangle test rejects too (the slab
+//    test errs towards hits, Ize 2013; BvhTraversal.MatchesBruteForceOnBunny);
 //  - within a leaf, the triangles are accepted in order against the shrinking closest
-//    distance, as the scalar loop does.
+//    distance, as the scalar loop does;
+//  - a ray with a NaN or an infinity in it, or without a direction, for which those
+//    shortcuts are not the scalar operations, takes traverse.cpp's loop itself over this
+//    tree's boxes (wide_traverse.cpp). (So does nothing else: for the rest, every distance
+//    computed is a number, as long as coordinates stay far from overflowing, below about
+//    1e18.)
 // Where two triangles lie at the same distance, which one is reported depends on the order
 // they are found in; keeping the order keeps the answer, and the images' bits.
 #pragma once
@@ -56,12 +65,20 @@ struct alignas(16) TrianglePacket {
   uint32_t first;               // Bvh::triangles index of lane 0; lane i holds first + i
   uint32_t count;               // 1 to 4 lanes in use
   uint32_t reserved[2];
+
+  Triangle triangle(uint32_t lane) const {
+    Triangle tri{};
+    tri.v0 = vec3(v[0][0][lane], v[0][1][lane], v[0][2][lane]);
+    tri.v1 = vec3(v[1][0][lane], v[1][1][lane], v[1][2][lane]);
+    tri.v2 = vec3(v[2][0][lane], v[2][1][lane], v[2][2][lane]);
+    return tri;
+  }
 };  // 160 bytes
 
 struct WideBvh {
   std::vector<WideNode> nodes;  // nodes[0] is the root: the binary root's descendants
   std::vector<TrianglePacket> packets;
-  vec3 rootMin{0.0f}, rootMax{0.0f};  // the binary root's box
+  vec3 rootMin{0.0f}, rootMax{0.0f};  // the binary root's box, tested first as it is there
   int maxDepth = 0;                   // deepest wide node below the root (root = 0)
   double buildSeconds = 0.0;          // of buildWideBvh (after the binary build)
 };
@@ -72,7 +89,7 @@ WideBvh buildWideBvh(const Bvh& bvh);
 
 // The same queries as on the binary Bvh (traverse.h), with the same answers. Boxes are
 // tested eight at a time and triangles four at a time, with x86-64 vector instructions
-// chosen at run time (AVX2, else SSE4 or SSSE3 in halves, else one lane at a time);
+// chosen at run time (AVX2, else SSE4 or SSSE3 in halves, else Highway's portable code);
 // Moller-Trumbore runs lane by lane.
 std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax = INFINITY,
                               Intersection test = Intersection::kWatertight);

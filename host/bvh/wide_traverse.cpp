@@ -1,6 +1,6 @@
 // Traversal of the wide BVH (wide_bvh.h): eight box tests and four triangle tests at a
 // time. Compiled once per x86 instruction set that Highway targets here (AVX2, SSE4, SSSE3
-// and its one-lane fallback: foreach_target.h includes this file once for each) and
+// and its portable fallback: foreach_target.h includes this file once for each) and
 // dispatched at run time to the best the CPU has, so that a build for baseline x86-64 still
 // runs vector code where the CPU has it. AVX2 tests a node's eight boxes in one 256-bit
 // vector, SSE4 and SSSE3 in two 128-bit halves; the four-lane triangle test uses 128-bit
@@ -12,6 +12,7 @@
 // Mul and Add are separate instructions, and ptcore is compiled with -ffp-contract=off.
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -41,10 +42,10 @@ struct ChildLanes {
   uint32_t hit;             // bit i: the ray enters child i's box within the range
   float enter[kWideLanes];  // entry distances (tNear of intersectBox)
   // With two or more hits (closest hit only), the binary traversal's order (wide_bvh.h):
-  // bit i of each says whether child i comes second at that level, for its pair (lanes
-  // 2k, 2k + 1: the children of one binary node), its half of a quad (the two pairs under
-  // one binary node) and its quad (lanes 0-3 and 4-7, under N's two children). The nearer
-  // comes first, the left one on a tie, as in traverse.cpp.
+  // bit i of each says whether child i's group comes second at that level: the lane within
+  // its pair (lanes 2k, 2k + 1, under one binary node), its pair within its quad (the two
+  // pairs under one binary node), its quad (lanes 0-3 and 4-7, under N's two children).
+  // The nearer comes first, the left one on a tie, as in traverse.cpp.
   uint32_t pairSecond = 0, quadSecond = 0, topSecond = 0;
   // Sort key of child i: its position in that order.
   uint32_t key(int i) const {
@@ -52,10 +53,10 @@ struct ChildLanes {
   }
 };
 
-// Which lanes come second when the comparisons `partnerLess` (the other group's entry
-// distance below this one's) and `partnerLessEqual` are known for every lane: a group that
-// is the left one (its lanes in `leftLanes`) comes second if the right one is nearer, the
-// right one unless the left one is farther.
+// The lanes whose group comes second, from each lane's comparisons of its partner group's
+// entry distance with its own group's, partner < own (partnerLess) and partner <= own
+// (partnerLessEqual): a left group (its lanes in leftLanes) comes second when its partner is
+// nearer, a right group when its partner is nearer or as near, since a tie goes left.
 constexpr uint32_t comesSecond(uint32_t partnerLess, uint32_t partnerLessEqual,
                                uint32_t leftLanes) {
   return (partnerLess & leftLanes) | (partnerLessEqual & ~leftLanes & 0xFFu);
@@ -125,10 +126,7 @@ bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket, uint32_t 
   for (uint32_t p = firstPacket; p < firstPacket + packetCount; ++p) {
     const TrianglePacket& packet = bvh.packets[p];
     for (uint32_t i = 0; i < packet.count; ++i) {
-      Triangle tri{};
-      tri.v0 = vec3(packet.v[0][0][i], packet.v[0][1][i], packet.v[0][2][i]);
-      tri.v1 = vec3(packet.v[1][0][i], packet.v[1][1][i], packet.v[1][2][i]);
-      tri.v2 = vec3(packet.v[2][0][i], packet.v[2][1][i], packet.v[2][2][i]);
+      const Triangle tri = packet.triangle(i);
       Hit hit;
       if (intersectTriangle(lanes.ray, tri, closest, hit)) {
         hit.triangle = packet.first + i;
@@ -389,10 +387,7 @@ HWY_NOINLINE bool intersectLeafFast(const WideBvh& bvh, uint32_t firstPacket, ui
   for (uint32_t p = firstPacket; p < firstPacket + packetCount; ++p) {
     const TrianglePacket& packet = bvh.packets[p];
     for (uint32_t i = 0; i < packet.count; ++i) {
-      Triangle tri{};
-      tri.v0 = vec3(packet.v[0][0][i], packet.v[0][1][i], packet.v[0][2][i]);
-      tri.v1 = vec3(packet.v[1][0][i], packet.v[1][1][i], packet.v[1][2][i]);
-      tri.v2 = vec3(packet.v[2][0][i], packet.v[2][1][i], packet.v[2][2][i]);
+      const Triangle tri = packet.triangle(i);
       Hit hit;
       if (intersectTriangleFast(ray, tri, closest, hit)) {
         hit.triangle = packet.first + i;
@@ -414,8 +409,10 @@ HWY_NOINLINE bool intersectLeafFast(const WideBvh& bvh, uint32_t firstPacket, ui
 // shrunk since its box was tested: a box test now would miss it.
 template <bool kAnyHit, bool kWatertight>
 bool traverse(const WideBvh& bvh, const Ray& ray, float tMax, Hit& best) {
-  // No test of the root's box: a ray that misses it misses every box inside it.
+  // The root's box first, as traverse.cpp tests it (the rays that miss it miss every box).
   const RayPrecomputed r(ray);
+  float rootEnter = 0.0f;
+  if (!intersectBox(r, bvh.rootMin, bvh.rootMax, tMax, rootEnter)) return false;
   const RayLanes lanes(r);
   struct Entry {
     uint32_t child, packetCount;
@@ -426,7 +423,7 @@ bool traverse(const WideBvh& bvh, const Ray& ray, float tMax, Hit& best) {
   bool found = false;
   float closest = tMax;
   float cull = closest * kFarScale;  // entry distances beyond it: a box test would miss
-  Entry next{0u, 0u, 0.0f};          // the root node
+  Entry next{0u, 0u, rootEnter};     // the root node
   for (;;) {
     if (!(next.child & kWideLeaf)) {
       const WideNode& node = bvh.nodes[next.child];
@@ -489,6 +486,116 @@ HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace pt {
+namespace {
+
+// The traversal above relies on every distance it computes being a number: the near plane
+// standing for min(t0, t1), the minima over lanes for the entry distances of the binary
+// nodes in between, the boxes of those nodes left untested. A ray with a NaN or an infinity
+// in it, or without a direction (|d| below kMinDirection on every axis: its sheared
+// coordinates are NaN, and every triangle takes it at t = NaN), breaks that; for those
+// this runs traverse.cpp's loop itself over the wide tree. A binary node is a range of one
+// wide node's lanes (all eight: the node's own binary node N; four: N's children; two:
+// theirs; one: a lane), and its box the union of its lanes' boxes, which is the binary
+// node's box exactly (every parent's box is the union of its children's).
+inline bool degenerate(const Ray& ray) {
+  const vec3 o = ray.origin, d = ray.direction;
+  // x - x is 0 for a number, NaN for an infinity or a NaN.
+  const bool finite =
+      (o.x - o.x) + (o.y - o.y) + (o.z - o.z) + (d.x - d.x) + (d.y - d.y) + (d.z - d.z) == 0.0f;
+  return !finite || (std::fabs(d.x) < kMinDirection && std::fabs(d.y) < kMinDirection &&
+                     std::fabs(d.z) < kMinDirection);
+}
+
+struct BinaryNode {
+  uint32_t node;  // the wide node
+  int first, size;
+  bool isLeaf(const WideBvh& bvh) const {
+    return size == 1 && (bvh.nodes[node].child[first] & kWideLeaf);
+  }
+};
+
+// The binary node of a range of lanes: where only the first lane is in use (a leaf less
+// than three levels down), that lane; a lane that is an interior node, that node's own
+// range.
+BinaryNode resolve(const WideBvh& bvh, BinaryNode b) {
+  for (;;) {
+    const WideNode& n = bvh.nodes[b.node];
+    const bool single = std::all_of(n.child + b.first + 1, n.child + b.first + b.size,
+                                    [](uint32_t c) { return c == kWideEmpty; });
+    if (!single) return b;
+    if (n.child[b.first] & kWideLeaf) return BinaryNode{b.node, b.first, 1};
+    b = BinaryNode{n.child[b.first], 0, kWideLanes};
+  }
+}
+
+bool intersectBinaryNode(const WideBvh& bvh, const RayPrecomputed& r, BinaryNode b, float tMax,
+                         float& tNear) {
+  const WideNode& n = bvh.nodes[b.node];
+  vec3 lo(INFINITY), hi(-INFINITY);
+  for (int i = b.first; i < b.first + b.size; ++i) {
+    lo = min(lo, vec3(n.bounds[0][i], n.bounds[1][i], n.bounds[2][i]));
+    hi = max(hi, vec3(n.bounds[3][i], n.bounds[4][i], n.bounds[5][i]));
+  }
+  return intersectBox(r, lo, hi, tMax, tNear);
+}
+
+template <bool kAnyHit>
+bool traverseAsBinary(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test,
+                      Hit& best) {
+  const RayPrecomputed r(ray);
+  float tNear = 0.0f;
+  if (!intersectBox(r, bvh.rootMin, bvh.rootMax, tMax, tNear)) return false;
+  BinaryNode stack[kBvhStackSize];
+  uint32_t stackSize = 0;
+  BinaryNode node = resolve(bvh, BinaryNode{0, 0, kWideLanes});
+  bool found = false;
+  float closest = tMax;
+  for (;;) {
+    if (node.isLeaf(bvh)) {
+      const uint32_t child = bvh.nodes[node.node].child[node.first];
+      const uint32_t first = child & ~kWideLeaf;
+      for (uint32_t p = first; p < first + bvh.nodes[node.node].packetCount[node.first]; ++p) {
+        const TrianglePacket& packet = bvh.packets[p];
+        for (uint32_t i = 0; i < packet.count; ++i) {
+          const Triangle tri = packet.triangle(i);
+          Hit hit;
+          const bool hitTriangle = test == Intersection::kWatertight
+                                       ? intersectTriangle(r, tri, closest, hit)
+                                       : intersectTriangleFast(r, tri, closest, hit);
+          if (hitTriangle) {
+            hit.triangle = packet.first + i;
+            best = hit;
+            closest = hit.t;
+            found = true;
+            if constexpr (kAnyHit) return true;
+          }
+        }
+      }
+    } else {
+      const int half = node.size / 2;
+      const BinaryNode left = resolve(bvh, BinaryNode{node.node, node.first, half});
+      const BinaryNode right = resolve(bvh, BinaryNode{node.node, node.first + half, half});
+      float tLeft = 0.0f, tRight = 0.0f;
+      const bool hitLeft = intersectBinaryNode(bvh, r, left, closest, tLeft);
+      const bool hitRight = intersectBinaryNode(bvh, r, right, closest, tRight);
+      if (hitLeft && hitRight) {
+        const bool leftFirst = tLeft <= tRight;
+        stack[stackSize++] = leftFirst ? right : left;
+        node = leftFirst ? left : right;
+        continue;
+      }
+      if (hitLeft || hitRight) {
+        node = hitLeft ? left : right;
+        continue;
+      }
+    }
+    if (stackSize == 0) break;
+    node = stack[--stackSize];
+  }
+  return found;
+}
+
+}  // namespace
 
 HWY_EXPORT(closestHitWatertight);
 HWY_EXPORT(closestHitFast);
@@ -497,7 +604,9 @@ HWY_EXPORT(anyHitFast);
 
 std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test) {
   Hit hit;
-  const bool found = test == Intersection::kWatertight
+  const bool found = degenerate(ray)
+                         ? traverseAsBinary</*kAnyHit=*/false>(bvh, ray, tMax, test, hit)
+                     : test == Intersection::kWatertight
                          ? HWY_DYNAMIC_DISPATCH(closestHitWatertight)(bvh, ray, tMax, hit)
                          : HWY_DYNAMIC_DISPATCH(closestHitFast)(bvh, ray, tMax, hit);
   if (found) return hit;
@@ -506,6 +615,7 @@ std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax, In
 
 bool anyHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test) {
   Hit hit;
+  if (degenerate(ray)) return traverseAsBinary</*kAnyHit=*/true>(bvh, ray, tMax, test, hit);
   return test == Intersection::kWatertight
              ? HWY_DYNAMIC_DISPATCH(anyHitWatertight)(bvh, ray, tMax, hit)
              : HWY_DYNAMIC_DISPATCH(anyHitFast)(bvh, ray, tMax, hit);

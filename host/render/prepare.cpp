@@ -7,9 +7,11 @@
 
 namespace pt {
 
-const WideBvh& LazyWideBvh::get(const Bvh& bvh) const {
-  std::call_once(state_->once, [&] { state_->wide = buildWideBvh(bvh); });
-  return state_->wide;
+void LazyWideBvh::build(const Bvh& bvh) const {
+  std::call_once(state_->once, [&] {
+    state_->wide = buildWideBvh(bvh);
+    state_->built.store(true, std::memory_order_release);
+  });
 }
 
 std::string EffectSet::toString() const {

@@ -4,6 +4,7 @@
 // reference reads them in place, but for the BVH, which it traverses in a four-wide copy.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -59,13 +60,19 @@ class LazyWideBvh {
   }
   LazyWideBvh& operator=(LazyWideBvh&&) noexcept = default;
 
-  const WideBvh& get(const Bvh& bvh) const;
+  // Once per ray in the CPU reference: inline, one load and a branch once it is built.
+  const WideBvh& get(const Bvh& bvh) const {
+    if (!state_->built.load(std::memory_order_acquire)) build(bvh);
+    return state_->wide;
+  }
 
  private:
   struct State {
     std::once_flag once;
+    std::atomic<bool> built{false};
     WideBvh wide;
   };
+  void build(const Bvh& bvh) const;
   std::unique_ptr<State> state_;
 };
 
