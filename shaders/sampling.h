@@ -51,38 +51,50 @@ PT_INLINE vec2 independentRandom2(uvec2 pixel, uint sampleIndex, uint dimension,
 // together, so the first 2^k samples are still such a net), which decorrelates the
 // dimensions of one path from each other. All of it is loop-free 32-bit integer arithmetic.
 
-// Sobol's second dimension: bit 31 - m of the result is the XOR of the index bits k whose
-// binomial coefficient C(k, m) is odd, that is (Lucas) the bits k that contain m as a
-// submask. Five shift-XOR steps sum every superset; the reversal puts bit m at 31 - m.
-PT_INLINE uint sobolSecondDimension(uint index) {
+// Sobol's second dimension, bit-reversed: bit m of the result is the XOR of the index bits k
+// whose binomial coefficient C(k, m) is odd, that is (Lucas) the bits k that contain m as a
+// submask. Five shift-XOR steps sum every superset.
+PT_INLINE uint sobolSecondDimensionReversed(uint index) {
   uint y = index;
   y ^= (y >> 1u) & 0x55555555u;
   y ^= (y >> 2u) & 0x33333333u;
   y ^= (y >> 4u) & 0x0F0F0F0Fu;
   y ^= (y >> 8u) & 0x00FF00FFu;
   y ^= (y >> 16u) & 0x0000FFFFu;
-  return bitfieldReverse(y);
+  return y;
 }
 
-// Nested uniform scramble of the bits of x, most significant first: each bit is flipped by
-// a hash of the seed and of the bits above it. The multiply-XOR steps (Laine and Karras
-// 2011, with their constants) let each bit depend only on lower bits, hence the reversals.
-PT_INLINE uint nestedUniformScramble(uint x, uint seed) {
-  x = bitfieldReverse(x);
+// Sobol's second dimension: the reversal puts bit m at 31 - m.
+PT_INLINE uint sobolSecondDimension(uint index) {
+  return bitfieldReverse(sobolSecondDimensionReversed(index));
+}
+
+// The multiply-XOR steps of Laine and Karras (2011, with their constants), which flip each
+// bit by a hash of the seed and of the bits below it.
+PT_INLINE uint laineKarrasPermutation(uint x, uint seed) {
   x += seed;
   x ^= x * 0x6C50B47Cu;
   x ^= x * 0xB82F1E52u;
   x ^= x * 0xC7AFE638u;
   x ^= x * 0x8D22F6E6u;
-  return bitfieldReverse(x);
+  return x;
+}
+
+// Nested uniform scramble of the bits of x, most significant first: each bit is flipped by
+// a hash of the seed and of the bits above it; hence the reversals around the permutation.
+PT_INLINE uint nestedUniformScramble(uint x, uint seed) {
+  return bitfieldReverse(laineKarrasPermutation(bitfieldReverse(x), seed));
 }
 
 PT_INLINE vec2 sobolRandom2(uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
   // Per pixel and dimension: a shuffle of the sample order and a scramble per coordinate.
   uvec4 h = pcg4d(uvec4(pixel.x, pixel.y, dimension, seed * 0x9E3779B9u + 0x7F4A7C15u));
   uint i = nestedUniformScramble(sampleIndex, h.x);
-  uint x = nestedUniformScramble(bitfieldReverse(i), h.y);  // Sobol's first dimension
-  uint y = nestedUniformScramble(sobolSecondDimension(i), h.z);
+  // Sobol's first dimension is i reversed, and so its nested scramble,
+  // nestedUniformScramble(bitfieldReverse(i), h.y), reverses it back first: the two
+  // reversals are left out, here and in the second dimension.
+  uint x = bitfieldReverse(laineKarrasPermutation(i, h.y));
+  uint y = bitfieldReverse(laineKarrasPermutation(sobolSecondDimensionReversed(i), h.z));
   return vec2(float(x >> 8u), float(y >> 8u)) * (1.0f / 16777216.0f);
 }
 

@@ -14,6 +14,15 @@ using uint = std::uint32_t;
 using namespace glm;  // so that shared code reads as GLSL: dot, cross, floatBitsToInt...
 #define PT_CONST inline constexpr
 #define PT_INLINE inline
+// GLSL's bitfieldReverse for a 32-bit word, the same bits as GLM's (five mask-and-shift
+// steps) with the last two done by one byte swap: the samplers reverse several words per
+// random number.
+inline uint bitfieldReverse(uint x) {
+  x = __builtin_bswap32(x);
+  x = ((x & 0x0F0F0F0Fu) << 4u) | ((x >> 4u) & 0x0F0F0F0Fu);
+  x = ((x & 0x33333333u) << 2u) | ((x >> 2u) & 0x33333333u);
+  return ((x & 0x55555555u) << 1u) | ((x >> 1u) & 0x55555555u);
+}
 #else
 #define PT_CONST const
 #define PT_INLINE

@@ -42,6 +42,30 @@ TEST(SobolSampler, NestedScrambleIsABijectionThatKeepsPrefixes) {
   }
 }
 
+TEST(SobolSampler, FastBitReversalIsGlmsAndTheShortcutsAreTheDefinition) {
+  // shared_types.h's bitfieldReverse stands in for GLM's (and GLSL's) in the C++ build, and
+  // sobolRandom2 leaves out reversals that cancel: both must keep every bit.
+  uint state = 12345u;
+  for (int n = 0; n < 100000; ++n) {
+    state = state * 747796405u + 2891336453u;
+    const uint x = state ^ (state >> 13u);
+    ASSERT_EQ(bitfieldReverse(x), glm::bitfieldReverse(x)) << "x " << x;
+  }
+  for (uint dimension = 0; dimension < 8; ++dimension) {
+    for (uint index = 0; index < 512; ++index) {
+      const uvec2 pixel(index * 7u % 61u, dimension * 3u + 5u);
+      const uvec4 h = pcg4d(uvec4(pixel.x, pixel.y, dimension, 9u * 0x9E3779B9u + 0x7F4A7C15u));
+      const uint i = nestedUniformScramble(index, h.x);
+      const uint x = nestedUniformScramble(glm::bitfieldReverse(i), h.y);
+      const uint y = nestedUniformScramble(sobolSecondDimension(i), h.z);
+      const vec2 expected = vec2(float(x >> 8u), float(y >> 8u)) * (1.0f / 16777216.0f);
+      const vec2 got = sobolRandom2(pixel, index, dimension, 9u);
+      ASSERT_EQ(got.x, expected.x) << "dimension " << dimension << " index " << index;
+      ASSERT_EQ(got.y, expected.y) << "dimension " << dimension << " index " << index;
+    }
+  }
+}
+
 // Every elementary interval of area 2^-k (2^a columns by 2^(k-a) rows) holds exactly one
 // of the 2^k points with indices first .. first + 2^k - 1.
 void expectNet(uvec2 pixel, uint dimension, uint seed, uint first, int k) {
