@@ -68,7 +68,7 @@ struct Options {
   int size = 256;                     // primary rays: one per pixel of a size x size film
   int threads = 0;                    // CPU backends; 0: every CPU this process may run on
   std::string device;                 // Vulkan device: index or part of the name
-  std::string builder = "lbvh";
+  std::string builder{nameOf(kBuilderNames, kDefaultBuilder)};
   int leafSize = 4;
   double minTime = 0.5;                 // Google Benchmark: least seconds per repetition
   int repetitions = 3;                  // the summary takes the median over these
@@ -995,7 +995,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 4096));
   app.add_option("--threads", o.threads, "CPU threads for the CPU backends (default: all)");
   app.add_option("--device", o.device, "Vulkan device: index or part of the name");
-  app.add_option("--builder", o.builder, "BVH builder of our tree (default lbvh, the renderer's)")
+  app.add_option("--builder", o.builder,
+                 "BVH builder of our tree (default: the renderer's, " +
+                     std::string(pt::nameOf(pt::kBuilderNames, pt::kDefaultBuilder)) + ")")
       ->check(CLI::IsMember(pt::namesOf(pt::kBuilderNames)));
   app.add_option("--leaf-size", o.leafSize, "Maximum triangles per leaf of our tree")
       ->check(CLI::Range(1, 64));

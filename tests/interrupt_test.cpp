@@ -533,7 +533,7 @@ TEST(Refusals, BadStatesAndSettingsGiveOneLineAndStatus2) {
       {"other depth", small + " --max-depth 3 --spp 16 --resume " + s + out, {"max_depth"}},
       {"other builder",
        small + " --builder sah --spp 16 --resume " + s + out,
-       {"builder lbvh vs sah"}},
+       {"builder ploc vs sah"}},
       {"beyond the target",
        small + " --spp 4 --resume " + s + out,
        {"holds samples 0:8, more than this render's 0:4"}},

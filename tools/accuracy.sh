@@ -30,17 +30,17 @@ scenes=(cornell-box bunny-box)
 
 # Configurations: label and `pt converge` flags. "baseline" is the scenes' own settings:
 # NEE+MIS, Russian roulette on (from depth 3), max depth 64, Owen-scrambled Sobol numbers,
-# LBVH with leaf size 4, watertight intersection, specialized.
+# PLOC BVH with leaf size 4, watertight intersection, specialized.
 declare -A flags=(
   [baseline]="" [nee]="--strategy nee" [bsdf]="--strategy bsdf" [rr-off]="--rr off"
   [depth-1]="--max-depth 1" [depth-2]="--max-depth 2" [depth-4]="--max-depth 4"
   [independent]="--sampler independent"
   [leaf-1]="--leaf-size 1" [leaf-8]="--leaf-size 8" [leaf-16]="--leaf-size 16"
-  [sah]="--builder sah" [fast-isect]="--intersection fast"
+  [lbvh]="--builder lbvh" [sah]="--builder sah" [fast-isect]="--intersection fast"
   [unspecialized]="--no-specialize"
 )
 cpu_labels="baseline nee bsdf rr-off depth-1 depth-2 depth-4 independent leaf-1 leaf-8 leaf-16"
-cpu_labels="$cpu_labels sah fast-isect"
+cpu_labels="$cpu_labels lbvh sah fast-isect"
 vulkan_labels="$cpu_labels unspecialized"
 # Knob groups: file name, title, labels (each plot and table shows one group).
 groups=(
@@ -48,7 +48,7 @@ groups=(
   "depth|Russian roulette on (baseline) / off, max depth 64 (baseline), 4, 2, 1|baseline rr-off depth-4 depth-2 depth-1"
   "sampler|Random numbers: Owen-scrambled Sobol (baseline) vs independent|baseline independent"
   "leaf|BVH leaf size 1, 4 (baseline), 8, 16|leaf-1 baseline leaf-8 leaf-16"
-  "builder|BVH builder: LBVH (baseline) vs binned SAH (trace time; build time below)|baseline sah"
+  "builder|BVH builder: PLOC (baseline) vs LBVH vs binned SAH (trace time; build time below)|baseline lbvh sah"
   "intersection|Ray/triangle test: watertight (baseline) vs Moller-Trumbore (not watertight)|baseline fast-isect"
   "specialize|Specialization constants on (baseline) / off, Vulkan only|baseline unspecialized"
 )
@@ -112,7 +112,7 @@ else
   # prints them), for the builder table.
   : >"$out/builds.txt"
   for scene in "${scenes[@]}"; do
-    for builder in lbvh sah; do
+    for builder in ploc lbvh sah; do
       for _ in 1 2 3 4 5; do
         "$pt" render "configs/$scene.json" --backend cpu --threads "$threads" --width 8 \
           --height 8 --spp 1 --builder "$builder" --out "$out/build-probe.pfm" 2>/dev/null |
@@ -340,7 +340,7 @@ EOF
       awk -v s="$scene" 'BEGIN {
           print "\nBVH builds (median of 5; the trace times are in the table above):\n"
           print "| builder | nodes | build seconds |"; print "|---|--:|--:|" }
-        $1 == s { printf "| %s | %d | %.4f |\n", $2 == "lbvh" ? "LBVH (baseline)" : "binned SAH", $3, $4 }' \
+        $1 == s { printf "| %s | %d | %.4f |\n", $2 == "ploc" ? "PLOC (baseline)" : $2 == "lbvh" ? "LBVH" : "binned SAH", $3, $4 }' \
         "$out/builds.txt"
     fi
     spec=$(field "$scene" vulkan baseline 7) unspec=$(field "$scene" vulkan unspecialized 7)

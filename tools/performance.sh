@@ -418,7 +418,9 @@ How it is measured:
   camera at 3.4 radii and a small light out of view; it is convex, so its shadow rays are
   rarely occluded and must prove that nothing is in the way.
 - **cpu**: \`closestHit\` / \`anyHit\` of \`host/bvh/traverse.h\` over the tree the renderer builds
-  (LBVH, leaf size 4, unless \`BENCH_ARGS\` says otherwise), the batch spread over the threads.
+  (the default builder, leaf size 4, unless \`BENCH_ARGS\` says otherwise), the batch spread over the threads.
+- **cpu-wide**: the same queries over the 8-wide tree collapsed from it (\`host/bvh/wide_bvh.h\`),
+  which the CPU renderer traverses.
 - **vulkan**: the ray-query shader (\`shaders/raycast.comp\`, the path tracer's traversal) through
   \`traceRaysVulkan\`. That call sets up a context, compiles the shader and uploads the BVH every
   time, so the bench subtracts that fixed cost (the median of three one-ray calls, printed in the

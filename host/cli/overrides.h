@@ -17,7 +17,7 @@ struct SceneOverrides {
   int leafSize = 4;
   // Names from the tables; empty: the scene's (strategy, roulette, sampler) or the default.
   std::string strategy, roulette, sampler;
-  std::string builder{nameOf(kBuilderNames, BvhBuilder::kLbvh)};
+  std::string builder{nameOf(kBuilderNames, kDefaultBuilder)};
   std::string intersection{nameOf(kIntersectionNames, false)};
 
   // The names were validated against the same tables when the command line was parsed.
@@ -31,7 +31,7 @@ struct SceneOverrides {
     s.strategy = valueNamed(kStrategyNames, strategy);
     s.russianRoulette = valueNamed(kRouletteNames, roulette);
     s.sampler = valueNamed(kSamplerNames, sampler);
-    s.builder = valueNamed(kBuilderNames, builder).value_or(BvhBuilder::kLbvh);
+    s.builder = valueNamed(kBuilderNames, builder).value_or(kDefaultBuilder);
     s.fastIntersection = valueNamed(kIntersectionNames, intersection).value_or(false);
     return s;
   }
