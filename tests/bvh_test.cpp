@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "brute_force.h"
 #include "bvh/bvh.h"
 #include "bvh/traverse.h"
 #include "closed_mesh.h"
@@ -93,12 +94,9 @@ void expectMortonOrder(const Bvh& bvh) {
   }
 }
 
+using test::BruteHit;
+
 // Closest hit by testing every triangle.
-struct BruteHit {
-  bool found = false;
-  float t = INFINITY;
-  uint primitive = 0;
-};
 
 BruteHit bruteForce(const std::vector<Triangle>& tris, const Ray& ray) {
   const RayPrecomputed r(ray);
@@ -207,58 +205,10 @@ TEST(BvhBuild, BunnyInvariants) {
 
 TEST(BvhTraversal, MatchesBruteForceOnBunny) {
   const std::vector<Triangle> bunny = loadBunny();
-  // Ray set: origins around the mesh; half aimed at a random point of a random triangle (so
-  // most hit), half in uniformly random directions (many miss).
-  constexpr int kRays = 100000;
-  std::mt19937 rng(1234);
-  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
-  std::vector<Ray> rays(kRays);
-  std::vector<float> shadowFraction(kRays);
-  for (int i = 0; i < kRays; ++i) {
-    const vec3 o(uni(rng) * 4 - 2, uni(rng) * 4 - 2, uni(rng) * 4 - 2);
-    vec3 d;
-    if (i % 2 == 0) {
-      const Triangle& t = bunny[size_t(uni(rng) * float(bunny.size())) % bunny.size()];
-      const vec2 b = sampleTriangleBarycentrics(vec2(uni(rng), uni(rng)));
-      d = normalize((1 - b.x - b.y) * t.v0 + b.x * t.v1 + b.y * t.v2 - o);
-    } else {
-      d = normalize(vec3(uni(rng) - 0.5f, uni(rng) - 0.5f, uni(rng) - 0.5f));
-    }
-    rays[i] = Ray{o, d};
-    shadowFraction[i] = uni(rng) * 2.0f;  // any-hit range as a fraction of the closest t
-  }
-  // Brute force on all cores: every triangle is considered for every ray (7e9 pairs); a
-  // conservative bounding-sphere test skips the exact test where it cannot hit.
-  std::vector<vec4> spheres;  // centre, squared radius
-  for (const Triangle& t : bunny) {
-    const vec3 c = (t.v0 + t.v1 + t.v2) / 3.0f;
-    const float r2 =
-        std::max({dot(t.v0 - c, t.v0 - c), dot(t.v1 - c, t.v1 - c), dot(t.v2 - c, t.v2 - c)});
-    spheres.emplace_back(c, r2 * 1.001f + 1e-12f);
-  }
-  auto bruteForceCulled = [&](const Ray& ray) {
-    const RayPrecomputed r(ray);
-    BruteHit best;
-    for (size_t k = 0; k < bunny.size(); ++k) {
-      const vec3 v = vec3(spheres[k]) - ray.origin;
-      const float vv = dot(v, v), tc = dot(v, ray.direction);
-      // Squared distance of the centre from the ray's line, with slack for rounding.
-      if (vv - tc * tc > spheres[k].w + 1e-5f * vv) continue;
-      Hit h;
-      if (intersectTriangle(r, bunny[k], best.t, h)) best = {true, h.t, bunny[k].primitive};
-    }
-    return best;
-  };
-  std::vector<BruteHit> expected(kRays);
-  {
-    const unsigned n = std::max(1u, std::thread::hardware_concurrency());
-    std::vector<std::thread> pool;
-    for (unsigned w = 0; w < n; ++w)
-      pool.emplace_back([&, w] {
-        for (int i = int(w); i < kRays; i += int(n)) expected[i] = bruteForceCulled(rays[i]);
-      });
-    for (auto& th : pool) th.join();
-  }
+  const int kRays = test::kBruteForceRays;
+  const test::RandomRays set = test::raysAroundMesh(bunny, kRays, 1234);
+  const std::vector<Ray>& rays = set.rays;
+  const std::vector<BruteHit> expected = test::bruteForceClosestHits(bunny, rays);
   // The LBVH and the PLOC tree (the SAH tree is compared with the LBVH below).
   for (BvhBuilder builder : {BvhBuilder::kLbvh, BvhBuilder::kPloc}) {
     SCOPED_TRACE(std::string(nameOf(kBuilderNames, builder)));
@@ -273,7 +223,7 @@ TEST(BvhTraversal, MatchesBruteForceOnBunny) {
       const bool same = hit.has_value() == e.found && (!e.found || hit->t == e.t);
       if (!same && ++mismatches <= 5) ADD_FAILURE() << "ray " << i << " closest hit differs";
       // Any-hit within a range that may or may not contain the closest hit.
-      const float tMax = e.found ? e.t * shadowFraction[i] : 1e3f;
+      const float tMax = e.found ? e.t * set.shadowFraction[i] : 1e3f;
       const bool blocked = anyHit(bvh, rays[i], tMax);
       const bool expectBlocked = e.found && e.t < tMax;
       if (blocked != expectBlocked && ++anyHitMismatches <= 5)

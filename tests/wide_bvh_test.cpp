@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "brute_force.h"
 #include "bvh/bvh.h"
 #include "bvh/traverse.h"
 #include "bvh/wide_bvh.h"
@@ -204,65 +205,15 @@ TEST(WideBvh, SingleLeafTree) {
 
 TEST(WideBvh, MatchesBruteForceAndTheBinaryTraversalOnBunny) {
   const std::vector<Triangle> bunny = loadBunny();
-  // The ray set of BvhTraversal.MatchesBruteForceOnBunny: origins around the mesh, half aimed
-  // at a random point of a random triangle (most hit), half in random directions (many miss).
-  constexpr int kRays = 100000;
-  std::mt19937 rng(4321);
-  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
-  std::vector<Ray> rays(kRays);
-  std::vector<float> shadowFraction(kRays);
-  for (int i = 0; i < kRays; ++i) {
-    const vec3 o(uni(rng) * 4 - 2, uni(rng) * 4 - 2, uni(rng) * 4 - 2);
-    vec3 d;
-    if (i % 2 == 0) {
-      const Triangle& t = bunny[size_t(uni(rng) * float(bunny.size())) % bunny.size()];
-      const vec2 b = sampleTriangleBarycentrics(vec2(uni(rng), uni(rng)));
-      d = normalize((1 - b.x - b.y) * t.v0 + b.x * t.v1 + b.y * t.v2 - o);
-    } else {
-      d = normalize(vec3(uni(rng) - 0.5f, uni(rng) - 0.5f, uni(rng) - 0.5f));
-    }
-    rays[i] = Ray{o, d};
-    shadowFraction[i] = uni(rng) * 2.0f;  // any-hit range as a fraction of the closest t
-  }
-  // Brute force on all cores, every triangle considered for every ray; a conservative
-  // bounding-sphere test skips the exact test where it cannot hit.
-  struct BruteHit {
-    bool found = false;
-    float t = INFINITY;
-  };
-  std::vector<vec4> spheres;  // centre, squared radius
-  for (const Triangle& t : bunny) {
-    const vec3 c = (t.v0 + t.v1 + t.v2) / 3.0f;
-    const float r2 =
-        std::max({dot(t.v0 - c, t.v0 - c), dot(t.v1 - c, t.v1 - c), dot(t.v2 - c, t.v2 - c)});
-    spheres.emplace_back(c, r2 * 1.001f + 1e-12f);
-  }
-  auto bruteForce = [&](const Ray& ray) {
-    const RayPrecomputed r(ray);
-    BruteHit best;
-    for (size_t k = 0; k < bunny.size(); ++k) {
-      const vec3 v = vec3(spheres[k]) - ray.origin;
-      const float vv = dot(v, v), tc = dot(v, ray.direction);
-      if (vv - tc * tc > spheres[k].w + 1e-5f * vv) continue;
-      Hit h;
-      if (intersectTriangle(r, bunny[k], best.t, h)) best = {true, h.t};
-    }
-    return best;
-  };
-  std::vector<BruteHit> expected(kRays);
-  {
-    const unsigned n = std::max(1u, std::thread::hardware_concurrency());
-    std::vector<std::thread> pool;
-    for (unsigned w = 0; w < n; ++w)
-      pool.emplace_back([&, w] {
-        for (int i = int(w); i < kRays; i += int(n)) expected[i] = bruteForce(rays[i]);
-      });
-    for (auto& th : pool) th.join();
-  }
+  // Rays as in BvhTraversal.MatchesBruteForceOnBunny, another seed.
+  const int kRays = test::kBruteForceRays;
+  const test::RandomRays set = test::raysAroundMesh(bunny, kRays, 4321);
+  const std::vector<Ray>& rays = set.rays;
+  const std::vector<test::BruteHit> expected = test::bruteForceClosestHits(bunny, rays);
   std::vector<float> tMax(kRays);
   int hits = 0;
   for (int i = 0; i < kRays; ++i) {
-    tMax[i] = expected[i].found ? expected[i].t * shadowFraction[i] : 1e3f;
+    tMax[i] = expected[i].found ? expected[i].t * set.shadowFraction[i] : 1e3f;
     hits += expected[i].found;
   }
   EXPECT_GT(hits, kRays / 2);  // the test exercises hits, not just misses
@@ -273,7 +224,7 @@ TEST(WideBvh, MatchesBruteForceAndTheBinaryTraversalOnBunny) {
     int mismatches = 0, anyHitMismatches = 0;
     for (int i = 0; i < kRays; ++i) {
       const auto hit = closestHit(wide, rays[i]);
-      const BruteHit& e = expected[i];
+      const test::BruteHit& e = expected[i];
       // The same distance bit for bit (at an edge two triangles may share it).
       const bool same = hit.has_value() == e.found && (!e.found || hit->t == e.t);
       if (!same && ++mismatches <= 5) ADD_FAILURE() << "ray " << i << " closest hit differs";
