@@ -407,6 +407,49 @@ TEST_F(ImageErrors, ExrWhoseDataWindowClaimsTooMuchIsRefusedBeforeDecoding) {
       << message;
 }
 
+TEST_F(ImageErrors, ExrHeadersThatWouldAbortTinyexrAreRefused) {
+  // tinyexr asserts (aborts the process) on a "type" attribute it does not know or that
+  // disagrees with the tiled flag, and on a "tiles" attribute that is not 9 bytes: each is
+  // refused with one line first. A valid EXR gets the attribute inserted after its version.
+  writeImage(Image(4, 4), dir_ / "small.exr");
+  const std::string valid = readFile(dir_ / "small.exr");
+  struct Case {
+    const char* name;
+    std::string attribute;
+    bool tiled;
+    const char* expected;
+  };
+  auto attribute = [](std::string_view name, std::string_view type, std::string_view value) {
+    std::string a = std::string(name) + '\0' + std::string(type) + '\0';
+    const uint32_t size = uint32_t(value.size());
+    a.append(reinterpret_cast<const char*>(&size), 4);  // little-endian, like x86
+    return a + std::string(value);
+  };
+  const Case cases[] = {
+      {"deep type", attribute("type", "string", std::string_view("deepscanline\0", 13)), false,
+       "EXR image type 'deepscanline' is not supported"},
+      {"unknown type", attribute("type", "string", std::string_view("Window\0", 7)), false,
+       "EXR image type 'Window' is not supported"},
+      {"tiled type in a scanline file", attribute("type", "string", "tiledimage"), false,
+       "EXR attribute 'type' is not a terminated string"},
+      {"short tiles", attribute("tiles", "tiledesc", std::string(8, '\1')), true,
+       "EXR attribute 'tiles' has 8 bytes, not 9"},
+      {"tile level mode 3", attribute("tiles", "tiledesc", std::string(8, '\1') + '\3'), true,
+       "EXR tile level mode 3 is not defined"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    std::string bytes = valid;
+    if (c.tiled) bytes[5] = char(bytes[5] | 0x02);  // the version's tiled bit (bit 9)
+    bytes.insert(8, c.attribute);
+    const fs::path path = dir_ / "odd.exr";
+    writeBytes(path, bytes);
+    const std::string message = inputErrorOf([&] { readImage(path); });
+    expectMessageStartsWithPath(message, path);
+    EXPECT_NE(message.find(c.expected), std::string::npos) << message;
+  }
+}
+
 TEST_F(ImageErrors, UnknownExtensionNamesTheFile) {
   const Image image(2, 2);
   for (const char* name : {"x.bmp", "x.jpg", "noextension"}) {

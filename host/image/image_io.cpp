@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string_view>
 #include <system_error>
 
@@ -242,6 +243,52 @@ struct ExrReadState {
   ExrReadState& operator=(const ExrReadState&) = delete;
 };
 
+// tinyexr aborts on a few headers instead of returning an error (Debian builds it with its
+// asserts on): a "type" attribute other than the four it knows or at odds with the version's
+// tiled flag, a "tiles" attribute that is not 9 bytes, tile level mode 3 (as the fuzzer
+// found). Those attributes are checked here first, read as tinyexr reads them: name and type
+// as terminated strings, a 4-byte little-endian size, the value; a single 0 byte ends the
+// header. Whatever else is wrong with the header is left to tinyexr to report.
+void checkExrHeaderForTinyexr(const Bytes& data, bool tiled, const fs::path& path) {
+  size_t at = 8;  // after the magic number and the version
+  auto terminated = [&](size_t from) -> std::optional<std::string_view> {
+    const auto* begin = reinterpret_cast<const char*>(data.data()) + from;
+    const size_t length = strnlen(begin, data.size() - from);
+    if (from + length >= data.size()) return std::nullopt;
+    return std::string_view(begin, length);
+  };
+  while (at < data.size() && data[at] != 0) {
+    const auto name = terminated(at);
+    if (!name) return;
+    const auto type = terminated(at + name->size() + 1);
+    if (!type) return;
+    const size_t sizeAt = at + name->size() + 1 + type->size() + 1;
+    if (data.size() - sizeAt < 4) return;
+    const uint32_t size = uint32_t(data[sizeAt]) | uint32_t(data[sizeAt + 1]) << 8 |
+                          uint32_t(data[sizeAt + 2]) << 16 | uint32_t(data[sizeAt + 3]) << 24;
+    const size_t valueAt = sizeAt + 4;
+    if (data.size() - valueAt < size) return;
+    const std::string_view value(reinterpret_cast<const char*>(data.data()) + valueAt, size);
+    if (*name == "type" && !value.empty() && value[0] != 0) {
+      const size_t end = value.find('\0');
+      if (end == std::string_view::npos)
+        fail(path, "EXR attribute 'type' is not a terminated string");
+      const std::string_view kind = value.substr(0, end);
+      if (kind != (tiled ? "tiledimage" : "scanlineimage")) {
+        fail(path, "EXR image type '" + std::string(kind) + "' is not supported in a " +
+                       (tiled ? "tiled" : "scanline") +
+                       " file (only scanlineimage and tiledimage)");
+      }
+    }
+    if (*name == "tiles" && tiled) {
+      if (size != 9)
+        fail(path, "EXR attribute 'tiles' has " + std::to_string(size) + " bytes, not 9");
+      if ((uint8_t(value[8]) & 0x3) == 3) fail(path, "EXR tile level mode 3 is not defined");
+    }
+    at = valueAt + size;
+  }
+}
+
 Image decodeExr(const Bytes& data, const fs::path& path) {
   EXRVersion version;
   if (ParseEXRVersionFromMemory(&version, data.data(), data.size()) != TINYEXR_SUCCESS) {
@@ -250,6 +297,7 @@ Image decodeExr(const Bytes& data, const fs::path& path) {
   if (version.multipart || version.non_image) {
     fail(path, "multi-part and deep EXR files are not supported");
   }
+  checkExrHeaderForTinyexr(data, version.tiled != 0, path);
   ExrReadState exr;
   const char* err = nullptr;
   const int parsed =
