@@ -165,23 +165,7 @@ TEST(BvhBuild, DepthStaysWithinTraversalStack) {
   // highest-differing-bit split peels off one cluster, a chain 62 levels deep, and each
   // cluster of 64 coincident triangles needs 6 more levels with leaves of 1. Without the
   // balanced fallback the tree would be 68 deep; the traversal stack holds kBvhStackSize.
-  constexpr float kCell = 1.0f / float(1 << 21);
-  std::vector<Triangle> tris;
-  auto addCluster = [&](vec3 c) {
-    // Coincident copies; small enough for the centroid to stay in its Morton cell, large
-    // enough to stay a real triangle in float where the coordinates reach 0.5.
-    const float s = 0.5f * kCell;
-    for (int i = 0; i < 64; ++i) {
-      tris.push_back(
-          Triangle{c, 0, c + vec3(s, 0, 0), kNoEmitter, c + vec3(0, s, 0), uint(tris.size())});
-    }
-  };
-  for (int bit = 0; bit < 63; ++bit) {
-    vec3 c(0.25f * kCell);
-    c[bit % 3] = (std::ldexp(1.0f, bit / 3) + 0.5f) * kCell;
-    addCluster(c);
-  }
-  addCluster(vec3(1.0f));  // fixes the centroid bounds to about [0, 1]
+  const std::vector<Triangle> tris = test::makeDeepMortonChain();
   const Bvh bvh = buildBvh(tris, BvhBuildOptions{1});
   expectValidBvh(bvh, tris.size(), 1);
   EXPECT_GT(bvh.maxDepth, 50);  // the Morton chain really is deep here

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -45,6 +46,32 @@ inline std::vector<Triangle> makeSphere(vec3 center, float radius, int rings, in
     }
   }
   for (uint i = 0; i < tris.size(); ++i) tris[i].primitive = i;
+  return tris;
+}
+
+// The deepest tree the BVH builders make: 63 clusters whose Morton codes each have a single
+// bit set, one cluster per bit, so that every highest-differing-bit split peels off one
+// cluster (a chain 62 levels deep), and each cluster is 64 coincident triangles, which need 6
+// more levels with leaves of 1; one more cluster at (1, 1, 1) fixes the centroid bounds to
+// about [0, 1].
+inline std::vector<Triangle> makeDeepMortonChain() {
+  constexpr float kCell = 1.0f / float(1 << 21);
+  std::vector<Triangle> tris;
+  auto addCluster = [&](vec3 c) {
+    // Coincident copies; small enough for the centroid to stay in its Morton cell, large
+    // enough to stay a real triangle in float where the coordinates reach 0.5.
+    const float s = 0.5f * kCell;
+    for (int i = 0; i < 64; ++i) {
+      tris.push_back(
+          Triangle{c, 0, c + vec3(s, 0, 0), kNoEmitter, c + vec3(0, s, 0), uint(tris.size())});
+    }
+  };
+  for (int bit = 0; bit < 63; ++bit) {
+    vec3 c(0.25f * kCell);
+    c[bit % 3] = (std::ldexp(1.0f, bit / 3) + 0.5f) * kCell;
+    addCluster(c);
+  }
+  addCluster(vec3(1.0f));
   return tris;
 }
 

@@ -275,21 +275,7 @@ TEST(WideBvh, DeepTreeWithinTheStack) {
   // The chain of BvhBuild.DepthStaysWithinTraversalStack (62 levels of Morton splits, then
   // clusters of coincident triangles), the deepest tree the builders make: the wide stack
   // must hold the widest and deepest traversal of it.
-  constexpr float kCell = 1.0f / float(1 << 21);
-  std::vector<Triangle> tris;
-  auto addCluster = [&](vec3 c) {
-    const float s = 0.5f * kCell;
-    for (int i = 0; i < 64; ++i) {
-      tris.push_back(
-          Triangle{c, 0, c + vec3(s, 0, 0), kNoEmitter, c + vec3(0, s, 0), uint(tris.size())});
-    }
-  };
-  for (int bit = 0; bit < 63; ++bit) {
-    vec3 c(0.25f * kCell);
-    c[bit % 3] = (std::ldexp(1.0f, bit / 3) + 0.5f) * kCell;
-    addCluster(c);
-  }
-  addCluster(vec3(1.0f));
+  const std::vector<Triangle> tris = test::makeDeepMortonChain();
   const Bvh bvh = buildBvh(tris, BvhBuildOptions{1});
   ASSERT_GT(bvh.maxDepth, 50);
   const WideBvh wide = buildWideBvh(bvh);
