@@ -18,7 +18,7 @@ PT_CONST float kInvPi = 0.31830988618379067154f;
 // pcg4d (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020): a 4D -> 4D
 // integer hash built from LCG steps and xorshifts. All arithmetic is 32-bit unsigned and
 // wraps, so C++ and GLSL compute identical bits.
-PT_INLINE uvec4 pcg4d(uvec4 v) {
+PT_HOT_INLINE uvec4 pcg4d(uvec4 v) {
   v = v * 1664525u + 1013904223u;
   v.x += v.y * v.w;
   v.y += v.z * v.x;
@@ -36,7 +36,7 @@ PT_INLINE uvec4 pcg4d(uvec4 v) {
 // other pair. The top 24 bits of a hash word convert to float exactly, so both sides get the
 // same bits. The seed is spread by an odd constant (the golden ratio in 32-bit fixed point)
 // so that neighbouring seeds do not share dimensions.
-PT_INLINE vec2 independentRandom2(uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
+PT_HOT_INLINE vec2 independentRandom2(uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
   uvec4 h = pcg4d(uvec4(pixel.x, pixel.y, sampleIndex, dimension + seed * 0x9E3779B9u));
   return vec2(float(h.x >> 8u), float(h.y >> 8u)) * (1.0f / 16777216.0f);
 }
@@ -54,7 +54,7 @@ PT_INLINE vec2 independentRandom2(uvec2 pixel, uint sampleIndex, uint dimension,
 // Sobol's second dimension, bit-reversed: bit m of the result is the XOR of the index bits k
 // whose binomial coefficient C(k, m) is odd, that is (Lucas) the bits k that contain m as a
 // submask. Five shift-XOR steps sum every superset.
-PT_INLINE uint sobolSecondDimensionReversed(uint index) {
+PT_HOT_INLINE uint sobolSecondDimensionReversed(uint index) {
   uint y = index;
   y ^= (y >> 1u) & 0x55555555u;
   y ^= (y >> 2u) & 0x33333333u;
@@ -71,7 +71,7 @@ PT_INLINE uint sobolSecondDimension(uint index) {
 
 // The multiply-XOR steps of Laine and Karras (2011, with their constants), which flip each
 // bit by a hash of the seed and of the bits below it.
-PT_INLINE uint laineKarrasPermutation(uint x, uint seed) {
+PT_HOT_INLINE uint laineKarrasPermutation(uint x, uint seed) {
   x += seed;
   x ^= x * 0x6C50B47Cu;
   x ^= x * 0xB82F1E52u;
@@ -82,11 +82,11 @@ PT_INLINE uint laineKarrasPermutation(uint x, uint seed) {
 
 // Nested uniform scramble of the bits of x, most significant first: each bit is flipped by
 // a hash of the seed and of the bits above it; hence the reversals around the permutation.
-PT_INLINE uint nestedUniformScramble(uint x, uint seed) {
+PT_HOT_INLINE uint nestedUniformScramble(uint x, uint seed) {
   return bitfieldReverse(laineKarrasPermutation(bitfieldReverse(x), seed));
 }
 
-PT_INLINE vec2 sobolRandom2(uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
+PT_HOT_INLINE vec2 sobolRandom2(uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
   // Per pixel and dimension: a shuffle of the sample order and a scramble per coordinate.
   uvec4 h = pcg4d(uvec4(pixel.x, pixel.y, dimension, seed * 0x9E3779B9u + 0x7F4A7C15u));
   uint i = nestedUniformScramble(sampleIndex, h.x);
@@ -100,12 +100,12 @@ PT_INLINE vec2 sobolRandom2(uvec2 pixel, uint sampleIndex, uint dimension, uint 
 
 // The integrators' source of random numbers: two numbers in [0, 1) for one dimension of one
 // path sample, from the chosen sampler (kSamplerIndependent or kSamplerSobol).
-PT_INLINE vec2 random2(bool sobol, uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
+PT_HOT_INLINE vec2 random2(bool sobol, uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
   return sobol ? sobolRandom2(pixel, sampleIndex, dimension, seed)
                : independentRandom2(pixel, sampleIndex, dimension, seed);
 }
 
-PT_INLINE float random1(bool sobol, uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
+PT_HOT_INLINE float random1(bool sobol, uvec2 pixel, uint sampleIndex, uint dimension, uint seed) {
   return random2(sobol, pixel, sampleIndex, dimension, seed).x;
 }
 

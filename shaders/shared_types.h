@@ -14,6 +14,10 @@ using uint = std::uint32_t;
 using namespace glm;  // so that shared code reads as GLSL: dot, cross, floatBitsToInt...
 #define PT_CONST inline constexpr
 #define PT_INLINE inline
+// For the few small functions called several times per path vertex (the random numbers):
+// inlined whatever the compiler's heuristics say, so that independent calls overlap and
+// unused results are dropped.
+#define PT_HOT_INLINE [[gnu::always_inline]] inline
 // GLSL's bitfieldReverse for a 32-bit word, the same bits as GLM's (five mask-and-shift
 // steps) with the last two done by one byte swap: the samplers reverse several words per
 // random number.
@@ -26,6 +30,7 @@ inline uint bitfieldReverse(uint x) {
 #else
 #define PT_CONST const
 #define PT_INLINE
+#define PT_HOT_INLINE
 #endif
 
 // ---- BVH -------------------------------------------------------------------------------
