@@ -32,8 +32,8 @@ Triangle loadTriangle(uint i) {
   uvec4 a = texelFetch(triangleTexels, at);
   uvec4 b = texelFetch(triangleTexels, at + 1);
   uvec4 c = texelFetch(triangleTexels, at + 2);
-  return Triangle(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
-                  uintBitsToFloat(c.xyz), c.w);
+  return Triangle(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w, uintBitsToFloat(c.xyz),
+                  c.w);
 }
 
 struct RayData {

@@ -24,6 +24,16 @@ namespace {
 
 const ContextOptions kValidated{.validation = validationWanted()};
 
+// The rays traced on the device with validation (where wanted), which must report no
+// validation error and no query cut short by the loop cap.
+std::vector<RayResult> traceChecked(const Bvh& bvh, const std::vector<RayQuery>& queries) {
+  RaycastStats stats;
+  std::vector<RayResult> results = traceRaysVulkan(bvh, queries, kValidated, &stats);
+  EXPECT_EQ(stats.validationErrors, 0u);
+  EXPECT_EQ(stats.truncated, 0u);
+  return results;
+}
+
 bool contains(vec3 lo, vec3 hi, vec3 p) {
   return all(lessThanEqual(lo, p)) && all(lessThanEqual(p, hi));
 }
@@ -200,10 +210,7 @@ TEST(GpuTraversal, WatertightAtSharedEdgesAndVertices) {
     }
   }
   ASSERT_GE(queries.size(), 1000000u);
-  RaycastStats stats;
-  const std::vector<RayResult> results = traceRaysVulkan(bvh, queries, kValidated, &stats);
-  EXPECT_EQ(stats.validationErrors, 0u);
-  EXPECT_EQ(stats.truncated, 0u);
+  const std::vector<RayResult> results = traceChecked(bvh, queries);
   size_t leaks = 0;
   for (const RayResult& r : results) leaks += r.found == 0u;
   EXPECT_EQ(leaks, 0u);
@@ -215,10 +222,7 @@ TEST(GpuTraversal, WatertightOnAClosedScannedMesh) {
   const std::vector<RayQuery> queries =
       test::aimedRays(bvh.triangles, test::interiorPoints(bvh, 8, 6));
   ASSERT_GE(queries.size(), 1000000u);
-  RaycastStats stats;
-  const std::vector<RayResult> results = traceRaysVulkan(bvh, queries, kValidated, &stats);
-  EXPECT_EQ(stats.validationErrors, 0u);
-  EXPECT_EQ(stats.truncated, 0u);
+  const std::vector<RayResult> results = traceChecked(bvh, queries);
   const float outward = test::outwardSign(bvh.triangles);
   size_t leaks = 0;
   for (size_t i = 0; i < queries.size(); ++i) {
@@ -241,10 +245,7 @@ TEST(GpuTraversal, ClosestAndAnyHitMatchTheCpuOnTheBunny) {
     const bool shadow = i % 3 == 0;
     queries.push_back(RayQuery{o, shadow ? std::abs(uni(rng)) : INFINITY, d, shadow ? 1u : 0u});
   }
-  RaycastStats stats;
-  const std::vector<RayResult> gpu = traceRaysVulkan(bvh, queries, kValidated, &stats);
-  EXPECT_EQ(stats.validationErrors, 0u);
-  EXPECT_EQ(stats.truncated, 0u);
+  const std::vector<RayResult> gpu = traceChecked(bvh, queries);
   size_t differ = 0, hits = 0;
   for (size_t i = 0; i < queries.size(); ++i) {
     const RayQuery& q = queries[i];
@@ -275,10 +276,7 @@ TEST(GpuTraversal, TiesGoToTheTriangleTheCpuReports) {
   const std::vector<RayQuery> queries =
       test::aimedRays(bvh.triangles, test::interiorPoints(bvh, 4, 2));
   ASSERT_GE(queries.size(), 100000u);
-  RaycastStats stats;
-  const std::vector<RayResult> gpu = traceRaysVulkan(bvh, queries, kValidated, &stats);
-  EXPECT_EQ(stats.validationErrors, 0u);
-  EXPECT_EQ(stats.truncated, 0u);
+  const std::vector<RayResult> gpu = traceChecked(bvh, queries);
   size_t differ = 0;
   for (size_t i = 0; i < queries.size(); ++i) {
     const auto cpu = closestHit(bvh, Ray{queries[i].origin, queries[i].direction});
@@ -317,10 +315,7 @@ TEST(GpuTraversal, SplitLeavesGiveTheCpusAnswers) {
     queries.push_back(RayQuery{o, shadow ? std::abs(uni(rng)) : INFINITY,
                                normalize((t.v0 + t.v1 + t.v2) / 3.0f - o), shadow ? 1u : 0u});
   }
-  RaycastStats stats;
-  const std::vector<RayResult> gpu = traceRaysVulkan(bvh, queries, kValidated, &stats);
-  EXPECT_EQ(stats.validationErrors, 0u);
-  EXPECT_EQ(stats.truncated, 0u);
+  const std::vector<RayResult> gpu = traceChecked(bvh, queries);
   size_t differ = 0;
   for (size_t i = 0; i < queries.size(); ++i) {
     const RayQuery& q = queries[i];

@@ -66,23 +66,17 @@ for dir in "$@"; do
     check scene "$f" "0 2" "$pt" render "$work/scene.json" --backend cpu --width 8 --height 8 \
       --spp 1 --threads 1 --out "$work/out.exr"
   done
-  for f in "$dir"/obj/*; do
-    [[ -f $f ]] || continue
-    cp "$f" "$work/box.obj"
-    check obj "$f" "0 2" "$pt" render "$work/box-obj.json" --backend cpu --threads 1 --out "$work/out.exr"
+  # Each mesh or material file in turn in place of the fixed scene's own.
+  for kind_scene in obj:box-obj.json ply:box-ply.json mtl:box.json; do
+    kind=${kind_scene%%:*} scene=${kind_scene#*:}
+    for f in "$dir/$kind"/*; do
+      [[ -f $f ]] || continue
+      cp "$f" "$work/box.$kind"
+      check "$kind" "$f" "0 2" "$pt" render "$work/$scene" --backend cpu --threads 1 \
+        --out "$work/out.exr"
+    done
+    [[ -f $work/box.$kind.orig ]] && cp "$work/box.$kind.orig" "$work/box.$kind"
   done
-  cp "$work/box.obj.orig" "$work/box.obj"
-  for f in "$dir"/ply/*; do
-    [[ -f $f ]] || continue
-    cp "$f" "$work/box.ply"
-    check ply "$f" "0 2" "$pt" render "$work/box-ply.json" --backend cpu --threads 1 --out "$work/out.exr"
-  done
-  for f in "$dir"/mtl/*; do
-    [[ -f $f ]] || continue
-    cp "$f" "$work/box.mtl"
-    check mtl "$f" "0 2" "$pt" render "$work/box.json" --backend cpu --threads 1 --out "$work/out.exr"
-  done
-  cp "$work/box.mtl.orig" "$work/box.mtl"
   for f in "$dir"/image/*; do
     [[ -f $f ]] || continue
     # The extension a user's file would have, from the magic number (as the fuzz target does).

@@ -87,6 +87,36 @@ struct WideBvh {
 // but holds copies of the vertices, so it does not depend on bvh's lifetime.
 WideBvh buildWideBvh(const Bvh& bvh);
 
+namespace wide_detail {
+
+// The triangles of a leaf (packetCount packets from firstPacket) one at a time, in order,
+// against the shrinking closest distance, as traverse.cpp's leaf loop: for Highway's portable
+// target, for Moller-Trumbore, and for the rays the vector code does not take.
+template <bool kAnyHit, bool kWatertight>
+bool intersectLeafLaneByLane(const WideBvh& bvh, uint32_t firstPacket, uint32_t packetCount,
+                             const RayPrecomputed& ray, float& closest, Hit& best) {
+  bool found = false;
+  for (uint32_t p = firstPacket; p < firstPacket + packetCount; ++p) {
+    const TrianglePacket& packet = bvh.packets[p];
+    for (uint32_t i = 0; i < packet.count; ++i) {
+      Hit hit;
+      const bool hitTriangle = kWatertight
+                                   ? intersectTriangle(ray, packet.triangle(i), closest, hit)
+                                   : intersectTriangleFast(ray, packet.triangle(i), closest, hit);
+      if (hitTriangle) {
+        hit.triangle = packet.first + i;
+        best = hit;
+        closest = hit.t;
+        found = true;
+        if constexpr (kAnyHit) return true;
+      }
+    }
+  }
+  return found;
+}
+
+}  // namespace wide_detail
+
 // The same queries as on the binary Bvh (traverse.h), with the same answers. Boxes are
 // tested eight at a time and triangles four at a time, with x86-64 vector instructions
 // chosen at run time (AVX2, else SSE4 or SSSE3 in halves, else Highway's portable code);

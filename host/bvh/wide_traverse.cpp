@@ -122,22 +122,8 @@ ChildLanes intersectBoxes(const WideNode& node, const RayLanes& lanes, float tMa
 template <bool kAnyHit>
 bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket, uint32_t packetCount,
                              const RayLanes& lanes, float& closest, Hit& best) {
-  bool found = false;
-  for (uint32_t p = firstPacket; p < firstPacket + packetCount; ++p) {
-    const TrianglePacket& packet = bvh.packets[p];
-    for (uint32_t i = 0; i < packet.count; ++i) {
-      const Triangle tri = packet.triangle(i);
-      Hit hit;
-      if (intersectTriangle(lanes.ray, tri, closest, hit)) {
-        hit.triangle = packet.first + i;
-        best = hit;
-        closest = hit.t;
-        found = true;
-        if constexpr (kAnyHit) return true;
-      }
-    }
-  }
-  return found;
+  return wide_detail::intersectLeafLaneByLane<kAnyHit, /*kWatertight=*/true>(
+      bvh, firstPacket, packetCount, lanes.ray, closest, best);
 }
 
 #else  // vector instructions
@@ -383,22 +369,8 @@ HWY_INLINE bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket
 template <bool kAnyHit>
 HWY_NOINLINE bool intersectLeafFast(const WideBvh& bvh, uint32_t firstPacket, uint32_t packetCount,
                                     const RayPrecomputed& ray, float& closest, Hit& best) {
-  bool found = false;
-  for (uint32_t p = firstPacket; p < firstPacket + packetCount; ++p) {
-    const TrianglePacket& packet = bvh.packets[p];
-    for (uint32_t i = 0; i < packet.count; ++i) {
-      const Triangle tri = packet.triangle(i);
-      Hit hit;
-      if (intersectTriangleFast(ray, tri, closest, hit)) {
-        hit.triangle = packet.first + i;
-        best = hit;
-        closest = hit.t;
-        found = true;
-        if constexpr (kAnyHit) return true;
-      }
-    }
-  }
-  return found;
+  return wide_detail::intersectLeafLaneByLane<kAnyHit, /*kWatertight=*/false>(
+      bvh, firstPacket, packetCount, ray, closest, best);
 }
 
 // One loop for both query kinds, as in traverse.cpp, over references to nodes and leaves.
@@ -552,24 +524,16 @@ bool traverseAsBinary(const WideBvh& bvh, const Ray& ray, float tMax, Intersecti
   float closest = tMax;
   for (;;) {
     if (node.isLeaf(bvh)) {
-      const uint32_t child = bvh.nodes[node.node].child[node.first];
-      const uint32_t first = child & ~kWideLeaf;
-      for (uint32_t p = first; p < first + bvh.nodes[node.node].packetCount[node.first]; ++p) {
-        const TrianglePacket& packet = bvh.packets[p];
-        for (uint32_t i = 0; i < packet.count; ++i) {
-          const Triangle tri = packet.triangle(i);
-          Hit hit;
-          const bool hitTriangle = test == Intersection::kWatertight
-                                       ? intersectTriangle(r, tri, closest, hit)
-                                       : intersectTriangleFast(r, tri, closest, hit);
-          if (hitTriangle) {
-            hit.triangle = packet.first + i;
-            best = hit;
-            closest = hit.t;
-            found = true;
-            if constexpr (kAnyHit) return true;
-          }
-        }
+      const uint32_t first = bvh.nodes[node.node].child[node.first] & ~kWideLeaf;
+      const uint32_t count = bvh.nodes[node.node].packetCount[node.first];
+      const bool hit = test == Intersection::kWatertight
+                           ? wide_detail::intersectLeafLaneByLane<kAnyHit, true>(bvh, first, count,
+                                                                                 r, closest, best)
+                           : wide_detail::intersectLeafLaneByLane<kAnyHit, false>(bvh, first, count,
+                                                                                  r, closest, best);
+      if (hit) {
+        found = true;
+        if constexpr (kAnyHit) return true;
       }
     } else {
       const int half = node.size / 2;
