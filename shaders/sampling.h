@@ -109,6 +109,27 @@ PT_HOT_INLINE float random1(bool sobol, uvec2 pixel, uint sampleIndex, uint dime
   return random2(sobol, pixel, sampleIndex, dimension, seed).x;
 }
 
+// The random numbers of one scattering event: the kDimsPerBounce dimensions from `dim`
+// (kDimFirstBounce + kDimsPerBounce * bounce), in the order of their offsets. The CPU
+// reference draws them together, four hashes in one vector (host/cpu/bounce_random.h: the
+// same bits); the shader draws each where it is used.
+struct BounceRandom {
+  vec2 lightChoose;  // dim + kDimLightChoose
+  vec2 lightPoint;   // dim + kDimLightPoint
+  vec2 bsdf;         // dim + kDimBsdf
+  vec2 roulette;     // dim + kDimRoulette (.x only)
+};
+
+PT_INLINE BounceRandom bounceRandom(bool sobol, uvec2 pixel, uint sampleIndex, uint dim,
+                                    uint seed) {
+  BounceRandom u;
+  u.lightChoose = random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed);
+  u.lightPoint = random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed);
+  u.bsdf = random2(sobol, pixel, sampleIndex, dim + kDimBsdf, seed);
+  u.roulette = random2(sobol, pixel, sampleIndex, dim + kDimRoulette, seed);
+  return u;
+}
+
 // ---- Directions and points -------------------------------------------------------------
 
 // Maps a direction given in the frame (t, b, n) of unit vector n to world space, with the

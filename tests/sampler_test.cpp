@@ -3,11 +3,15 @@
 // better than independent numbers while staying unbiased.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <random>
 #include <set>
 
+#include <hwy/targets.h>
+
 #include "common/shared.h"
+#include "cpu/bounce_random.h"
 
 namespace pt {
 namespace {
@@ -79,6 +83,40 @@ void expectNet(uvec2 pixel, uint dimension, uint seed, uint first, int k) {
     }
     EXPECT_EQ(cells.size(), n) << "k=" << k << " a=" << a << " first=" << first;
   }
+}
+
+TEST(BounceRandomSimd, EqualsTheScalarDefinitionOnEveryTarget) {
+  // The CPU reference's vector version of one scattering event's numbers gives the bits of
+  // the definition that the shader uses, on every instruction set it may run on here, for
+  // both samplers: small and extreme pixels, samples, dimensions and seeds, then random ones.
+  const std::vector<int64_t> targets = bounceRandomTargets();
+  ASSERT_FALSE(targets.empty());
+  const uint edge[] = {0u, 1u, 2u, 255u, 65535u, 0x7FFFFFFFu, 0xFFFFFFFCu, 0xFFFFFFFFu};
+  std::mt19937 rng(11);
+  for (int64_t target : targets) {
+    SCOPED_TRACE(hwy::TargetName(target));
+    hwy::SetSupportedTargetsForTest(target);
+    for (int i = 0; i < 40000; ++i) {
+      const bool sobol = i % 2 == 0;
+      const uvec2 pixel =
+          i < 4096 ? uvec2(edge[i % 8], edge[(i / 8) % 8]) : uvec2(rng() % 4096u, rng() % 4096u);
+      const uint sampleIndex = i < 4096 ? edge[(i / 64) % 8] : uint(rng());
+      const uint dim = i < 4096 ? kDimFirstBounce + kDimsPerBounce * uint(i % 13) : uint(rng());
+      const uint seed = i < 4096 ? edge[(i / 512) % 8] : uint(rng());
+      const BounceRandom a = bounceRandom(sobol, pixel, sampleIndex, dim, seed);
+      const BounceRandom b = bounceRandomSimd(sobol, pixel, sampleIndex, dim, seed);
+      const float expected[8] = {a.lightChoose.x, a.lightChoose.y, a.lightPoint.x, a.lightPoint.y,
+                                 a.bsdf.x,        a.bsdf.y,        a.roulette.x,   a.roulette.y};
+      const float actual[8] = {b.lightChoose.x, b.lightChoose.y, b.lightPoint.x, b.lightPoint.y,
+                               b.bsdf.x,        b.bsdf.y,        b.roulette.x,   b.roulette.y};
+      for (int k = 0; k < 8; ++k) {
+        ASSERT_EQ(std::bit_cast<uint32_t>(actual[k]), std::bit_cast<uint32_t>(expected[k]))
+            << "number " << k << " of sobol=" << sobol << " pixel (" << pixel.x << ", " << pixel.y
+            << ") sample " << sampleIndex << " dim " << dim << " seed " << seed;
+      }
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
 }
 
 TEST(SobolSampler, EveryAlignedPowerOfTwoBlockIsANet) {

@@ -17,6 +17,7 @@
 
 #include "bvh/traverse.h"
 #include "common/check.h"
+#include "cpu/bounce_random.h"
 
 namespace pt {
 namespace {
@@ -149,6 +150,9 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
 
     // Both materials are two-sided: shade with the normal facing the incoming ray.
     const vec3 n = cosOut >= 0.0f ? ng : -ng;
+    // This event's random numbers, all four dimensions at once (the shader draws each where
+    // it is used: the same numbers).
+    const BounceRandom u = bounceRandomSimd(sobol, pixel, sampleIndex, dim, seed);
     vec3 wi;
     if (material.type == kMaterialMirror) {
       // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
@@ -159,14 +163,11 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
       const vec3 f = material.reflectance * kInvPi;
       // Sample direct illumination from an emitter (next-event estimation).
       if (neeOn && material.reflectance != vec3(0.0f)) {
-        L += sampleDirectLight(scene, p, n, magnitude, beta, f,
-                               random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
-                               random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
-                               misOn, test, rays, debugPrint, depth);
+        L += sampleDirectLight(scene, p, n, magnitude, beta, f, u.lightChoose, u.lightPoint, misOn,
+                               test, rays, debugPrint, depth);
       }
       // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
-      wi = localToWorld(
-          sampleCosineHemisphere(random2(sobol, pixel, sampleIndex, dim + kDimBsdf, seed)), n);
+      wi = localToWorld(sampleCosineHemisphere(u.bsdf), n);
       bsdfPdf = dot(wi, n) * kInvPi;
       if (!(bsdfPdf > 0.0f)) break;  // direction in the tangent plane: zero contribution
       beta *= material.reflectance;
@@ -177,7 +178,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
     if (params.russianRoulette != 0u && depth >= params.rrStartDepth) {
       const float q = std::max(0.0f, 1.0f - maxComponent(beta));
-      if (random1(sobol, pixel, sampleIndex, dim + kDimRoulette, seed) < q) break;
+      if (u.roulette.x < q) break;
       beta /= 1.0f - q;
     }
 
