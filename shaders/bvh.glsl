@@ -13,6 +13,10 @@
 // all the code in its body, whatever each lane needs; what a fetch costs is how lavapipe
 // gathers it (see PT_BINDING_NODES in shared_types.h).
 
+// Rows of four stack entries that traceRay keeps (1 to 16): enough for the tree's depth, set
+// by the host from it (host/vulkan/gpu_bvh.h, gpuStackRows).
+layout(constant_id = PT_SPEC_STACK_ROWS) const uint kStackRows = 16u;
+
 // The structs from their 16-byte rows, fetched as texels (see PT_BINDING_NODES): row k
 // holds the struct's members 2k and 2k + 1, a vec3 and a 4-byte scalar, as
 // host/common/shared.h checks on the C++ side; the constructors take the members in
@@ -164,9 +168,16 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
   // Node 0 holds the root's box and reference.
   GpuBvhNode root = loadNode(0u);
   if (!intersectBox(r, root.leftMin, root.leftMax, tMax, tNear)) return false;
-  // One entry more than the deepest tree pushes: the slot above the top is written on every
-  // iteration (see the push below).
-  uint stack[kBvhStackSize + 1u];
+  // The stack of what to visit later, in variables rather than an array: stack0.x is the top,
+  // then stack0.y, ..., stack1.x, ...; a push shifts every entry down one place, a pop up.
+  // Lavapipe reads and writes a local array lane by lane, with a branch on each lane's mask,
+  // but moves variables for all its lanes at once. The tree's depth bounds the entries (one
+  // per interior node above the one visited), and kStackRows rows of four hold them; the
+  // rows beyond are compiled out.
+  uvec4 stack0 = uvec4(0u), stack1 = uvec4(0u), stack2 = uvec4(0u), stack3 = uvec4(0u);
+  uvec4 stack4 = uvec4(0u), stack5 = uvec4(0u), stack6 = uvec4(0u), stack7 = uvec4(0u);
+  uvec4 stack8 = uvec4(0u), stack9 = uvec4(0u), stack10 = uvec4(0u), stack11 = uvec4(0u);
+  uvec4 stack12 = uvec4(0u), stack13 = uvec4(0u), stack14 = uvec4(0u), stack15 = uvec4(0u);
   uint stackSize = 0u;
   uint ref = root.left;  // what to visit next: an interior node or a leaf, never 0 here
   bool found = false;
@@ -199,12 +210,28 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
       near = far;
       far = 0u;
     }
-    // The push, as a store on every iteration into the slot above the top, which counts only
-    // when there is something to push: lavapipe stores to a different index per lane lane by
-    // lane, with a branch on each lane's mask, and the loop's mask is far easier to predict
-    // than whether a node pushes.
-    stack[stackSize] = far;
-    if (far != 0u) stackSize++;
+    if (far != 0u) {
+      // Push. (The host sizes the stack from the tree; a push that would drop the bottom
+      // entry all the same is reported as a traversal cut short.)
+      if (stackSize == 4u * kStackRows) gTruncated = true;
+      if (kStackRows > 15u) stack15 = uvec4(stack14.w, stack15.xyz);
+      if (kStackRows > 14u) stack14 = uvec4(stack13.w, stack14.xyz);
+      if (kStackRows > 13u) stack13 = uvec4(stack12.w, stack13.xyz);
+      if (kStackRows > 12u) stack12 = uvec4(stack11.w, stack12.xyz);
+      if (kStackRows > 11u) stack11 = uvec4(stack10.w, stack11.xyz);
+      if (kStackRows > 10u) stack10 = uvec4(stack9.w, stack10.xyz);
+      if (kStackRows > 9u) stack9 = uvec4(stack8.w, stack9.xyz);
+      if (kStackRows > 8u) stack8 = uvec4(stack7.w, stack8.xyz);
+      if (kStackRows > 7u) stack7 = uvec4(stack6.w, stack7.xyz);
+      if (kStackRows > 6u) stack6 = uvec4(stack5.w, stack6.xyz);
+      if (kStackRows > 5u) stack5 = uvec4(stack4.w, stack5.xyz);
+      if (kStackRows > 4u) stack4 = uvec4(stack3.w, stack4.xyz);
+      if (kStackRows > 3u) stack3 = uvec4(stack2.w, stack3.xyz);
+      if (kStackRows > 2u) stack2 = uvec4(stack1.w, stack2.xyz);
+      if (kStackRows > 1u) stack1 = uvec4(stack0.w, stack1.xyz);
+      stack0 = uvec4(far, stack0.xyz);
+      stackSize++;
+    }
     // The leaves' triangles in order, shrinking the search range as hits are found.
     uint k = 0u;
     for (; k < count + count2; ++k) {
@@ -223,7 +250,25 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
     ref = near;
     if (ref == 0u) {
       if (stackSize == 0u) break;
-      ref = stack[--stackSize];
+      // Pop.
+      ref = stack0.x;
+      stack0 = uvec4(stack0.yzw, stack1.x);
+      if (kStackRows > 1u) stack1 = uvec4(stack1.yzw, stack2.x);
+      if (kStackRows > 2u) stack2 = uvec4(stack2.yzw, stack3.x);
+      if (kStackRows > 3u) stack3 = uvec4(stack3.yzw, stack4.x);
+      if (kStackRows > 4u) stack4 = uvec4(stack4.yzw, stack5.x);
+      if (kStackRows > 5u) stack5 = uvec4(stack5.yzw, stack6.x);
+      if (kStackRows > 6u) stack6 = uvec4(stack6.yzw, stack7.x);
+      if (kStackRows > 7u) stack7 = uvec4(stack7.yzw, stack8.x);
+      if (kStackRows > 8u) stack8 = uvec4(stack8.yzw, stack9.x);
+      if (kStackRows > 9u) stack9 = uvec4(stack9.yzw, stack10.x);
+      if (kStackRows > 10u) stack10 = uvec4(stack10.yzw, stack11.x);
+      if (kStackRows > 11u) stack11 = uvec4(stack11.yzw, stack12.x);
+      if (kStackRows > 12u) stack12 = uvec4(stack12.yzw, stack13.x);
+      if (kStackRows > 13u) stack13 = uvec4(stack13.yzw, stack14.x);
+      if (kStackRows > 14u) stack14 = uvec4(stack14.yzw, stack15.x);
+      if (kStackRows > 15u) stack15 = uvec4(stack15.yzw, 0u);
+      stackSize--;
     }
   }
   // Ended by a break: a hit found for any-hit, or nothing left. (A flag set at each break

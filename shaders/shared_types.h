@@ -168,7 +168,9 @@ struct RenderParams {
 // that alternative is compiled, or kSpecAtRunTime to compile both and read RenderParams.
 #define PT_SPEC_INTERSECTION 6  // uint: RenderParams::fastIntersection (0 watertight, 1 fast)
 #define PT_SPEC_SAMPLER 7       // uint: RenderParams::samplerType (independent or Sobol)
-#define PT_SPEC_COUNT 8
+// Not an effect: the traversal stack's size, rows of four entries (bvh.glsl), from the tree.
+#define PT_SPEC_STACK_ROWS 8  // uint: 1 to kBvhStackSize / 4
+#define PT_SPEC_COUNT 9
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever

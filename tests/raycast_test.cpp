@@ -195,6 +195,62 @@ TEST(GpuBvhLayout, SplitLeavesTooDeepForTheStackAreRefused) {
   expectValidLayout(chainTree(62, 30), buildGpuBvh(chainTree(62, 30)));
 }
 
+// A chain of `depth` interior nodes built by hand, on which a ray along +z through (0.2, 0.2)
+// pushes an entry at every node but the last: each node's left child, the rest of the chain,
+// starts at z = 1 (the bottom leaf, a small triangle the ray misses), nearer than its right
+// child, a leaf of one large triangle at z = 2 + level. The closest hit is the first one
+// pushed, at the bottom of the stack: the stack must hold depth - 1 entries to find it.
+Bvh stackFillingChain(int depth) {
+  const auto big = [](float z) {
+    return Triangle{vec3(-1, -1, z), 0, vec3(3, -1, z), kNoEmitter, vec3(-1, 3, z), 0};
+  };
+  Bvh bvh;
+  // Triangles in depth-first leaf order: the bottom leaf, then the right leaves upwards.
+  bvh.triangles.push_back(
+      Triangle{vec3(0.5f, 0.5f, 1), 0, vec3(0.6f, 0.5f, 1), kNoEmitter, vec3(0.5f, 0.6f, 1), 0});
+  for (int level = depth - 1; level >= 0; --level) bvh.triangles.push_back(big(2.0f + level));
+  for (uint i = 0; i < bvh.triangles.size(); ++i) bvh.triangles[i].primitive = i;
+  const auto box = [](const Triangle& t, vec3& lo, vec3& hi) {
+    lo = min(t.v0, min(t.v1, t.v2));
+    hi = max(t.v0, max(t.v1, t.v2));
+  };
+  const vec3 chainLo(-1, -1, 1), chainHi(3, 3, 2.0f + float(depth - 1));
+  for (int level = 0; level < depth; ++level) bvh.nodes.push_back(BvhNode{chainLo, 0, chainHi, 0});
+  BvhNode bottom{vec3(0), 0, vec3(0), 1};
+  box(bvh.triangles[0], bottom.boundsMin, bottom.boundsMax);
+  bvh.nodes.push_back(bottom);
+  for (int level = depth - 1; level >= 0; --level) {
+    const uint32_t triangle = uint32_t(depth - level);
+    bvh.nodes[size_t(level)].offset = uint32_t(bvh.nodes.size());
+    BvhNode leaf{vec3(0), triangle, vec3(0), 1};
+    box(bvh.triangles[triangle], leaf.boundsMin, leaf.boundsMax);
+    bvh.nodes.push_back(leaf);
+  }
+  // The last interior node's box is its two leaves'.
+  bvh.nodes[size_t(depth - 1)].boundsMin = min(bvh.nodes[size_t(depth)].boundsMin, chainLo);
+  bvh.maxDepth = depth;
+  return bvh;
+}
+
+TEST(GpuTraversal, TheStackHoldsTheDeepestTraversal) {
+  // The shader's stack is sized from the tree (gpuStackRows); every depth up to the largest
+  // the layout allows, so that each remainder of the rows of four comes up.
+  for (int depth = 1; depth <= int(kBvhStackSize); ++depth) {
+    SCOPED_TRACE("depth " + std::to_string(depth));
+    const Bvh bvh = stackFillingChain(depth);
+    expectValidLayout(bvh, buildGpuBvh(bvh));
+    const Ray ray{vec3(0.2f, 0.2f, 0.0f), vec3(0, 0, 1)};
+    const std::optional<Hit> cpu = closestHit(bvh, ray);
+    ASSERT_TRUE(cpu.has_value());
+    ASSERT_EQ(cpu->t, 2.0f);
+    const std::vector<RayResult> gpu =
+        traceChecked(bvh, {RayQuery{ray.origin, INFINITY, ray.direction, 0u}});
+    EXPECT_EQ(gpu[0].found, 1u);
+    EXPECT_EQ(gpu[0].t, 2.0f);
+    EXPECT_EQ(gpu[0].triangle, cpu->triangle);
+  }
+}
+
 TEST(GpuTraversal, WatertightAtSharedEdgesAndVertices) {
   // The CPU test's 1.26 million rays, on the device.
   const vec3 center(0.3f, -0.2f, 0.1f);

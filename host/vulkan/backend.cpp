@@ -23,7 +23,8 @@ using A = vk::AccessFlagBits;
 using U = vk::BufferUsageFlagBits;
 
 // The effect set as specialization constants, in PT_SPEC_* id order: booleans (VkBool32)
-// for the effects, the chosen value (or kSpecAtRunTime) for the two choices.
+// for the effects, the chosen value (or kSpecAtRunTime) for the two choices, then the
+// traversal stack's rows.
 struct SpecData {
   uint32_t values[PT_SPEC_COUNT];
 };
@@ -32,6 +33,7 @@ struct SpecData {
 // accumulation and the counters are copied back through.
 struct RenderBuffers {
   std::vector<Buffer> bound;
+  uint32_t stackRows = 0;    // the traversal's stack for the uploaded tree (gpuStackRows)
   std::vector<bool> texels;  // by binding: read as texels (a uniform texel buffer)
   Buffer readback;
   vk::DeviceSize accumSize = 0;
@@ -75,6 +77,7 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   // allows 128 MiB), the scene's arrays as well, as before they were read as texels, and
   // those to the texel-buffer limit besides.
   RenderBuffers buffers;
+  buffers.stackRows = gpuStackRows(bvh);
   buffers.accumSize = vk::DeviceSize(cam.width) * cam.height * sizeof(AccumPixel);
   checkRange(ctx, "accumulation", buffers.accumSize);
   for (const Upload& u : uploads) {
@@ -118,10 +121,11 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   const SpecData spec{{all || fx.diffuse, all || fx.mirror, all || fx.lightSampling,
                        all || fx.bsdfEmission, all || fx.mis, all || fx.russianRoulette,
                        all ? kSpecAtRunTime : params.fastIntersection,
-                       all ? kSpecAtRunTime : params.samplerType}};
+                       all ? kSpecAtRunTime : params.samplerType, buffers.stackRows}};
   static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
                 PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
-                PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_COUNT == 8);
+                PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
+                PT_SPEC_COUNT == 9);
   std::vector<vk::SpecializationMapEntry> entries;
   for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));

@@ -6,6 +6,7 @@
 // always gives the same bytes.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "bvh/bvh.h"
@@ -27,6 +28,13 @@ struct GpuBvh {
 // Throws InputError for a tree the layout cannot address (more than 2^27 triangles) or
 // whose split leaves make it deeper than the traversal stack.
 GpuBvh buildGpuBvh(const Bvh& bvh);
+
+// The rows of four stack entries the shader's traversal needs for this tree (its
+// specialization constant PT_SPEC_STACK_ROWS): one entry per interior node above the one
+// visited, so maxDepth entries.
+inline uint gpuStackRows(const GpuBvh& gpu) {
+  return uint(std::max(gpu.maxDepth, 1) + 3) / 4u;
+}
 
 inline bool isGpuBvhLeaf(uint reference) {
   return (reference & kGpuBvhLeaf) != 0u;

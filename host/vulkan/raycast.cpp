@@ -38,7 +38,12 @@ std::vector<RayResult> traceRaysVulkan(const Bvh& bvh, const std::vector<RayQuer
     if (i < 3) std::memcpy(buffers[i].mapped, data[i], sizes[i]);
   }
   for (int i = 0; i < 4; ++i) bound.push_back(Binding{&buffers[i], texels[i]});
-  const ComputeProgram program = makeComputeProgram(ctx, kRaycastSpv, bound, sizeof(uint32_t));
+  // The traversal stack sized for this tree, as in the path tracer.
+  const uint32_t stackRows = gpuStackRows(gpu);
+  const vk::SpecializationMapEntry stackEntry(PT_SPEC_STACK_ROWS, 0, sizeof(uint32_t));
+  const vk::SpecializationInfo spec(1, &stackEntry, sizeof(stackRows), &stackRows);
+  const ComputeProgram program =
+      makeComputeProgram(ctx, kRaycastSpv, bound, sizeof(uint32_t), &spec);
 
   const uint64_t groups = (queries.size() + kRaycastWorkgroupSize - 1) / kRaycastWorkgroupSize;
   PT_CHECK(groups <= ctx.limits.maxComputeWorkGroupCount[0], "too many rays for one dispatch");
