@@ -1,14 +1,69 @@
 #!/usr/bin/env bash
-# On a machine with an NVIDIA GPU (and its Vulkan driver): the CPU/GPU agreement tests on the
-# GPU, then the Cornell box at 1024x1024 on the GPU and on the CPU reference with every core,
-# in one run, so the ratio holds. Expects a build in build/ (pt and pt_tests) made on an
-# x86-64 Debian 12 machine; needs only libvulkan1 at run time.
-#   tools/gpu-check.sh [GPU_SPP] [CPU_SPP]
+# The speed issue's GPU figures and the GPU's agreement with the CPU reference, on a machine
+# with an NVIDIA GPU (and its Vulkan driver), in one run:
+#  - the agreement and device traversal tests (validation off: the layers may be missing);
+#  - the Cornell box and the seed's scene (bunny and dragon, when its meshes are at hand) at
+#    1024x1024, each on the GPU (GPU_SPP) and on the CPU reference with every core (CPU_SPP),
+#    so that the GPU/CPU ratio is taken on one machine in one run;
+#  - `pt diff` of the GPU's image against the CPU's at CPU_SPP: the same samples, so what
+#    differs is floating-point divergence.
+#
+# That machine may have neither this machine's libraries nor the meshes. On the build machine,
+#   tools/gpu-check.sh --bundle
+# copies the shared libraries that build/pt and build/pt_tests load, the Vulkan loader and the
+# dynamic loader into out/gpu-bundle/lib, and the seed scene's meshes, gzipped, into
+# out/gpu-bundle (about 25 MB in all). Send build/ and out/gpu-bundle with the checkout; there,
+#   tools/gpu-check.sh [GPU_SPP] [CPU_SPP]          (SIZE=512: another resolution)
+# runs the binaries through the bundled dynamic loader when out/gpu-bundle exists, so they need
+# nothing from the machine but its Vulkan driver. Results go to $OUT (default: a temporary
+# directory); a table comes last. The whole run takes a minute or two on an H100-class GPU
+# with 16 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+bundle=out/gpu-bundle
+size=${SIZE:-1024}
+
+if [ "${1:-}" = "--bundle" ]; then
+  rm -rf "$bundle"
+  mkdir -p "$bundle/lib"
+  # Every library the binaries load, by the name they ask for, and libvulkan, which the
+  # Vulkan-Hpp dispatcher opens at run time.
+  libs=$(ldd build/pt build/pt_tests | awk '$2 == "=>" && $3 ~ /^\// {print $1 " " $3}' | sort -u)
+  vulkan=$(ldconfig -p | awk '$1 == "libvulkan.so.1" {print $NF; exit}')
+  [ -n "$vulkan" ] || { echo "gpu-check: libvulkan.so.1 not found (Debian: libvulkan1)" >&2; exit 1; }
+  while read -r name path; do cp -L "$path" "$bundle/lib/$name"; done <<<"$libs
+libvulkan.so.1 $vulkan"
+  cp -L /lib64/ld-linux-x86-64.so.2 "$bundle/lib/"
+  if [ -f assets/dragon_vrip.ply ] && [ -f /usr/share/glmark2/models/bunny.obj ]; then
+    gzip -c assets/dragon_vrip.ply >"$bundle/dragon_vrip.ply.gz"
+    gzip -c /usr/share/glmark2/models/bunny.obj >"$bundle/bunny.obj.gz"
+  else
+    echo "gpu-check: the seed scene's meshes are missing (tools/fetch-assets.sh, glmark2-data);" \
+      "the bundle leaves the scene out" >&2
+  fi
+  du -sh "$bundle"
+  exit 0
+fi
+
 gpu_spp=${1:-1024}
 cpu_spp=${2:-16}
 out=${OUT:-$(mktemp -d)}
+mkdir -p "$out"
+
+# The binaries, through the bundled loader when there is a bundle.
+run() {
+  if [ -d "$bundle/lib" ]; then
+    "$bundle/lib/ld-linux-x86-64.so.2" --library-path "$PWD/$bundle/lib" "$@"
+  else
+    "$@"
+  fi
+}
+
+# Some NVIDIA container images keep the driver's ICD file where the Vulkan loader does not look.
+nvidia_icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+if [ -z "${VK_DRIVER_FILES:-}${VK_ICD_FILENAMES:-}" ] && [ -f "$nvidia_icd" ]; then
+  export VK_DRIVER_FILES=$nvidia_icd
+fi
 
 # The tests find configs/ and build/pt by the absolute paths they were built with: when this
 # checkout lives elsewhere (a copy sent to another machine), link that path to it.
@@ -17,20 +72,55 @@ if [ -n "$built" ] && [ ! -e "$built" ]; then
   mkdir -p "$(dirname "$built")" && ln -s "$PWD" "$built"
 fi
 
-build/pt devices
-# Agreement with the CPU reference and the device traversal tests, validation off (the
-# layers may be missing there).
-PT_NO_VALIDATION=1 build/pt_tests --gtest_filter='Vulkan.*:VulkanLoopCap.*:GpuTraversal.*' 2>&1 |
+# The scenes: the Cornell box, and the seed's scene with its meshes from the bundle or from
+# where this machine keeps them.
+scenes=(cornell-box)
+cp configs/cornell-box.json "$out/cornell-box.json"
+if [ -f "$bundle/dragon_vrip.ply.gz" ]; then
+  mkdir -p "$out/meshes"
+  gunzip -c "$bundle/dragon_vrip.ply.gz" >"$out/meshes/dragon_vrip.ply"
+  gunzip -c "$bundle/bunny.obj.gz" >"$out/meshes/bunny.obj"
+  sed -e "s|/usr/share/glmark2/models/bunny.obj|$out/meshes/bunny.obj|" \
+    -e "s|\.\./assets/dragon_vrip.ply|$out/meshes/dragon_vrip.ply|" \
+    configs/bunny-dragon.json >"$out/bunny-dragon.json"
+  scenes+=(bunny-dragon)
+elif [ -f assets/dragon_vrip.ply ] && [ -f /usr/share/glmark2/models/bunny.obj ]; then
+  sed -e "s|\.\./assets/|$PWD/assets/|" configs/bunny-dragon.json >"$out/bunny-dragon.json"
+  scenes+=(bunny-dragon)
+else
+  echo "gpu-check: no meshes for the seed scene; the Cornell box only" >&2
+fi
+
+run build/pt devices
+PT_NO_VALIDATION=1 run build/pt_tests --gtest_filter='Vulkan.*:VulkanLoopCap.*:GpuTraversal.*' 2>&1 |
   tail -20
 
-build/pt render configs/cornell-box.json --width 1024 --height 1024 --spp "$gpu_spp" \
-  --out "$out/gpu-1024.exr" | tee "$out/gpu.txt"
-build/pt render configs/cornell-box.json --backend cpu --width 1024 --height 1024 \
-  --spp "$cpu_spp" --out "$out/cpu-1024.exr" | tee "$out/cpu.txt"
-
 field() { sed -n "s|.* $1=\([^ ]*\).*|\1|p" "$2"; }
-g=$(field 'Mrays/s' "$out/gpu.txt")
-c=$(field 'Mrays/s' "$out/cpu.txt")
-printf '\n%-8s %14s\n' backend 'Grays/s'
-awk -v g="$g" -v c="$c" 'BEGIN {
-  printf "%-8s %14.4f\n%-8s %14.4f\nGPU / CPU: %.1f\n", "gpu", g / 1000, "cpu", c / 1000, g / c }'
+rows=()
+for scene in "${scenes[@]}"; do
+  common=("$out/$scene.json" --width "$size" --height "$size")
+  run build/pt render "${common[@]}" --spp "$gpu_spp" --out "$out/$scene-gpu.exr" |
+    tee "$out/$scene-gpu.txt"
+  run build/pt render "${common[@]}" --spp "$cpu_spp" --out "$out/$scene-gpu-$cpu_spp.exr" \
+    >"$out/$scene-gpu-$cpu_spp.txt"
+  run build/pt render "${common[@]}" --backend cpu --spp "$cpu_spp" \
+    --out "$out/$scene-cpu-$cpu_spp.exr" | tee "$out/$scene-cpu.txt"
+  diff=$(run build/pt diff "$out/$scene-gpu-$cpu_spp.exr" "$out/$scene-cpu-$cpu_spp.exr" 2>&1 |
+    tr '\n' ' ' || true)
+  echo "$scene diff: $diff" | tee "$out/$scene-diff.txt"
+  relmse=$(sed -n 's/.* relmse=\([^ ]*\).*/\1/p' "$out/$scene-diff.txt")
+  device=$(sed -n 's/.* device="\([^"]*\)".*/\1/p' "$out/$scene-gpu.txt" | tr ' ' '_')
+  rows+=("$scene $(field 'Mrays/s' "$out/$scene-gpu.txt") $(field 'Mrays/s' "$out/$scene-cpu.txt") \
+${device:-?} ${relmse:-?}")
+done
+
+printf '\n%-14s %12s %12s %9s %12s  %s\n' scene 'GPU Grays/s' 'CPU Grays/s' 'GPU/CPU' \
+  'relMSE' device
+for row in "${rows[@]}"; do
+  awk -v r="$row" 'BEGIN {
+    split(r, f, " ")
+    printf "%-14s %12.3f %12.4f %9.1f %12s  %s\n", f[1], f[2] / 1000, f[3] / 1000, f[2] / f[3], f[5], f[4]
+  }'
+done
+echo "GPU at $gpu_spp spp, CPU reference at $cpu_spp spp on every core, ${size}x$size; relMSE:" \
+  "GPU against CPU at $cpu_spp spp. Files in $out"
