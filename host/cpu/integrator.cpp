@@ -43,11 +43,11 @@ vec3 sampleDirectLight(const SceneData& scene, vec3 p, vec3 n, float magnitude, 
   const uint slot = aliasTableSlot(uChoose.x, scene.params.emitterCount);
   const Emitter& emitter = scene.emitters[aliasTablePick(slot, scene.emitters[slot], uChoose.y)];
   const Triangle& light = scene.bvh.triangles[emitter.triangle];
+  const TriangleShading& lightShading = scene.cpuCopies().shading[emitter.triangle];
   const vec2 b = sampleTriangleBarycentrics(uLight);
   const vec3 lightPoint = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
-  const vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
-  const float lightArea = 0.5f * length(lightCross);
-  const vec3 lightNormal = normalize(lightCross);
+  const float lightArea = lightShading.area;
+  const vec3 lightNormal = lightShading.normal;
 
   const vec3 toLight = lightPoint - p;
   const float dist2 = dot(toLight, toLight);
@@ -58,8 +58,7 @@ vec3 sampleDirectLight(const SceneData& scene, vec3 p, vec3 n, float magnitude, 
 
   // Shadow ray between the two offset points; t in [0, 1) spans the segment.
   const vec3 from = offsetRayOrigin(p, n, magnitude);
-  const vec3 to =
-      offsetRayOrigin(lightPoint, lightNormal, triangleMagnitude(light.v0, light.v1, light.v2));
+  const vec3 to = offsetRayOrigin(lightPoint, lightNormal, lightShading.magnitude);
   ++rays;
   if (anyHit(scene.wideBvh(), Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
 
@@ -111,12 +110,13 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     // Hit point from barycentrics (more accurate than origin + t * direction).
     const vec3 p =
         hit->barycentrics.x * tri.v0 + hit->barycentrics.y * tri.v1 + hit->barycentrics.z * tri.v2;
-    const vec3 edgeCross = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
-    const vec3 ng = normalize(edgeCross);
+    // The geometric normal, the area and the coordinates' scale (for the ray offsets), as
+    // computed once per triangle (TriangleShading; the shader computes them here).
+    const TriangleShading& shading = scene.cpuCopies().shading[hit->triangle];
+    const vec3 ng = shading.normal;
     const vec3 wo = -ray.direction;
     const float cosOut = dot(ng, wo);
-    // Coordinates' scale at this vertex, for the ray offsets.
-    const float magnitude = triangleMagnitude(tri.v0, tri.v1, tri.v2);
+    const float magnitude = shading.magnitude;
     if (debugPrint) {
       std::fprintf(stderr,
                    "cpu depth %u: hit triangle %u (primitive %u) t=%g p=(%g, %g, %g) "
@@ -134,9 +134,8 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
         // Weigh against the chance that light sampling had produced this point.
         float weight = 1.0f;
         if (misOn) {
-          const float area = 0.5f * length(edgeCross);
           const float lightPdf = scene.emitters[tri.emitter].pmf * hit->t * hit->t /
-                                 (cosOut * area);  // |direction| = 1, so t is the distance
+                                 (cosOut * shading.area);  // |direction| = 1: t is the distance
           weight = powerHeuristic(bsdfPdf, lightPdf);
         }
         L += beta * weight * Le;
@@ -195,7 +194,7 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
   const auto callStart = std::chrono::steady_clock::now();
-  scene.wideBvh();  // built here on a first render: set-up, not render time
+  scene.cpuCopies();  // built here on a first render: set-up, not render time
   const auto start = std::chrono::steady_clock::now();
   CpuRenderStats stats;
   stats.threads = options.threads > 0 ? options.threads : availableCpus();

@@ -2,7 +2,9 @@
 // the image, multithreaded over tiles.
 // It reads the same flat arrays and draws the same random numbers as the shader, so a
 // difference image between the two backends points at a bug. (The BVH it traverses in a
-// four-wide copy, SceneData::wideBvh, whose answers are the binary tree's bit for bit.)
+// eight-wide copy, SceneData::wideBvh, whose answers are the binary tree's bit for bit, and
+// takes each triangle's normal, area and offset scale from SceneData::cpuCopies, computed once
+// as it would compute them.)
 #pragma once
 
 #include <cstdint>

@@ -7,9 +7,21 @@
 
 namespace pt {
 
-void LazyWideBvh::build(const Bvh& bvh) const {
+std::vector<TriangleShading> computeTriangleShading(const std::vector<Triangle>& triangles) {
+  std::vector<TriangleShading> shading;
+  shading.reserve(triangles.size());
+  for (const Triangle& t : triangles) {
+    const vec3 edgeCross = cross(t.v1 - t.v0, t.v2 - t.v0);
+    shading.push_back(TriangleShading{normalize(edgeCross), triangleMagnitude(t.v0, t.v1, t.v2),
+                                      0.5f * length(edgeCross)});
+  }
+  return shading;
+}
+
+void LazyCpuSceneCopies::build(const Bvh& bvh) const {
   std::call_once(state_->once, [&] {
-    state_->wide = buildWideBvh(bvh);
+    state_->copies.wide = buildWideBvh(bvh);
+    state_->copies.shading = computeTriangleShading(bvh.triangles);
     state_->built.store(true, std::memory_order_release);
   });
 }

@@ -1,7 +1,8 @@
 // Scene -> the flat arrays both backends read: the BVH (nodes, triangles in leaf order),
 // materials, the emitter alias table and the per-render parameters, plus the set of
 // effects the scene calls for. The Vulkan backend uploads exactly these arrays; the CPU
-// reference reads them in place, but for the BVH, which it traverses in a four-wide copy.
+// reference reads them in place, but for the BVH, which it traverses in an eight-wide copy,
+// and the triangles' normals, areas and offset scales, which it computes once (CpuSceneCopies).
 #pragma once
 
 #include <atomic>
@@ -52,31 +53,51 @@ struct EffectSet {
   std::string toString() const;  // e.g. "diffuse+mirror+nee+mis+rr" (+"fast-isect", "sobol")
 };
 
-// The CPU reference's wide copy of a BVH (wide_bvh.h), built on first use, once, by whichever
-// thread asks first: the Vulkan backend never asks, and does not pay for it. A copy of the
-// holder starts empty and builds its own, so it never describes another BVH than its owner's.
-class LazyWideBvh {
+// What the CPU reference computes at every path vertex on a triangle, and at every light
+// sample on an emitting one, computed once per triangle with the same operations in the same
+// order (ptcore is compiled without fused multiply-adds), so that the values are, bit for bit,
+// the ones the integrator computed in place before. The shader computes them in place.
+struct TriangleShading {
+  vec3 normal;      // normalize(cross(v1 - v0, v2 - v0)): the unit geometric normal
+  float magnitude;  // triangleMagnitude(v0, v1, v2): the scale of the ray offsets there
+  float area;       // 0.5 * length(cross(v1 - v0, v2 - v0))
+};                  // 20 bytes
+
+// One TriangleShading per triangle, in the order of `triangles` (Bvh::triangles).
+std::vector<TriangleShading> computeTriangleShading(const std::vector<Triangle>& triangles);
+
+// What only the CPU reference reads: the wide copy of the BVH (wide_bvh.h) and the
+// triangles' shading constants.
+struct CpuSceneCopies {
+  WideBvh wide;
+  std::vector<TriangleShading> shading;  // in Bvh::triangles order
+};
+
+// CpuSceneCopies, built on first use, once, by whichever thread asks first: the Vulkan
+// backend never asks, and does not pay for them. A copy of the holder starts empty and builds
+// its own, so it never describes another BVH than its owner's.
+class LazyCpuSceneCopies {
  public:
-  LazyWideBvh() : state_(std::make_unique<State>()) {}
-  LazyWideBvh(const LazyWideBvh&) : LazyWideBvh() {}
-  LazyWideBvh(LazyWideBvh&&) noexcept = default;
-  LazyWideBvh& operator=(const LazyWideBvh&) {
+  LazyCpuSceneCopies() : state_(std::make_unique<State>()) {}
+  LazyCpuSceneCopies(const LazyCpuSceneCopies&) : LazyCpuSceneCopies() {}
+  LazyCpuSceneCopies(LazyCpuSceneCopies&&) noexcept = default;
+  LazyCpuSceneCopies& operator=(const LazyCpuSceneCopies&) {
     state_ = std::make_unique<State>();
     return *this;
   }
-  LazyWideBvh& operator=(LazyWideBvh&&) noexcept = default;
+  LazyCpuSceneCopies& operator=(LazyCpuSceneCopies&&) noexcept = default;
 
   // Once per ray in the CPU reference: inline, one load and a branch once it is built.
-  const WideBvh& get(const Bvh& bvh) const {
+  const CpuSceneCopies& get(const Bvh& bvh) const {
     if (!state_->built.load(std::memory_order_acquire)) build(bvh);
-    return state_->wide;
+    return state_->copies;
   }
 
  private:
   struct State {
     std::once_flag once;
     std::atomic<bool> built{false};
-    WideBvh wide;
+    CpuSceneCopies copies;
   };
   void build(const Bvh& bvh) const;
   std::unique_ptr<State> state_;
@@ -89,12 +110,14 @@ struct SceneData {
   RenderParams params{};
   int spp = 0;
   EffectSet effects;
-  vec3 shift{0.0f};  // subtracted from every coordinate of a scene far from the origin
-  LazyWideBvh wide;  // of bvh; through wideBvh()
+  vec3 shift{0.0f};        // subtracted from every coordinate of a scene far from the origin
+  LazyCpuSceneCopies cpu;  // of bvh; through cpuCopies() and wideBvh()
 
-  // The BVH the CPU reference traverses: bvh collapsed to four-wide nodes, with the same
-  // answers to every query (wide_bvh.h). Built on the first call.
-  const WideBvh& wideBvh() const { return wide.get(bvh); }
+  // What only the CPU reference reads, built from bvh on the first call.
+  const CpuSceneCopies& cpuCopies() const { return cpu.get(bvh); }
+  // The BVH the CPU reference traverses: bvh collapsed to eight-wide nodes, with the same
+  // answers to every query (wide_bvh.h).
+  const WideBvh& wideBvh() const { return cpuCopies().wide; }
 };
 
 // Takes the scene by value: pass it with std::move when it is not needed afterwards, so that
