@@ -29,7 +29,7 @@ int runConvergeCommand(const ConvergeArgs& args) {
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
   // The same overrides as `pt render`.
-  const RenderSettings settings = args.overrides.toSettings();
+  const RenderSettings settings = args.overrides.toSettings(args.backend);
   const SceneData data = prepareScene(std::move(scene), settings);
   const Camera& cam = data.params.camera;
 

@@ -137,7 +137,7 @@ int runRender(const RenderArgs& args) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
-  RenderSettings settings = args.overrides.toSettings();
+  RenderSettings settings = args.overrides.toSettings(args.backend);
   settings.spp = args.spp;  // unset: the scene's
   // A film too large for memory is refused before the BVH build and the device start-up, with
   // the file (or the options) it came from.
@@ -400,9 +400,11 @@ void addOverrideOptions(CLI::App* cmd, SceneOverrides& o) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--max-depth", o.maxDepth, "Maximum scattering events per path")
       ->check(CLI::Range(0, 100000));
-  cmd->add_option("--leaf-size", o.leafSize, "Maximum triangles per BVH leaf")
-      ->check(CLI::Range(1, 64))
-      ->capture_default_str();
+  cmd->add_option(
+         "--leaf-size", o.leafSize,
+         "Maximum triangles per BVH leaf (default: " + std::to_string(kDefaultLeafSizeCpu) +
+             " on the CPU, " + std::to_string(kDefaultLeafSizeVulkan) + " with Vulkan)")
+      ->check(CLI::Range(1, 64));
   cmd->add_option("--strategy", o.strategy,
                   "Direct light: " + describeNames(kStrategyNames) + "; default: the scene's")
       ->check(CLI::IsMember(namesOf(kStrategyNames)));

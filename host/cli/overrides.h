@@ -14,20 +14,22 @@ namespace pt {
 struct SceneOverrides {
   std::optional<int> width, height, maxDepth;  // unset: the scene's
   std::optional<uint32_t> seed;
-  int leafSize = 4;
+  std::optional<int> leafSize;  // unset: the backend's default (kDefaultLeafSize*)
   // Names from the tables; empty: the scene's (strategy, roulette, sampler) or the default.
   std::string strategy, roulette, sampler;
   std::string builder{nameOf(kBuilderNames, kDefaultBuilder)};
   std::string intersection{nameOf(kIntersectionNames, false)};
 
   // The names were validated against the same tables when the command line was parsed.
-  RenderSettings toSettings() const {
+  // `backend`: "cpu" or "vulkan", for the defaults that differ between them.
+  RenderSettings toSettings(const std::string& backend) const {
     RenderSettings s;
     s.width = width;
     s.height = height;
     s.seed = seed;
     s.maxDepth = maxDepth;
-    s.maxLeafSize = leafSize;
+    s.maxLeafSize =
+        leafSize.value_or(backend == "cpu" ? kDefaultLeafSizeCpu : kDefaultLeafSizeVulkan);
     s.strategy = valueNamed(kStrategyNames, strategy);
     s.russianRoulette = valueNamed(kRouletteNames, roulette);
     s.sampler = valueNamed(kSamplerNames, sampler);
