@@ -226,8 +226,6 @@ Bvh stackFillingChain(int depth) {
     box(bvh.triangles[triangle], leaf.boundsMin, leaf.boundsMax);
     bvh.nodes.push_back(leaf);
   }
-  // The last interior node's box is its two leaves'.
-  bvh.nodes[size_t(depth - 1)].boundsMin = min(bvh.nodes[size_t(depth)].boundsMin, chainLo);
   bvh.maxDepth = depth;
   return bvh;
 }

@@ -8,10 +8,9 @@
 #include <random>
 #include <set>
 
-#include <hwy/targets.h>
-
 #include "common/shared.h"
 #include "cpu/bounce_random.h"
+#include "test_util.h"
 
 namespace pt {
 namespace {
@@ -89,13 +88,9 @@ TEST(BounceRandomSimd, EqualsTheScalarDefinitionOnEveryTarget) {
   // The CPU reference's vector version of one scattering event's numbers gives the bits of
   // the definition that the shader uses, on every instruction set it may run on here, for
   // both samplers: small and extreme pixels, samples, dimensions and seeds, then random ones.
-  const std::vector<int64_t> targets = bounceRandomTargets();
-  ASSERT_FALSE(targets.empty());
   const uint edge[] = {0u, 1u, 2u, 255u, 65535u, 0x7FFFFFFFu, 0xFFFFFFFCu, 0xFFFFFFFFu};
-  std::mt19937 rng(11);
-  for (int64_t target : targets) {
-    SCOPED_TRACE(hwy::TargetName(target));
-    hwy::SetSupportedTargetsForTest(target);
+  test::forEachHighwayTarget(bounceRandomTargets(), [&] {
+    std::mt19937 rng(11);
     for (int i = 0; i < 40000; ++i) {
       const bool sobol = i % 2 == 0;
       const uvec2 pixel =
@@ -115,8 +110,7 @@ TEST(BounceRandomSimd, EqualsTheScalarDefinitionOnEveryTarget) {
             << ") sample " << sampleIndex << " dim " << dim << " seed " << seed;
       }
     }
-  }
-  hwy::SetSupportedTargetsForTest(0);
+  });
 }
 
 TEST(SobolSampler, EveryAlignedPowerOfTwoBlockIsANet) {

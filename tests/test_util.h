@@ -17,11 +17,30 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <hwy/targets.h>
+
 #include "common/shared.h"
 #include "cpu/integrator.h"
 #include "scene/scene.h"
 
 namespace pt::test {
+
+// Runs body() once per instruction set in `targets` (a Highway-dispatched function's compiled
+// and runnable targets, e.g. wideTraversalTargets()), making the dispatch choose it, and
+// restores the normal choice afterwards, also when body() fails a fatal assertion.
+template <typename Body>
+void forEachHighwayTarget(const std::vector<int64_t>& targets, const Body& body) {
+  ASSERT_FALSE(targets.empty());
+  struct Restore {
+    ~Restore() { hwy::SetSupportedTargetsForTest(0); }
+  } restore;
+  for (int64_t target : targets) {
+    SCOPED_TRACE(hwy::TargetName(target));
+    hwy::SetSupportedTargetsForTest(target);
+    body();
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+}
 
 // The scene files in configs/.
 inline const std::filesystem::path kConfigs = std::filesystem::path(PT_SOURCE_DIR) / "configs";

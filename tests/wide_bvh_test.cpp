@@ -2,7 +2,6 @@
 // brute force and against the binary traversal, which they must reproduce bit for bit
 // (distance, triangle, barycentrics) on every instruction set the traversal is compiled for.
 #include <gtest/gtest.h>
-#include <hwy/targets.h>
 
 #include <algorithm>
 #include <bit>
@@ -49,17 +48,10 @@ bool sameHit(const std::optional<Hit>& a, const std::optional<Hit>& b) {
 }
 
 // Runs body() once per instruction set the wide traversal runs on here, the portable
-// fallback included, then restores the normal choice.
+// fallback included.
 template <typename Body>
 void forEachTarget(const Body& body) {
-  const std::vector<int64_t> targets = wideTraversalTargets();
-  ASSERT_FALSE(targets.empty());
-  for (int64_t target : targets) {
-    SCOPED_TRACE(hwy::TargetName(target));
-    hwy::SetSupportedTargetsForTest(target);
-    body();
-  }
-  hwy::SetSupportedTargetsForTest(0);
+  test::forEachHighwayTarget(wideTraversalTargets(), body);
 }
 
 // Counts the rays (and reports the first few) whose wide answers differ from the binary

@@ -36,14 +36,14 @@ int availableCpus() {
 // point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
 // contribution to L, beta * f * Le * cos / pdf, weighted by the power heuristic against BSDF
 // sampling when misOn; zero when the point faces away or is occluded.
-vec3 sampleDirectLight(const SceneData& scene, vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f,
-                       vec2 uChoose, vec2 uLight, bool misOn, Intersection test, uint64_t& rays,
-                       bool debugPrint, uint depth) {
+vec3 sampleDirectLight(const SceneData& scene, const CpuSceneCopies& copies, vec3 p, vec3 n,
+                       float magnitude, vec3 beta, vec3 f, vec2 uChoose, vec2 uLight, bool misOn,
+                       Intersection test, uint64_t& rays, bool debugPrint, uint depth) {
   // Pick an emitter from the alias table, then a uniform point on its triangle.
   const uint slot = aliasTableSlot(uChoose.x, scene.params.emitterCount);
   const Emitter& emitter = scene.emitters[aliasTablePick(slot, scene.emitters[slot], uChoose.y)];
   const Triangle& light = scene.bvh.triangles[emitter.triangle];
-  const TriangleShading& lightShading = scene.cpuCopies().shading[emitter.triangle];
+  const TriangleShading& lightShading = copies.shading[emitter.triangle];
   const vec2 b = sampleTriangleBarycentrics(uLight);
   const vec3 lightPoint = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
   const float lightArea = lightShading.area;
@@ -60,7 +60,7 @@ vec3 sampleDirectLight(const SceneData& scene, vec3 p, vec3 n, float magnitude, 
   const vec3 from = offsetRayOrigin(p, n, magnitude);
   const vec3 to = offsetRayOrigin(lightPoint, lightNormal, lightShading.magnitude);
   ++rays;
-  if (anyHit(scene.wideBvh(), Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
+  if (anyHit(copies.wide, Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
 
   const float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
   const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
@@ -83,6 +83,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
                     bool debugPrint) {
   const RenderParams& params = scene.params;
   const Bvh& bvh = scene.bvh;
+  const CpuSceneCopies& copies = scene.cpuCopies();  // the wide BVH, TriangleShading
   const uint seed = params.seed;
   const bool sobol = params.samplerType == kSamplerSobol;  // else independent random numbers
   const bool misOn = params.strategy == kStrategyMis;
@@ -103,7 +104,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
   for (uint depth = 0;;) {
     // Find the closest surface along the ray; the background is black.
     ++rays;
-    const std::optional<Hit> hit = closestHit(scene.wideBvh(), ray, INFINITY, test);
+    const std::optional<Hit> hit = closestHit(copies.wide, ray, INFINITY, test);
     if (!hit) break;
     const Triangle& tri = bvh.triangles[hit->triangle];
     const Material& material = scene.materials[tri.material];
@@ -112,7 +113,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
         hit->barycentrics.x * tri.v0 + hit->barycentrics.y * tri.v1 + hit->barycentrics.z * tri.v2;
     // The geometric normal, the area and the coordinates' scale (for the ray offsets), as
     // computed once per triangle (TriangleShading; the shader computes them here).
-    const TriangleShading& shading = scene.cpuCopies().shading[hit->triangle];
+    const TriangleShading& shading = copies.shading[hit->triangle];
     const vec3 ng = shading.normal;
     const vec3 wo = -ray.direction;
     const float cosOut = dot(ng, wo);
@@ -162,8 +163,8 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
       const vec3 f = material.reflectance * kInvPi;
       // Sample direct illumination from an emitter (next-event estimation).
       if (neeOn && material.reflectance != vec3(0.0f)) {
-        L += sampleDirectLight(scene, p, n, magnitude, beta, f, u.lightChoose, u.lightPoint, misOn,
-                               test, rays, debugPrint, depth);
+        L += sampleDirectLight(scene, copies, p, n, magnitude, beta, f, u.lightChoose, u.lightPoint,
+                               misOn, test, rays, debugPrint, depth);
       }
       // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
       wi = localToWorld(sampleCosineHemisphere(u.bsdf), n);
