@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets up, builds and renders the canonical Cornell box to out/cornell-box.{png,exr}.
 # Uses the Vulkan backend when a GPU is present; on a machine without one, the CPU reference
-# is several times faster than lavapipe (software Vulkan), so it uses that. Extra arguments
+# is about twice as fast as lavapipe (software Vulkan), so it uses that. Extra arguments
 # go to `pt render` (e.g. --spp 4096, or --backend vulkan to force lavapipe).
 set -euo pipefail
 cd "$(dirname "$0")/.."
