@@ -24,6 +24,7 @@ struct RayPrecomputed {
   int kx, ky, kz;     // kz: axis of the largest |direction|; (kx, ky) keep the winding
   float sx, sy, sz;   // shear constants
   explicit RayPrecomputed(const Ray& ray);
+  RayPrecomputed() = default;  // for callers that set several up at once (integrator_lanes)
 };
 
 struct Hit {

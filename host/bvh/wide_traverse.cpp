@@ -379,12 +379,9 @@ HWY_NOINLINE bool intersectLeafFast(const WideBvh& bvh, uint32_t firstPacket, ui
 // and the first is taken off at once; a lone child is visited without the stack. A child
 // taken off the stack is skipped when its entry distance lies beyond the range, which has
 // shrunk since its box was tested: a box test now would miss it.
+// For a ray that enters the root's box (the caller has tested it).
 template <bool kAnyHit, bool kWatertight>
-bool traverse(const WideBvh& bvh, const Ray& ray, float tMax, Hit& best) {
-  // The root's box first, as traverse.cpp tests it (the rays that miss it miss every box).
-  const RayPrecomputed r(ray);
-  float rootEnter = 0.0f;
-  if (!intersectBox(r, bvh.rootMin, bvh.rootMax, tMax, rootEnter)) return false;
+bool traverseFromRoot(const WideBvh& bvh, const RayPrecomputed& r, float tMax, Hit& best) {
   const RayLanes lanes(r);
   struct Entry {
     uint32_t child, packetCount;
@@ -395,7 +392,7 @@ bool traverse(const WideBvh& bvh, const Ray& ray, float tMax, Hit& best) {
   bool found = false;
   float closest = tMax;
   float cull = closest * kFarScale;  // entry distances beyond it: a box test would miss
-  Entry next{0u, 0u, rootEnter};     // the root node
+  Entry next{0u, 0u, 0.0f};          // the root node (never on the stack: its entry unused)
   for (;;) {
     if (!(next.child & kWideLeaf)) {
       const WideNode& node = bvh.nodes[next.child];
@@ -439,6 +436,25 @@ bool traverse(const WideBvh& bvh, const Ray& ray, float tMax, Hit& best) {
   }
 }
 
+template <bool kAnyHit, bool kWatertight>
+bool traverse(const WideBvh& bvh, const Ray& ray, float tMax, Hit& best) {
+  // The root's box first, as traverse.cpp tests it (the rays that miss it miss every box).
+  const RayPrecomputed r(ray);
+  float rootEnter = 0.0f;
+  if (!intersectBox(r, bvh.rootMin, bvh.rootMax, tMax, rootEnter)) return false;
+  return traverseFromRoot<kAnyHit, kWatertight>(bvh, r, tMax, best);
+}
+
+bool preparedQuery(const WideBvh& bvh, const RayPrecomputed& ray, float tMax, bool anyHit,
+                   bool watertight, Hit& hit) {
+  if (anyHit) {
+    return watertight ? traverseFromRoot<true, true>(bvh, ray, tMax, hit)
+                      : traverseFromRoot<true, false>(bvh, ray, tMax, hit);
+  }
+  return watertight ? traverseFromRoot<false, true>(bvh, ray, tMax, hit)
+                    : traverseFromRoot<false, false>(bvh, ray, tMax, hit);
+}
+
 bool closestHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, Hit& hit) {
   return traverse</*kAnyHit=*/false, true>(bvh, ray, tMax, hit);
 }
@@ -458,7 +474,6 @@ HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace pt {
-namespace {
 
 // The traversal above relies on every distance it computes being a number: the near plane
 // standing for min(t0, t1), the minima over lanes for the entry distances of the binary
@@ -469,7 +484,7 @@ namespace {
 // wide node's lanes (all eight: the node's own binary node N; four: N's children; two:
 // theirs; one: a lane), and its box the union of its lanes' boxes, which is the binary
 // node's box exactly (every parent's box is the union of its children's).
-inline bool degenerate(const Ray& ray) {
+bool degenerateRay(const Ray& ray) {
   const vec3 o = ray.origin, d = ray.direction;
   // x - x is 0 for a number, NaN for an infinity or a NaN.
   const bool finite =
@@ -477,6 +492,8 @@ inline bool degenerate(const Ray& ray) {
   return !finite || (std::fabs(d.x) < kMinDirection && std::fabs(d.y) < kMinDirection &&
                      std::fabs(d.z) < kMinDirection);
 }
+
+namespace {
 
 struct BinaryNode {
   uint32_t node;  // the wide node
@@ -565,10 +582,11 @@ HWY_EXPORT(closestHitWatertight);
 HWY_EXPORT(closestHitFast);
 HWY_EXPORT(anyHitWatertight);
 HWY_EXPORT(anyHitFast);
+HWY_EXPORT(preparedQuery);
 
 std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test) {
   Hit hit;
-  const bool found = degenerate(ray)
+  const bool found = degenerateRay(ray)
                          ? traverseAsBinary</*kAnyHit=*/false>(bvh, ray, tMax, test, hit)
                      : test == Intersection::kWatertight
                          ? HWY_DYNAMIC_DISPATCH(closestHitWatertight)(bvh, ray, tMax, hit)
@@ -579,10 +597,22 @@ std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax, In
 
 bool anyHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test) {
   Hit hit;
-  if (degenerate(ray)) return traverseAsBinary</*kAnyHit=*/true>(bvh, ray, tMax, test, hit);
+  if (degenerateRay(ray)) return traverseAsBinary</*kAnyHit=*/true>(bvh, ray, tMax, test, hit);
   return test == Intersection::kWatertight
              ? HWY_DYNAMIC_DISPATCH(anyHitWatertight)(bvh, ray, tMax, hit)
              : HWY_DYNAMIC_DISPATCH(anyHitFast)(bvh, ray, tMax, hit);
+}
+
+bool closestHitPrepared(const WideBvh& bvh, const RayPrecomputed& ray, float tMax,
+                        Intersection test, Hit& hit) {
+  return HWY_DYNAMIC_DISPATCH(preparedQuery)(bvh, ray, tMax, /*anyHit=*/false,
+                                             test == Intersection::kWatertight, hit);
+}
+
+bool anyHitPrepared(const WideBvh& bvh, const RayPrecomputed& ray, float tMax, Intersection test) {
+  Hit hit;
+  return HWY_DYNAMIC_DISPATCH(preparedQuery)(bvh, ray, tMax, /*anyHit=*/true,
+                                             test == Intersection::kWatertight, hit);
 }
 
 std::vector<int64_t> wideTraversalTargets() {

@@ -18,6 +18,7 @@
 #include "bvh/traverse.h"
 #include "common/check.h"
 #include "cpu/bounce_random.h"
+#include "cpu/integrator_lanes.h"
 
 namespace pt {
 namespace {
@@ -245,8 +246,16 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
         dropped = true;
         break;
       }
+      // The tile's paths, several at a time (sampleRadianceLanes: sampleRadiance's
+      // results, bit for bit).
+      uvec2 tilePixels[kTile * kTile];
+      vec3 samples[kTile * kTile];
+      size_t count = 0;
+      forTilePixels(tile, [&](int x, int y, vec3&) { tilePixels[count++] = uvec2(x, y); });
+      sampleRadianceLanes(scene, tilePixels, count, sampleIndex, samples, rays);
+      count = 0;
       forTilePixels(tile, [&](int x, int y, vec3& sample) {
-        sample = sampleRadiance(scene, uvec2(x, y), sampleIndex, rays);
+        sample = samples[count++];
         film.add(x, y, sample);
       });
       traced[size_t(tile)] = 1;

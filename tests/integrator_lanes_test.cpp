@@ -1,0 +1,98 @@
+// sampleRadianceLanes, the CPU reference's paths several at a time, against sampleRadiance,
+// which it transcribes: the same radiance bit for bit and the same ray count, on every
+// instruction set Highway builds here, in settings that take each of its branches.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "cpu/integrator.h"
+#include "cpu/integrator_lanes.h"
+#include "render/prepare.h"
+#include "scene/scene.h"
+#include "test_util.h"
+
+namespace pt {
+namespace {
+
+using test::kConfigs;
+
+struct Case {
+  std::string config;
+  RenderSettings settings;
+};
+
+std::vector<Case> cases() {
+  const RenderSettings small{.width = 20, .height = 14};
+  std::vector<Case> list;
+  for (const char* config : {"cornell-box.json", "cornell-mirror.json", "bunny-box.json"}) {
+    list.push_back({config, small});
+  }
+  auto variant = [&](auto&& change) {
+    RenderSettings s = small;
+    change(s);
+    list.push_back({"cornell-mirror.json", s});
+  };
+  variant([](RenderSettings& s) { s.strategy = kStrategyNee; });
+  variant([](RenderSettings& s) { s.strategy = kStrategyBsdf; });
+  variant([](RenderSettings& s) { s.sampler = kSamplerIndependent; });
+  variant([](RenderSettings& s) { s.russianRoulette = false; });
+  variant([](RenderSettings& s) { s.maxDepth = 0; });
+  variant([](RenderSettings& s) { s.maxDepth = 2; });
+  variant([](RenderSettings& s) { s.fastIntersection = true; });
+  variant([](RenderSettings& s) { s.seed = 12345u; });
+  return list;
+}
+
+uint32_t bitsOf(float x) {
+  uint32_t b;
+  std::memcpy(&b, &x, sizeof(b));
+  return b;
+}
+
+TEST(CpuLanes, EqualsTheReferenceBitForBit) {
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.config);
+    const SceneData data = prepareScene(loadScene(kConfigs / c.config), c.settings);
+    const Camera& cam = data.params.camera;
+    std::vector<uvec2> pixels;
+    for (uint y = 0; y < cam.height; ++y) {
+      for (uint x = 0; x < cam.width; ++x) pixels.push_back(uvec2(x, y));
+    }
+    for (uint32_t sample : {0u, 1u, 7u}) {
+      std::vector<vec3> expected(pixels.size());
+      uint64_t expectedRays = 0;
+      for (size_t i = 0; i < pixels.size(); ++i) {
+        expected[i] = sampleRadiance(data, pixels[i], sample, expectedRays);
+      }
+      test::forEachHighwayTarget(radianceLanesTargets(), [&] {
+        // All pixels in one call, and a call for one pixel and for none.
+        std::vector<vec3> out(pixels.size(), vec3(-1.0f));
+        uint64_t rays = 0;
+        sampleRadianceLanes(data, pixels.data(), pixels.size(), sample, out.data(), rays);
+        EXPECT_EQ(rays, expectedRays) << "sample " << sample;
+        int differing = 0;
+        for (size_t i = 0; i < pixels.size(); ++i) {
+          for (int k = 0; k < 3; ++k) {
+            if (bitsOf(out[i][k]) != bitsOf(expected[i][k]) && ++differing <= 3) {
+              ADD_FAILURE() << "sample " << sample << " pixel (" << pixels[i].x << ", "
+                            << pixels[i].y << ") channel " << k << ": " << out[i][k]
+                            << " against the reference's " << expected[i][k];
+            }
+          }
+        }
+        EXPECT_EQ(differing, 0) << "sample " << sample;
+        vec3 one(-1.0f);
+        uint64_t oneRays = 0;
+        sampleRadianceLanes(data, &pixels[5], 1, sample, &one, oneRays);
+        EXPECT_EQ(bitsOf(one.x), bitsOf(expected[5].x));
+        sampleRadianceLanes(data, pixels.data(), 0, sample, &one, oneRays);
+        EXPECT_EQ(bitsOf(one.x), bitsOf(expected[5].x));  // untouched
+      });
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pt
