@@ -28,9 +28,9 @@
 #include <hwy/highway.h>
 
 #include "bvh/wide_bvh.h"
-#include "cpu/bounce_random.h"
 #include "cpu/integrator.h"
 #include "cpu/integrator_lanes.h"
+#include "cpu/random_lanes-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace pt {
@@ -202,6 +202,18 @@ HWY_INLINE V3 sampleCosineHemisphere(V ux, V uy) {
             hn::Sqrt(glmMax(hn::Zero(D()), hn::Sub(splat(1.0f), ux)))};
 }
 
+// cameraDirection: normalize(v) is v * (1 / sqrt(dot(v, v))) in glm.
+HWY_INLINE V3 cameraDirection(const Camera& cam, V filmX, V filmY) {
+  const V u = hn::Sub(hn::Div(hn::Mul(splat(2.0f), filmX), splat(float(cam.width))), splat(1.0f));
+  const V v = hn::Sub(splat(1.0f), hn::Div(hn::Mul(splat(2.0f), filmY), splat(float(cam.height))));
+  auto broadcast = [](vec3 a) { return V3{splat(a.x), splat(a.y), splat(a.z)}; };
+  const V3 w =
+      (broadcast(cam.forward) +
+       hn::Mul(hn::Mul(u, splat(cam.tanHalfFovY)), splat(cam.aspect)) * broadcast(cam.right)) +
+      hn::Mul(v, splat(cam.tanHalfFovY)) * broadcast(cam.up);
+  return hn::Div(splat(1.0f), hn::Sqrt(dot(w, w))) * w;
+}
+
 HWY_INLINE V3 offsetRayOrigin(V3 p, V3 n, V magnitude) {
   return p + hn::Mul(magnitude, splat(kOffsetScale)) * n;
 }
@@ -221,16 +233,22 @@ HWY_INLINE uint32_t setUpRays(const WideBvh& bvh, const Lanes3& originLanes,
                               RayPrecomputed* prepared, uint32_t& degenerate) {
   const D d;
   const V zero = hn::Zero(d);
-  degenerate = 0;
-  forEachLane(lanes, [&](size_t i) {
-    if (degenerateRay(Ray{originLanes.get(i), directionLanes.get(i)})) degenerate |= 1u << i;
-  });
-  const uint32_t regular = lanes & ~degenerate;
-  if (regular == 0) return 0;
   const V3 o = load(originLanes);
   const V3 dir = load(directionLanes);
-  // 1 / direction, with |direction| clamped away from 0 (safeInverse).
+  // degenerateRay: not finite (x - x is 0 for a number, NaN otherwise), or no direction.
   const V minDirection = splat(kMinDirection);
+  const V finite = hn::Add(
+      hn::Add(hn::Add(hn::Add(hn::Add(hn::Sub(o.x, o.x), hn::Sub(o.y, o.y)), hn::Sub(o.z, o.z)),
+                      hn::Sub(dir.x, dir.x)),
+              hn::Sub(dir.y, dir.y)),
+      hn::Sub(dir.z, dir.z));
+  const M noDirection =
+      hn::And(hn::And(hn::Lt(hn::Abs(dir.x), minDirection), hn::Lt(hn::Abs(dir.y), minDirection)),
+              hn::Lt(hn::Abs(dir.z), minDirection));
+  degenerate = lanes & bits(hn::Or(hn::Not(hn::Eq(finite, zero)), noDirection));
+  const uint32_t regular = lanes & ~degenerate;
+  if (regular == 0) return 0;
+  // 1 / direction, with |direction| clamped away from 0 (safeInverse).
   auto safeInverse = [&](V x) {
     return hn::Div(splat(1.0f), hn::IfThenElse(hn::Lt(hn::Abs(x), minDirection),
                                                hn::CopySign(minDirection, x), x));
@@ -283,17 +301,41 @@ HWY_INLINE uint32_t setUpRays(const WideBvh& bvh, const Lanes3& originLanes,
 // The state of one path per lane: what sampleRadiance keeps across its loop.
 struct Paths {
   int32_t slot[kMaxLanes];  // index into the caller's pixels, -1: the lane is free
-  uvec2 pixel[kMaxLanes];
-  uint depth[kMaxLanes];
-  Lanes3 origin, direction;  // `ray`
+  alignas(32) uint32_t pixelX[kMaxLanes] = {}, pixelY[kMaxLanes] = {};
+  alignas(32) uint32_t depth[kMaxLanes] = {};
+  alignas(32) uint32_t dim[kMaxLanes] = {};  // the scattering event's first dimension
+  Lanes3 origin, direction;                  // `ray`
   Lanes3 L, beta;
   Lanes bsdfPdf;
   uint32_t specular = 0;  // bits: specularBounce
 };
 
+// random2 of each lane in `lanes`: its pixel, the sample, dimension dim[i] + offset (for a
+// lane outside `lanes`, numbers of no use); .x into ux, .y into uy where given.
+HWY_INLINE void drawRandom2(bool sobol, const Paths& path, uint sampleIndex, uint offset, uint seed,
+                            uint32_t lanes, Lanes& ux, Lanes* uy) {
+#if HWY_TARGET == HWY_SCALAR
+  forEachLane(lanes, [&](size_t i) {
+    const vec2 u = random2(sobol, uvec2(path.pixelX[i], path.pixelY[i]), sampleIndex,
+                           path.dim[i] + offset, seed);
+    ux.v[i] = u.x;
+    if (uy) uy->v[i] = u.y;
+  });
+#else
+  (void)lanes;
+  const hn::RebindToUnsigned<D> du;
+  V x, y;
+  random_lanes::random2(sobol, hn::Load(du, path.pixelX), hn::Load(du, path.pixelY), sampleIndex,
+                        hn::Add(hn::Load(du, path.dim), hn::Set(du, offset)), seed, x, y);
+  ux.store(x);
+  if (uy) uy->store(y);
+#endif
+}
+
 void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t count,
                              uint32_t sampleIndex, vec3* out, uint64_t& rays) {
   const D d;
+  const hn::RebindToUnsigned<D> du;
   const size_t lanes = hn::Lanes(d);
   const RenderParams& params = scene.params;
   const Bvh& bvh = scene.bvh;
@@ -320,25 +362,39 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   Lanes3 lightEmission, shadowFrom, shadowDir;
   Lanes lightPmf;
   RayPrecomputed prepared[kMaxLanes];
+  Lanes filmX, filmY;
+  const Camera& camera = params.camera;
 
   for (;;) {
     // Free lanes start the next pixels' paths: the primary ray through a jittered point of
     // the pixel, radiance 0, throughput 1, the camera ray counting as specular.
+    uint32_t starting = 0;
     for (size_t i = 0; i < lanes && nextPixel < count; ++i) {
       if (active >> i & 1u) continue;
       const uvec2 pixel = pixels[nextPixel];
-      const Ray ray = cameraRay(params.camera,
-                                vec2(pixel) + random2(sobol, pixel, sampleIndex, kDimPixel, seed));
       path.slot[i] = int32_t(nextPixel++);
-      path.pixel[i] = pixel;
+      path.pixelX[i] = pixel.x;
+      path.pixelY[i] = pixel.y;
       path.depth[i] = 0;
-      path.origin.set(i, ray.origin);
-      path.direction.set(i, ray.direction);
+      path.dim[i] = 0;
+      path.origin.set(i, camera.position);
       path.L.set(i, vec3(0.0f));
       path.beta.set(i, vec3(1.0f));
       path.bsdfPdf.v[i] = 0.0f;
       path.specular |= 1u << i;
-      active |= 1u << i;
+      starting |= 1u << i;
+    }
+    if (starting != 0) {
+      // Through a uniformly jittered point of the pixel: vec2(pixel) + random2(.., kDimPixel).
+      drawRandom2(sobol, path, sampleIndex, kDimPixel, seed, starting, filmX, &filmY);
+      const hn::RebindToSigned<D> di;
+      const V filmPointX =
+          hn::Add(hn::ConvertTo(d, hn::BitCast(di, hn::Load(du, path.pixelX))), filmX.load());
+      const V filmPointY =
+          hn::Add(hn::ConvertTo(d, hn::BitCast(di, hn::Load(du, path.pixelY))), filmY.load());
+      const V3 direction = cameraDirection(camera, filmPointX, filmPointY);
+      store(path.direction, select(mask(starting), direction, load(path.direction)));
+      active |= starting;
     }
     if (active == 0) break;
 
@@ -418,17 +474,15 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
         live &= ~(1u << i);
         return;
       }
-      const uint dim = kDimFirstBounce + kDimsPerBounce * path.depth[i];
+      path.dim[i] = kDimFirstBounce + kDimsPerBounce * path.depth[i];
       ++path.depth[i];
-      const BounceRandom u = bounceRandomSimd(sobol, path.pixel[i], sampleIndex, dim, seed);
-      uLightChooseX.v[i] = u.lightChoose.x;
-      uLightChooseY.v[i] = u.lightChoose.y;
-      uLightX.v[i] = u.lightPoint.x;
-      uLightY.v[i] = u.lightPoint.y;
-      uBsdfX.v[i] = u.bsdf.x;
-      uBsdfY.v[i] = u.bsdf.y;
-      uRoulette.v[i] = u.roulette.x;
     });
+    // (bounceRandom: four dimensions from dim, each for all lanes at once.)
+    drawRandom2(sobol, path, sampleIndex, kDimLightChoose, seed, live, uLightChooseX,
+                &uLightChooseY);
+    drawRandom2(sobol, path, sampleIndex, kDimLightPoint, seed, live, uLightX, &uLightY);
+    drawRandom2(sobol, path, sampleIndex, kDimBsdf, seed, live, uBsdfX, &uBsdfY);
+    drawRandom2(sobol, path, sampleIndex, kDimRoulette, seed, live, uRoulette, nullptr);
 
     // Both materials are two-sided: shade with the normal facing the incoming ray.
     const V3 n = select(hn::Ge(cosOut, zero), ngv, -ngv);
