@@ -33,9 +33,9 @@ SceneData prepare(const std::string& config, int size) {
 void expectSameFilm(const Film& a, const Film& b) {
   ASSERT_EQ(a.width, b.width);
   ASSERT_EQ(a.height, b.height);
-  for (size_t i = 0; i < a.sum.size(); ++i) {
+  for (size_t i = 0; i < a.pixelCount(); ++i) {
     ASSERT_EQ(a.exact[i], b.exact[i]) << "pixel " << i;
-    ASSERT_EQ(a.sum[i], b.sum[i]) << "pixel " << i;
+    ASSERT_EQ(a.sum(i), b.sum(i)) << "pixel " << i;
     ASSERT_EQ(a.sampleCount[i], b.sampleCount[i]) << "pixel " << i;
     ASSERT_EQ(a.invalidCount[i], b.invalidCount[i]) << "pixel " << i;
   }
@@ -342,7 +342,7 @@ TEST(MergeFilmStates, RefusesOtherSettingsSizesAndOverlaps) {
   EXPECT_EQ(merged.ranges, (std::vector<SampleRange>{{0, 8}, {10, 12}}));
   EXPECT_EQ(merged.info, (KeyValues{{"job", "0:12"}}));
   EXPECT_EQ(merged.film.sampleCount[1], 10u);
-  EXPECT_EQ(merged.film.sum[1].x, 0 + 1 + 2 + 3 + 4 + 5 + 6 + 7 + 10 + 11);
+  EXPECT_EQ(merged.film.sum(1).x, 0 + 1 + 2 + 3 + 4 + 5 + 6 + 7 + 10 + 11);
 
   // Open batches: folded in the middle, kept open at the end of the merged samples.
   auto withOpen = [&](uint32_t first, uint32_t end, uint32_t openFirst) {
@@ -359,8 +359,8 @@ TEST(MergeFilmStates, RefusesOtherSettingsSizesAndOverlaps) {
   EXPECT_EQ(ends.open.first, 10u);
   EXPECT_EQ(ends.open.count, 2u);
   EXPECT_EQ(ends.film.sampleCount[0], 10u);
-  EXPECT_EQ(ends.film.sum[0].x, 0 + 1 + 2 + 3 + 4 + 5 + 100 + 8 + 9);
-  EXPECT_EQ(ends.combinedFilm().sum[0].x, 0 + 1 + 2 + 3 + 4 + 5 + 100 + 8 + 9 + 100);
+  EXPECT_EQ(ends.film.sum(0).x, 0 + 1 + 2 + 3 + 4 + 5 + 100 + 8 + 9);
+  EXPECT_EQ(ends.combinedFilm().sum(0).x, 0 + 1 + 2 + 3 + 4 + 5 + 100 + 8 + 9 + 100);
 }
 
 // ---- The CPU renderer's passes --------------------------------------------------------------
@@ -418,7 +418,7 @@ TEST(CpuPasses, AStopLeavesWholePassesAndCheckpointsSeeThem) {
   EXPECT_TRUE(stats.stopped);
   EXPECT_EQ(stats.samplesDone, 3);
   EXPECT_EQ(seen, (std::vector<int>{1, 2, 3}));
-  for (size_t i = 0; i < film.sum.size(); ++i) {
+  for (size_t i = 0; i < film.pixelCount(); ++i) {
     ASSERT_EQ(film.sampleCount[i] + film.invalidCount[i], 3u) << "pixel " << i;
   }
   Film three(32, 32);
@@ -438,7 +438,7 @@ TEST(CpuPasses, AStopLeavesWholePassesAndCheckpointsSeeThem) {
   EXPECT_TRUE(partial.stopped);
   EXPECT_GE(partial.samplesDone, 4);
   EXPECT_LE(partial.samplesDone, 5);
-  for (size_t i = 0; i < dropped.sum.size(); ++i) {
+  for (size_t i = 0; i < dropped.pixelCount(); ++i) {
     ASSERT_EQ(dropped.sampleCount[i] + dropped.invalidCount[i], uint64_t(partial.samplesDone));
   }
   // The dropped pass's tiles were taken back out bit for bit.

@@ -651,7 +651,7 @@ TEST(Film, MillionsOfSamplesDoNotDrift) {
   // The exact mean of the samples (each product and the sum round once).
   const double exact =
       (double(kEach) * double(0.1f) + double(kEach) * double(1e-8f)) / (2.0 * kEach);
-  const double mean = film.sum[1].x / double(film.sampleCount[1]);
+  const double mean = film.sum(1).x / double(film.sampleCount[1]);
   // Recursive summation in double is off by at most (n - 1) * 2^-53 relative (2.2e-10 for
   // 2e6 terms); the 1e-8 samples contribute 1e-7, far above that, so losing them fails here.
   // (1e-12, tighter than that bound, is not guaranteed by plain double summation.)
@@ -690,7 +690,7 @@ TEST(Film, MergeAddsSumsAndCounts) {
   b.add(1, 0, glm::vec3(kNaN));
   a.merge(b);
   EXPECT_EQ(a.sampleCount[0], 3u);
-  EXPECT_EQ(a.sum[0], glm::dvec3(9.0));
+  EXPECT_EQ(a.sum(0), glm::dvec3(9.0));
   EXPECT_EQ(a.invalidCount[1], 1u);
   EXPECT_EQ(a.totalInvalid(), 1u);
   EXPECT_EQ(a.resolve().at(0, 0), glm::vec3(3.0f));

@@ -222,7 +222,7 @@ void checkInterruptAtRandomMoment(const std::string& backend, const std::string&
   const FilmState state = readFilmState(dir / "s.ptstate");
   ASSERT_EQ(state.ranges, (std::vector<SampleRange>{{0, uint32_t(k)}}));
   const Film film = state.combinedFilm();
-  for (size_t i = 0; i < film.sum.size(); ++i) {
+  for (size_t i = 0; i < film.pixelCount(); ++i) {
     ASSERT_EQ(film.sampleCount[i] + film.invalidCount[i], uint64_t(k)) << "pixel " << i;
   }
   // The images are those of a render of k samples.

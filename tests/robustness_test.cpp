@@ -103,7 +103,7 @@ TEST(RobustEnergy, MillionSamplePixelMatchesADoubleSum) {
   ASSERT_EQ(film.sampleCount[0], kSamples);
   for (int c = 0; c < 3; ++c) {
     ASSERT_GT(exact[c], 0.0);
-    const double gpuError = std::abs(film.sum[0][c] - exact[c]) / exact[c];
+    const double gpuError = std::abs(film.sum(0)[c] - exact[c]) / exact[c];
     const double floatError = std::abs(double(naive[c]) - exact[c]) / exact[c];
     std::printf("channel %d: relative error of the device sum %.3g, of a float sum %.3g\n", c,
                 gpuError, floatError);

@@ -214,7 +214,7 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
   const int tilesX = (film.width + kTile - 1) / kTile;
   const int tilesY = (film.height + kTile - 1) / kTile;
   const int tileCount = tilesX * tilesY;
-  std::vector<vec3> pass(film.sum.size());
+  std::vector<vec3> pass(film.pixelCount());
   std::vector<char> traced(static_cast<size_t>(tileCount));  // tiles of this pass in the film
   auto forTilePixels = [&](int tile, auto&& f) {
     const int x0 = (tile % tilesX) * kTile;

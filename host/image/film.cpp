@@ -13,9 +13,8 @@ void Film::checkFitsInMemory(int w, int h, const std::string& what) {
   // Refused with the numbers before allocating, not killed by the OOM killer halfway. The
   // resolved Image is counted too: it is allocated while the film is alive.
   constexpr size_t kBytesPerPixel =
-      sizeof(decltype(sum)::value_type) + sizeof(decltype(sampleCount)::value_type) +
-      sizeof(decltype(invalidCount)::value_type) + sizeof(decltype(exact)::value_type) +
-      sizeof(decltype(Image::pixels)::value_type);
+      sizeof(decltype(sampleCount)::value_type) + sizeof(decltype(invalidCount)::value_type) +
+      sizeof(decltype(exact)::value_type) + sizeof(decltype(Image::pixels)::value_type);
   const uint64_t n = uint64_t(std::max(w, 0)) * uint64_t(std::max(h, 0));
   pt::checkFitsInMemory(n * kBytesPerPixel,
                         what + "a " + std::to_string(w) + "x" + std::to_string(h) + " film",
@@ -26,7 +25,6 @@ Film::Film(int w, int h) : width(w), height(h) {
   PT_CHECK(w >= 0 && h >= 0, "film size must not be negative");
   const size_t n = size_t(w) * size_t(h);
   checkFitsInMemory(w, h);
-  sum.assign(n, glm::dvec3(0.0));
   sampleCount.assign(n, 0);
   invalidCount.assign(n, 0);
   exact.assign(n, {});
@@ -34,11 +32,8 @@ Film::Film(int w, int h) : width(w), height(h) {
 
 void Film::merge(const Film& other) {
   PT_CHECK(width == other.width && height == other.height, "merging films of different sizes");
-  for (size_t i = 0; i < sum.size(); ++i) {
-    for (int c = 0; c < 3; ++c) {
-      exact[i][c].add(other.exact[i][c]);
-      sum[i][c] = exact[i][c].toDouble();
-    }
+  for (size_t i = 0; i < pixelCount(); ++i) {
+    for (int c = 0; c < 3; ++c) exact[i][c].add(other.exact[i][c]);
     sampleCount[i] += other.sampleCount[i];
     invalidCount[i] += other.invalidCount[i];
   }
@@ -52,9 +47,9 @@ uint64_t Film::totalInvalid() const {
 
 Image Film::resolve() const {
   Image image(width, height);
-  for (size_t i = 0; i < sum.size(); ++i) {
+  for (size_t i = 0; i < pixelCount(); ++i) {
     // Divide in double and round once to float.
-    if (sampleCount[i] > 0) image.pixels[i] = glm::vec3(sum[i] / double(sampleCount[i]));
+    if (sampleCount[i] > 0) image.pixels[i] = glm::vec3(sum(i) / double(sampleCount[i]));
   }
   return image;
 }

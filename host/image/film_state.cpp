@@ -199,7 +199,7 @@ uint64_t OpenBatch::invalidTotal() const {
 
 void OpenBatch::foldInto(Film& film) const {
   if (empty()) return;
-  PT_CHECK(sum.size() == film.sum.size() && invalid.size() == film.sum.size(),
+  PT_CHECK(sum.size() == film.pixelCount() && invalid.size() == film.pixelCount(),
            "open batch and film sizes differ");
   for (size_t i = 0; i < sum.size(); ++i) {
     film.addSums(i, sum[i], uint64_t(count) - invalid[i], invalid[i]);
@@ -292,8 +292,8 @@ void writeFilmState(const FilmState& state, const fs::path& path) {
            "an open batch must end the last range");
 
   Bytes body;
-  body.reserve(film.sum.size() * 60);
-  for (size_t i = 0; i < film.sum.size(); ++i) {
+  body.reserve(film.pixelCount() * 60);
+  for (size_t i = 0; i < film.pixelCount(); ++i) {
     putVarint(body, film.sampleCount[i]);
     putVarint(body, film.invalidCount[i]);
     for (const ExactSum& s : film.exact[i]) {
@@ -306,10 +306,10 @@ void writeFilmState(const FilmState& state, const fs::path& path) {
     }
   }
   if (!state.open.empty()) {
-    PT_CHECK(
-        state.open.sum.size() == film.sum.size() && state.open.invalid.size() == film.sum.size(),
-        "open batch and film sizes differ");
-    for (size_t i = 0; i < film.sum.size(); ++i) {
+    PT_CHECK(state.open.sum.size() == film.pixelCount() &&
+                 state.open.invalid.size() == film.pixelCount(),
+             "open batch and film sizes differ");
+    for (size_t i = 0; i < film.pixelCount(); ++i) {
       for (int c = 0; c < 3; ++c) putLittle(body, std::bit_cast<uint32_t>(state.open.sum[i][c]), 4);
       putLittle(body, state.open.invalid[i], 4);
     }
@@ -458,7 +458,7 @@ FilmState readFilmState(const fs::path& path) {
   state.film = Film(int(width), int(height));
   Film& film = state.film;
   Reader in(path, bytes.data() + pos, bytes.data() + checked);
-  for (size_t i = 0; i < film.sum.size(); ++i) {
+  for (size_t i = 0; i < film.pixelCount(); ++i) {
     film.sampleCount[i] = in.varint();
     film.invalidCount[i] = in.varint();
     if (film.sampleCount[i] + film.invalidCount[i] != inFilm) {
@@ -473,16 +473,15 @@ FilmState readFilmState(const fs::path& path) {
       for (int l = 0; l < ExactSum::kLimbs; ++l) {
         if (mask & (1 << l)) s.limb[l] = in.little(8);
       }
-      film.sum[i][c] = s.toDouble();
     }
   }
   if (openRange.count() > 0) {
     OpenBatch& open = state.open;
     open.first = openRange.first;
     open.count = openRange.count();
-    open.sum.resize(film.sum.size());
-    open.invalid.resize(film.sum.size());
-    for (size_t i = 0; i < film.sum.size(); ++i) {
+    open.sum.resize(film.pixelCount());
+    open.invalid.resize(film.pixelCount());
+    for (size_t i = 0; i < film.pixelCount(); ++i) {
       for (int c = 0; c < 3; ++c) open.sum[i][c] = std::bit_cast<float>(uint32_t(in.little(4)));
       open.invalid[i] = uint32_t(in.little(4));
       if (open.invalid[i] > open.count) in.corrupt("an open batch count is out of range");

@@ -84,9 +84,8 @@ uint8_t linearToSrgb8(float linear);
 // reported, never silently dropped.
 struct Film {
   int width = 0, height = 0;
-  std::vector<glm::dvec3> sum;                 // row-major, row 0 top: exact[i] rounded to double
-  std::vector<uint64_t> sampleCount;           // valid samples added per pixel
-  std::vector<uint64_t> invalidCount;          // NaN/Inf samples seen per pixel
+  std::vector<uint64_t> sampleCount;   // valid samples added per pixel, row-major, row 0 top
+  std::vector<uint64_t> invalidCount;  // NaN/Inf samples seen per pixel
   std::vector<std::array<ExactSum, 3>> exact;  // the sums themselves, per channel
 
   Film() = default;
@@ -97,6 +96,13 @@ struct Film {
   // constructor checks, and a caller that knows where the size came from checks first, so that
   // its error names the file (`what`, e.g. "scene.json: ") and nothing has been built yet.
   static void checkFitsInMemory(int w, int h, const std::string& what = "");
+
+  size_t pixelCount() const { return exact.size(); }
+  // Pixel i's sum (row-major index), rounded to double from the exact sums when asked: adding
+  // a sample does not round, which saves that work on each of a render's samples.
+  glm::dvec3 sum(size_t i) const {
+    return glm::dvec3(exact[i][0].toDouble(), exact[i][1].toDouble(), exact[i][2].toDouble());
+  }
 
   // Inline because it runs once per sample. Threads may call it concurrently for disjoint
   // pixels: it touches only pixel (x, y) and takes no lock.
@@ -149,10 +155,7 @@ struct Film {
 
  private:
   void addExact(size_t i, glm::vec3 v) {
-    for (int c = 0; c < 3; ++c) {
-      exact[i][c].add(v[c]);
-      sum[i][c] = exact[i][c].toDouble();
-    }
+    for (int c = 0; c < 3; ++c) exact[i][c].add(v[c]);
   }
 };
 

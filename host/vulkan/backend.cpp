@@ -205,7 +205,7 @@ void addCounters(const RenderBuffers& buffers, VulkanRenderStats& stats) {
 // to the film exactly, so a batch contributes the same bits whenever it is folded.
 void foldIntoFilm(const RenderBuffers& buffers, int samples, Film& film, VulkanRenderStats& stats) {
   const auto* px = static_cast<const AccumPixel*>(buffers.readback.mapped);
-  for (size_t i = 0; i < film.sum.size(); ++i) {
+  for (size_t i = 0; i < film.pixelCount(); ++i) {
     film.addSums(i, px[i].sum, uint64_t(samples) - px[i].invalid, px[i].invalid);
   }
   addCounters(buffers, stats);
@@ -285,7 +285,7 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   const uint64_t batch = uint64_t(perPass) * uint64_t(std::max(1, options.passesPerFlush));
   const uint32_t first = options.firstSample;
   const uint32_t end = first + uint32_t(options.spp);
-  const size_t pixels = film.sum.size();
+  const size_t pixels = film.pixelCount();
   auto stopRequested = [&] {
     return options.stop && options.stop->load(std::memory_order_relaxed);
   };
