@@ -1,5 +1,6 @@
 // The CPU reference path tracer: plain C++, written for clarity, in progressive passes over
-// the image, multithreaded over tiles.
+// the image, multithreaded over tiles. (renderCpu traces with its vector transcription,
+// integrator_lanes.h, eight paths at a time: the same bits.)
 // It reads the same flat arrays and draws the same random numbers as the shader, so a
 // difference image between the two backends points at a bug. (The BVH it traverses in a
 // eight-wide copy, SceneData::wideBvh, whose answers are the binary tree's bit for bit, and
