@@ -10,9 +10,10 @@
 //  - a branch of the reference becomes a lane mask: both sides are computed where any lane
 //    takes them and each lane keeps its own side's result; a lane whose path ended leaves
 //    the mask `live` and keeps its radiance;
-//  - what reads memory by index (the hit triangle, its material, the emitter table) and
-//    what is not arithmetic on lanes (traversal, the random numbers, the camera ray) runs
-//    lane by lane through the reference's own functions.
+//  - what reads memory by index (the hit triangle, its material, the emitter table) runs
+//    lane by lane, and so does traversal, through the wide BVH's own queries; the rays'
+//    set-up and root-box test before it run in lanes (setUpRays). The random numbers are
+//    random2's vector form (random_lanes-inl.h).
 #include <bit>
 #include <cstdint>
 #include <optional>
@@ -28,7 +29,6 @@
 #include <hwy/highway.h>
 
 #include "bvh/wide_bvh.h"
-#include "cpu/integrator.h"
 #include "cpu/integrator_lanes.h"
 #include "cpu/random_lanes-inl.h"
 

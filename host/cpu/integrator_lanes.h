@@ -2,9 +2,9 @@
 // pixels in the lanes of x86 vector registers. Each lane performs the reference's float
 // operations in its order (no fused multiply-adds, IEEE division and square root, its
 // comparisons and its selections), so each pixel's radiance is the reference's bit for bit
-// (CpuLanes.EqualsTheReferenceBitForBit); traversal, the random numbers and the camera ray
-// stay the reference's own functions, called lane by lane. renderCpu traces with this; the
-// reference, sampleRadiance, stays the readable definition and serves --debug-pixel.
+// (CpuLanes.EqualsTheReferenceBitForBit); traversal stays the wide BVH's queries, called lane
+// by lane. renderCpu traces with this; the reference, sampleRadiance, stays the readable
+// definition and serves --debug-pixel.
 #pragma once
 
 #include <cstddef>
