@@ -480,7 +480,7 @@ How the Embree numbers come about, and what they compare:
   (work per ray: traversal plus shading), not frames/s. Embree's tutorial is C++ with
   Embree's single-ray calls, not its ISPC or packet variants.
 - Not done: our integrator's exact ray stream over Embree's traversal. It would need a
-  traversal hook in \`host/cpu/integrator.cpp\`; Embree's own path tracer with its own count is
+  traversal hook in \`host/cpu/integrator_lanes.cpp\`; Embree's own path tracer with its own count is
   the comparison the goal asks for. The ray benchmark above gives the traversal-only ratio.
 
 ## Time to relMSE $target, Cornell box ${size}x${size}
