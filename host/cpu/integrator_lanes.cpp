@@ -17,7 +17,6 @@
 #include <bit>
 #include <cstdint>
 #include <optional>
-#include <utility>
 #include <vector>
 
 #ifndef HWY_DISABLED_TARGETS  // AVX-512 is left out, as in the traversal
@@ -287,10 +286,13 @@ HWY_INLINE uint32_t setUpRays(const WideBvh& bvh, const Lanes3& originLanes,
     r.origin = originLanes.get(i);
     r.direction = directionLanes.get(i);
     r.invDirection = invLanes.get(i);
-    r.kz = (xBits >> i & 1u) ? 0 : (yBits >> i & 1u) ? 1 : 2;
-    r.kx = (r.kz + 1) % 3;
-    r.ky = (r.kx + 1) % 3;
-    if (swapBits >> i & 1u) std::swap(r.kx, r.ky);
+    // kz as above (zIsX and zIsY exclude each other); kx = (kz + 1) % 3 and ky = (kx + 1) % 3,
+    // swapped: by table, as the signs of directions would make branches unpredictable.
+    static constexpr int kNext[2][3] = {{1, 2, 0}, {2, 0, 1}};
+    const int swapped = int(swapBits >> i & 1u);
+    r.kz = 2 - 2 * int(xBits >> i & 1u) - int(yBits >> i & 1u);
+    r.kx = kNext[swapped][r.kz];
+    r.ky = kNext[1 - swapped][r.kz];
     r.sx = sx.v[i];
     r.sy = sy.v[i];
     r.sz = sz.v[i];
@@ -432,8 +434,8 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
         emitting |= 1u << i;
         hitEmitterPmf.v[i] = scene.emitters[tri.emitter].pmf;
       }
-      if (material.type == kMaterialMirror) mirror |= 1u << i;
-      if (material.reflectance != vec3(0.0f)) nonBlack |= 1u << i;
+      mirror |= uint32_t(material.type == kMaterialMirror) << i;
+      nonBlack |= uint32_t(material.reflectance != vec3(0.0f)) << i;
     });
 
     // Hit point from barycentrics; the geometric normal; the cosine towards the viewer.
@@ -469,14 +471,15 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
     }
 
     // Stop after maxDepth scattering events; the others draw this event's random numbers.
-    forEachLane(live, [&](size_t i) {
-      if (path.depth[i] == params.maxDepth) {
-        live &= ~(1u << i);
-        return;
-      }
-      path.dim[i] = kDimFirstBounce + kDimsPerBounce * path.depth[i];
-      ++path.depth[i];
-    });
+    {
+      const auto depth = hn::Load(du, path.depth);
+      live &= ~bits(hn::RebindMask(d, hn::Eq(depth, hn::Set(du, params.maxDepth))));
+      hn::Store(hn::Add(hn::Set(du, kDimFirstBounce), hn::Mul(hn::Set(du, kDimsPerBounce), depth)),
+                du, path.dim);
+      hn::Store(
+          hn::IfThenElse(hn::RebindMask(du, mask(live)), hn::Add(depth, hn::Set(du, 1u)), depth),
+          du, path.depth);
+    }
     // (bounceRandom: four dimensions from dim, each for all lanes at once.)
     drawRandom2(sobol, path, sampleIndex, kDimLightChoose, seed, live, uLightChooseX,
                 &uLightChooseY);
@@ -538,7 +541,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
                 ? anyHit(copies.wide, Ray{shadowFrom.get(i), shadowDir.get(i)}, 1.0f, intersection)
                 : (shadowEnters >> i & 1u) &&
                       anyHitPrepared(copies.wide, prepared[i], 1.0f, intersection);
-        if (!occluded) unoccluded |= 1u << i;
+        unoccluded |= uint32_t(!occluded) << i;
       });
       if (unoccluded != 0) {
         const V lightPdf =
@@ -566,10 +569,9 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
 
     // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
     if (params.russianRoulette != 0u) {
-      uint32_t roulette = 0;  // lanes deep enough for it
-      forEachLane(live, [&](size_t i) {
-        if (path.depth[i] >= params.rrStartDepth) roulette |= 1u << i;
-      });
+      const uint32_t roulette =  // lanes deep enough for it
+          live & ~bits(hn::RebindMask(
+                     d, hn::Lt(hn::Load(du, path.depth), hn::Set(du, params.rrStartDepth))));
       if (roulette != 0) {
         const V q = glmMax(zero, hn::Sub(splat(1.0f), maxComponent(beta)));
         live &= ~(roulette & bits(hn::Lt(uRoulette.load(), q)));
