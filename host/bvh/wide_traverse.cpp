@@ -344,13 +344,19 @@ HWY_INLINE bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket
     hn::Store(u, d, ul);
     hn::Store(v, d, vl);
     hn::Store(w, d, wl);
+    // Until a lane is taken, `closest` is the distance the vector test used: its lanes pass
+    // again, and only later ones are tested against the shrunk distance.
+    bool shrunk = false;
     for (uint32_t rest = accepted; rest != 0; rest &= rest - 1u) {
       const int i = std::countr_zero(rest);
-      const float laneRange = closest * dl[i];
-      if (dl[i] > 0.0f ? (tl[i] <= 0.0f || tl[i] >= laneRange)
-                       : (tl[i] >= 0.0f || tl[i] <= laneRange)) {
-        continue;
+      if (shrunk) {
+        const float laneRange = closest * dl[i];
+        if (dl[i] > 0.0f ? (tl[i] <= 0.0f || tl[i] >= laneRange)
+                         : (tl[i] >= 0.0f || tl[i] <= laneRange)) {
+          continue;
+        }
       }
+      shrunk = true;
       const float invDet = 1.0f / dl[i];
       best.t = tl[i] * invDet;
       best.barycentrics = vec3(ul[i], vl[i], wl[i]) * invDet;
