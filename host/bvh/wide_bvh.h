@@ -126,13 +126,10 @@ std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax = I
 bool anyHit(const WideBvh& bvh, const Ray& ray, float tMax,
             Intersection test = Intersection::kWatertight);
 
-// True for the rays the vector traversal does not take (a NaN or an infinity in them, or no
-// direction): the queries above run the binary traversal's loop for those.
-bool degenerateRay(const Ray& ray);
-
 // The queries above after their first steps, for callers that take those steps for several
-// rays at once (the lanes integrator): `ray` is RayPrecomputed of a ray that is not
-// degenerate and enters the root's box (intersectBox with rootMin, rootMax and tMax).
+// rays at once (the lanes integrator): `ray` is RayPrecomputed of a ray that enters the
+// root's box (intersectBox with rootMin, rootMax and tMax) and is not degenerate (no NaN or
+// infinity in it, and a direction: see above; the queries above take those elsewhere).
 bool closestHitPrepared(const WideBvh& bvh, const RayPrecomputed& ray, float tMax,
                         Intersection test, Hit& hit);
 bool anyHitPrepared(const WideBvh& bvh, const RayPrecomputed& ray, float tMax, Intersection test);

@@ -489,7 +489,10 @@ namespace pt {
 // this runs traverse.cpp's loop itself over the wide tree. A binary node is a range of one
 // wide node's lanes (all eight: the node's own binary node N; four: N's children; two:
 // theirs; one: a lane), and its box the union of its lanes' boxes, which is the binary
-// node's box exactly (every parent's box is the union of its children's).
+// node's box exactly (every parent's box is the union of its children's). (The lanes
+// integrator tests the same in vector lanes: integrator_lanes.cpp, setUpRays.)
+namespace {
+
 bool degenerateRay(const Ray& ray) {
   const vec3 o = ray.origin, d = ray.direction;
   // x - x is 0 for a number, NaN for an infinity or a NaN.
@@ -498,8 +501,6 @@ bool degenerateRay(const Ray& ray) {
   return !finite || (std::fabs(d.x) < kMinDirection && std::fabs(d.y) < kMinDirection &&
                      std::fabs(d.z) < kMinDirection);
 }
-
-namespace {
 
 struct BinaryNode {
   uint32_t node;  // the wide node

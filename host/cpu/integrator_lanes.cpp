@@ -234,7 +234,8 @@ HWY_INLINE uint32_t setUpRays(const WideBvh& bvh, const Lanes3& originLanes,
   const V zero = hn::Zero(d);
   const V3 o = load(originLanes);
   const V3 dir = load(directionLanes);
-  // degenerateRay: not finite (x - x is 0 for a number, NaN otherwise), or no direction.
+  // Degenerate, as wide_traverse.cpp's degenerateRay tests it: not finite (x - x is 0 for a
+  // number, NaN otherwise), or no direction.
   const V minDirection = splat(kMinDirection);
   const V finite = hn::Add(
       hn::Add(hn::Add(hn::Add(hn::Add(hn::Sub(o.x, o.x), hn::Sub(o.y, o.y)), hn::Sub(o.z, o.z)),
