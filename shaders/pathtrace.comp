@@ -116,128 +116,142 @@ vec3 sampleDirectLight(vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f, vec2 
   return beta * f * Le * (cosSurface * weight / lightPdf);
 }
 
-vec3 sampleRadiance(uvec2 pixel, uint sampleIndex) {
-  uint seed = params.seed;
-  // Effects switched off by a specialization constant fold away here; the run-time half of
-  // each test keeps the unspecialized shader (every constant true) correct for any scene.
-  bool neeOn = kNee && params.emitterCount > 0u && params.strategy != kStrategyBsdf;
-  bool misOn = kMis && params.strategy == kStrategyMis;
-  bool bsdfEmissionOn = kBsdfEmission && params.strategy != kStrategyNee;
-  bool rouletteOn = kRussianRoulette && params.russianRoulette != 0u;
-  bool sobol = PT_SOBOL;  // else independent random numbers
-  // Primary ray through a uniformly jittered point of the pixel (box filter of width 1).
-  vec3 origin = params.camera.position;
-  vec3 direction = cameraDirection(
-      params.camera, vec2(pixel) + random2(sobol, pixel, sampleIndex, kDimPixel, seed));
-  vec3 L = vec3(0.0);     // radiance gathered so far
-  vec3 beta = vec3(1.0);  // path throughput
-  // The camera ray counts as specular: emission it finds is taken at full weight.
-  bool specularBounce = true;
-  float bsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that produced the ray
+// What sampleRadiance (host/cpu/integrator.cpp) keeps across its loop: one sample's path,
+// between two bounces.
+struct Path {
+  uint sampleIndex;
+  uint depth;   // scattering events so far
+  vec3 origin;  // the ray to trace next
+  vec3 direction;
+  vec3 L;               // radiance gathered so far
+  vec3 beta;            // path throughput
+  bool specularBounce;  // the ray leaves a specular bounce (or the camera)
+  float bsdfPdf;        // solid-angle pdf of the BSDF sample that produced the ray
+};
 
-  bool pathEnded = false;
-  for (uint depth = 0u;;) {
-    gLoopIterations++;
-    // Find the closest surface along the ray; the background is black.
-    gRays++;
-    HitData hit;
-    if (!traceRay(origin, direction, 1.0 / 0.0, /*anyHit=*/false, hit)) {
-      pathEnded = true;
-      break;
-    }
-    Triangle tri = loadTriangle(hit.triangle);
-    Material material = loadMaterial(tri.material);
-    // Hit point from barycentrics (more accurate than origin + t * direction).
-    vec3 p =
-        hit.barycentrics.x * tri.v0 + hit.barycentrics.y * tri.v1 + hit.barycentrics.z * tri.v2;
-    vec3 edgeCross = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
-    vec3 ng = normalize(edgeCross);
-    vec3 wo = -direction;
-    float cosOut = dot(ng, wo);
-    // Coordinates' scale at this vertex, for the ray offsets.
-    float magnitude = triangleMagnitude(tri.v0, tri.v1, tri.v2);
+// The effects in use. Those switched off by a specialization constant fold away here; the
+// run-time half of each test keeps the unspecialized shader (every constant true) correct for
+// any scene.
+bool neeOn() {
+  return kNee && params.emitterCount > 0u && params.strategy != kStrategyBsdf;
+}
+bool misOn() {
+  return kMis && params.strategy == kStrategyMis;
+}
+bool bsdfEmissionOn() {
+  return kBsdfEmission && params.strategy != kStrategyNee;
+}
+bool rouletteOn() {
+  return kRussianRoulette && params.russianRoulette != 0u;
+}
+
+// sampleRadiance's start: the primary ray through a uniformly jittered point of the pixel
+// (box filter of width 1), radiance 0, throughput 1.
+Path startPath(uvec2 pixel, uint sampleIndex) {
+  Path path;
+  path.sampleIndex = sampleIndex;
+  path.depth = 0u;
+  path.origin = params.camera.position;
+  path.direction = cameraDirection(
+      params.camera, vec2(pixel) + random2(PT_SOBOL, pixel, sampleIndex, kDimPixel, params.seed));
+  path.L = vec3(0.0);
+  path.beta = vec3(1.0);
+  // The camera ray counts as specular: emission it finds is taken at full weight.
+  path.specularBounce = true;
+  path.bsdfPdf = 0.0;
+  return path;
+}
+
+// One iteration of sampleRadiance's loop: traces the path's ray, adds the emission it finds,
+// scatters. Returns true when the path has ended, its radiance then being path.L.
+bool extendPath(inout Path path, uvec2 pixel) {
+  uint seed = params.seed;
+  bool sobol = PT_SOBOL;  // else independent random numbers
+  uint sampleIndex = path.sampleIndex;
+  // Find the closest surface along the ray; the background is black.
+  gRays++;
+  HitData hit;
+  if (!traceRay(path.origin, path.direction, 1.0 / 0.0, /*anyHit=*/false, hit)) return true;
+  Triangle tri = loadTriangle(hit.triangle);
+  Material material = loadMaterial(tri.material);
+  // Hit point from barycentrics (more accurate than origin + t * direction).
+  vec3 p = hit.barycentrics.x * tri.v0 + hit.barycentrics.y * tri.v1 + hit.barycentrics.z * tri.v2;
+  vec3 edgeCross = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
+  vec3 ng = normalize(edgeCross);
+  vec3 wo = -path.direction;
+  float cosOut = dot(ng, wo);
+  // Coordinates' scale at this vertex, for the ray offsets.
+  float magnitude = triangleMagnitude(tri.v0, tri.v1, tri.v2);
 #ifdef PT_DEBUG_PRINTF
-    if (gDebug) {
-      debugPrintfEXT(
-          "gpu depth %u: hit triangle %u (primitive %u) t=%g p=(%g, %g, %g) beta=(%g, %g, %g)",
-          depth, hit.triangle, tri.primitive, hit.t, p.x, p.y, p.z, beta.x, beta.y, beta.z);
-    }
+  if (gDebug) {
+    debugPrintfEXT(
+        "gpu depth %u: hit triangle %u (primitive %u) t=%g p=(%g, %g, %g) beta=(%g, %g, %g)",
+        path.depth, hit.triangle, tri.primitive, hit.t, p.x, p.y, p.z, path.beta.x, path.beta.y,
+        path.beta.z);
+  }
 #endif
 
-    // Add emitted light found by this ray: one-sided, on the geometric normal's side.
-    if (tri.emitter != kNoEmitter && cosOut > 0.0) {
-      vec3 Le = material.emission;
-      if (specularBounce) {
-        L += beta * Le;
-      } else if (bsdfEmissionOn) {
-        // Weigh against the chance that light sampling had produced this point.
-        float weight = 1.0;
-        if (misOn) {
-          float area = 0.5 * length(edgeCross);
-          float lightPdf = loadEmitter(tri.emitter).pmf * hit.t * hit.t / (cosOut * area);
-          weight = powerHeuristic(bsdfPdf, lightPdf);
-        }
-        L += beta * weight * Le;
+  // Add emitted light found by this ray: one-sided, on the geometric normal's side.
+  if (tri.emitter != kNoEmitter && cosOut > 0.0) {
+    vec3 Le = material.emission;
+    if (path.specularBounce) {
+      path.L += path.beta * Le;
+    } else if (bsdfEmissionOn()) {
+      // Weigh against the chance that light sampling had produced this point.
+      float weight = 1.0;
+      if (misOn()) {
+        float area = 0.5 * length(edgeCross);
+        float lightPdf = loadEmitter(tri.emitter).pmf * hit.t * hit.t / (cosOut * area);
+        weight = powerHeuristic(path.bsdfPdf, lightPdf);
       }
+      path.L += path.beta * weight * Le;
     }
-
-    // Stop after maxDepth scattering events.
-    if (depth == params.maxDepth) {
-      pathEnded = true;
-      break;
-    }
-    uint dim = kDimFirstBounce + kDimsPerBounce * depth;
-    ++depth;
-
-    // Both materials are two-sided: shade with the normal facing the incoming ray.
-    vec3 n = cosOut >= 0.0 ? ng : -ng;
-    vec3 wi;
-    if (kMirror && (!kDiffuse || material.type == kMaterialMirror)) {
-      // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
-      wi = direction - 2.0 * dot(direction, n) * n;
-      beta *= material.reflectance;
-      specularBounce = true;
-    } else {
-      vec3 f = material.reflectance * kInvPi;
-      // Sample direct illumination from an emitter (next-event estimation).
-      if (neeOn && material.reflectance != vec3(0.0)) {
-        L += sampleDirectLight(p, n, magnitude, beta, f,
-                               random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
-                               random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
-                               misOn, depth);
-      }
-      // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
-      wi = localToWorld(
-          sampleCosineHemisphere(random2(sobol, pixel, sampleIndex, dim + kDimBsdf, seed)), n);
-      bsdfPdf = dot(wi, n) * kInvPi;
-      if (!(bsdfPdf > 0.0)) {  // direction in the tangent plane: zero contribution
-        pathEnded = true;
-        break;
-      }
-      beta *= material.reflectance;
-      specularBounce = false;
-    }
-    if (maxComponent(beta) <= 0.0) {
-      pathEnded = true;
-      break;
-    }
-
-    // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
-    if (rouletteOn && depth >= params.rrStartDepth) {
-      float q = max(0.0, 1.0 - maxComponent(beta));
-      if (random1(sobol, pixel, sampleIndex, dim + kDimRoulette, seed) < q) {
-        pathEnded = true;
-        break;
-      }
-      beta /= 1.0 - q;
-    }
-
-    // Leave the surface on the side of the new direction.
-    origin = offsetRayOrigin(p, n, magnitude);
-    direction = wi;
   }
-  if (!pathEnded) gTruncated = true;
-  return L;
+
+  // Stop after maxDepth scattering events.
+  if (path.depth == params.maxDepth) return true;
+  uint dim = kDimFirstBounce + kDimsPerBounce * path.depth;
+  ++path.depth;
+
+  // Both materials are two-sided: shade with the normal facing the incoming ray.
+  vec3 n = cosOut >= 0.0 ? ng : -ng;
+  vec3 wi;
+  if (kMirror && (!kDiffuse || material.type == kMaterialMirror)) {
+    // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
+    wi = path.direction - 2.0 * dot(path.direction, n) * n;
+    path.beta *= material.reflectance;
+    path.specularBounce = true;
+  } else {
+    vec3 f = material.reflectance * kInvPi;
+    // Sample direct illumination from an emitter (next-event estimation).
+    if (neeOn() && material.reflectance != vec3(0.0)) {
+      path.L += sampleDirectLight(p, n, magnitude, path.beta, f,
+                                  random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
+                                  random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
+                                  misOn(), path.depth);
+    }
+    // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
+    wi = localToWorld(
+        sampleCosineHemisphere(random2(sobol, pixel, sampleIndex, dim + kDimBsdf, seed)), n);
+    path.bsdfPdf = dot(wi, n) * kInvPi;
+    // A direction in the tangent plane: zero contribution.
+    if (!(path.bsdfPdf > 0.0)) return true;
+    path.beta *= material.reflectance;
+    path.specularBounce = false;
+  }
+  if (maxComponent(path.beta) <= 0.0) return true;
+
+  // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
+  if (rouletteOn() && path.depth >= params.rrStartDepth) {
+    float q = max(0.0, 1.0 - maxComponent(path.beta));
+    if (random1(sobol, pixel, sampleIndex, dim + kDimRoulette, seed) < q) return true;
+    path.beta /= 1.0 - q;
+  }
+
+  // Leave the surface on the side of the new direction.
+  path.origin = offsetRayOrigin(p, n, magnitude);
+  path.direction = wi;
+  return false;
 }
 
 void main() {
@@ -246,18 +260,28 @@ void main() {
   uint index = pixel.y * params.camera.width + pixel.x;
   gDebug = index == pass.debugPixel;
 
-  // This dispatch's samples of the pixel, summed in float: a few thousand samples at most
-  // (the host folds the buffer into double precision after every few dispatches).
-  vec3 sum = vec3(0.0);
+  // This dispatch's samples of the pixel, added in float to the batch's sum one by one, in
+  // the order of their indices: how a batch's samples are split into dispatches does not
+  // change a bit of it (the host folds it into the film's exact sums after every batch, a few
+  // dozen samples at most). One loop runs them all, a bounce per iteration, and a path that
+  // ends makes way for the next sample's at once (path regeneration): the invocations of a
+  // SIMD group (lavapipe's vector lanes, a GPU's warp) each go on with a ray of their own,
+  // rather than wait for the group's longest path of the same sample. Every sample is still
+  // its own path with its own random numbers.
+  vec3 sum = accum[index].sum;
   uint invalid = 0u;
   uint truncated = 0u;
   uint done = 0u;
-  for (uint s = 0u; s < pass.sampleCount; ++s) {
-    gTruncated = false;
-    vec3 L = sampleRadiance(pixel, pass.sampleIndex + s);
+  bool finished = pass.sampleCount == 0u;
+  Path path = startPath(pixel, pass.sampleIndex);
+  gTruncated = false;
+  while (!finished) {
+    gLoopIterations++;
+    if (!extendPath(path, pixel)) continue;
+    vec3 L = path.L;
 #ifdef PT_DEBUG_PRINTF
     if (gDebug) {
-      debugPrintfEXT("gpu sample %u: L=(%g, %g, %g)", pass.sampleIndex + s, L.x, L.y, L.z);
+      debugPrintfEXT("gpu sample %u: L=(%g, %g, %g)", path.sampleIndex, L.x, L.y, L.z);
     }
 #endif
     // Lavapipe's cap, once reached, ends every loop after its first iteration. A loop that
@@ -276,12 +300,16 @@ void main() {
       sum += L;
     }
     done++;
+    finished = done == pass.sampleCount;
+    // The next sample's path.
+    path = startPath(pixel, pass.sampleIndex + done);
+    gTruncated = false;
   }
-  // The sample loop itself can be cut short by lavapipe's cap: the samples it never ran.
+  // The loop itself can be cut short by lavapipe's cap: the samples it never finished.
   truncated += pass.sampleCount - done;
   invalid += pass.sampleCount - done;
 
-  accum[index].sum += sum;
+  accum[index].sum = sum;
   accum[index].invalid += invalid;
   if (truncated > 0u) atomicAdd(counters.truncated, truncated);
   atomicMax(counters.maxLoopIterations, gLoopIterations);

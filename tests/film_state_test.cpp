@@ -452,8 +452,8 @@ TEST(CpuPasses, AStopLeavesWholePassesAndCheckpointsSeeThem) {
 VulkanRenderOptions vulkanOptions(uint32_t first, int spp) {
   VulkanRenderOptions options = validatedOptions(spp);
   options.firstSample = first;
-  options.passesPerFlush = 4;
-  options.samplesPerPass = 2;  // batches of 8 samples
+  options.samplesPerFold = 8;
+  options.samplesPerPass = 2;
   return options;
 }
 

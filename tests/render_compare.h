@@ -23,7 +23,7 @@ inline VulkanRenderOptions validatedOptions(int spp) {
   VulkanRenderOptions options;
   options.context.validation = validationWanted();
   options.spp = spp;
-  options.passesPerFlush = 3;  // exercise several folds into the film
+  options.samplesPerFold = 3;  // exercise several folds into the film
   return options;
 }
 

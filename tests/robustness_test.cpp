@@ -68,9 +68,9 @@ TEST(RobustFurnace, ClosedFormOnBothBackendsUpToAlbedo099) {
 }
 
 // Long renders: one pixel accumulated over a million samples equals the double-precision sum
-// of the same samples. The device sums a dispatch's samples in float and the host folds the
-// float sums into double every few dispatches; a plain float running sum of the same
-// samples is shown to be far off, so the bound can tell.
+// of the same samples. The device sums a batch's samples in float (2,000 here) and the host
+// folds the float sums into its exact film after every batch; a plain float running sum of
+// the same samples is shown to be far off, so the bound can tell.
 TEST(RobustEnergy, MillionSamplePixelMatchesADoubleSum) {
   Scene scene;
   scene.materials = {Material{vec3(0.5f, 0.6f, 0.7f), kMaterialDiffuse, vec3(0.0f), 0},
@@ -94,7 +94,7 @@ TEST(RobustEnergy, MillionSamplePixelMatchesADoubleSum) {
   }
   VulkanRenderOptions options = validatedOptions(int(kSamples));
   options.samplesPerPass = 2000;
-  options.passesPerFlush = 16;
+  options.samplesPerFold = 2000;
   Film film(1, 1);
   const VulkanRenderStats stats = renderVulkan(data, options, film);
   EXPECT_EQ(stats.validationErrors, 0u);

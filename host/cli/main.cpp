@@ -41,7 +41,7 @@ struct RenderArgs {
   SceneOverrides overrides;
   std::optional<int> spp;
   int threads = 0;
-  int samplesPerPass = 1;
+  int samplesPerPass = 0;            // 0: the Vulkan backend chooses
   std::vector<std::string> outputs;  // images, or film states (.ptstate)
   // Film states: written every checkpointEvery seconds, when interrupted and at the end.
   std::string checkpoint;
@@ -104,7 +104,7 @@ void checkOutputPath(const std::filesystem::path& path, bool state) {
 }
 
 int runRender(const RenderArgs& args) {
-  if (args.backend == "cpu" && args.samplesPerPass != 1) {
+  if (args.backend == "cpu" && args.samplesPerPass != 0) {
     throw InputError("--samples-per-pass applies to the Vulkan backend only");
   }
   const std::optional<std::pair<int, int>> task = chosenTask(args);
@@ -178,9 +178,8 @@ int runRender(const RenderArgs& args) {
     target = *sliceArg;
     if (target.first % unit != 0) {
       throw InputError("--samples " + args.samples + ": on the Vulkan backend FIRST must be a " +
-                       "multiple of " + std::to_string(unit) + " (samples per pass x " +
-                       std::to_string(vulkan.passesPerFlush) +
-                       " passes per fold), so that slices merge to the one-run image");
+                       "multiple of " + std::to_string(unit) +
+                       " (the samples per fold), so that slices merge to the one-run image");
     }
   } else if (task) {
     target = taskSlice(job, task->first, task->second, unit);
@@ -447,10 +446,9 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   render
       ->add_option("--samples-per-pass", r.samplesPerPass,
-                   "Vulkan: samples per pixel in one dispatch (fewer dispatches for small "
-                   "images; lavapipe's loop cap limits it)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
+                   "Vulkan: samples per pixel in one dispatch (default: as many as keep a "
+                   "dispatch to about half a second; lavapipe's loop cap limits it)")
+      ->check(CLI::PositiveNumber);
   addOverrideOptions(render, r.overrides);
   render->add_option("--debug-pixel", r.debugPixel,
                      "Print pixel X,Y's paths from the CPU reference and from the shader");

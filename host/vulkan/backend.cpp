@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstddef>
 #include <cstring>
 
 #include "common/check.h"
@@ -172,6 +174,24 @@ class PassRecorder {
             A::eShaderRead | A::eShaderWrite | A::eTransferRead);
   }
 
+  // Copies the most loop iterations an invocation of the last dispatch ran to the readback
+  // buffer (for loopIterations), then clears it for the next dispatch.
+  void copyLoopIterations() const {
+    const vk::DeviceSize at = offsetof(DeviceCounters, maxLoopIterations);
+    cmd_.copyBuffer(*buffers_.counters().buffer, *buffers_.readback.buffer,
+                    vk::BufferCopy(at, buffers_.accumSize + at, sizeof(uint32_t)));
+    barrier(cmd_, S::eTransfer, A::eTransferRead, S::eTransfer, A::eTransferWrite);
+    cmd_.fillBuffer(*buffers_.counters().buffer, at, sizeof(uint32_t), 0);
+    barrier(cmd_, S::eTransfer, A::eTransferWrite, S::eComputeShader,
+            A::eShaderRead | A::eShaderWrite);
+  }
+  uint32_t loopIterations() const {
+    DeviceCounters c;
+    std::memcpy(&c, static_cast<const char*>(buffers_.readback.mapped) + buffers_.accumSize,
+                sizeof(c));
+    return c.maxLoopIterations;
+  }
+
   // Copies the accumulation and the counters to the readback buffer, then clears them.
   void readBack() const {
     cmd_.copyBuffer(*buffers_.accum().buffer, *buffers_.readback.buffer,
@@ -242,6 +262,22 @@ void uploadOpenBatch(const VulkanContext& ctx, const vk::raii::CommandBuffer& cm
 
 }  // namespace
 
+// Samples per pass when the options leave it open: as many as keep a dispatch to about
+// kDispatchSeconds (a stop waits for the dispatch under way) and an invocation's loop
+// iterations to a quarter of lavapipe's cap, judged by the last dispatch (`count` samples,
+// `seconds`, `loopIterations` in its busiest invocation); at most four times the last count
+// and at most a batch. More samples per pass save dispatches and keep a SIMD group's lanes busy:
+// each lane goes on with its next sample as soon as a path ends.
+uint32_t nextSamplesPerPass(uint32_t count, double seconds, uint32_t loopIterations,
+                            uint64_t batch) {
+  constexpr double kDispatchSeconds = 0.5;
+  constexpr double kLoopIterations = 65535.0 / 4.0;
+  const double byTime = kDispatchSeconds * count / std::max(seconds, 1e-6);
+  const double byLoops = kLoopIterations * count / std::max(loopIterations, 1u);
+  const double k = std::min({byTime, byLoops, 4.0 * count, double(batch)});
+  return uint32_t(std::max(1.0, std::floor(k)));
+}
+
 VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions& options,
                                Film& film) {
   const auto start = std::chrono::steady_clock::now();
@@ -270,19 +306,21 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   passes.clearAccumulators();
   commands.submitAndWait(ctx);
 
-  // Batches of passes: samplesPerPass samples per pixel per dispatch, folded into the film
-  // after every passesPerFlush dispatches. Batches cover the sample indices [k * batch,
-  // (k + 1) * batch), aligned to absolute sample indices rather than to this call's first
-  // sample, and passes step from the batch's first sample: a render that is stopped and
-  // continued, or split into slices at batch boundaries, sums every batch in float exactly
-  // as one uninterrupted render does, and the film's exact sums do the rest.
+  // Batches of samplesPerFold samples per pixel, summed in float on the device in the order of
+  // their sample indices, then folded into the film. Batches cover the sample indices
+  // [k * batch, (k + 1) * batch), aligned to absolute sample indices rather than to this
+  // call's first sample: a render that is stopped and continued, or split into slices at
+  // batch boundaries, sums every batch in float exactly as one uninterrupted render does, and
+  // the film's exact sums do the rest. A batch goes to the device in passes (dispatches) of
+  // samplesPerPass samples, or of as many as nextSamplesPerPass finds; the split does not
+  // change the sums.
   VulkanRenderStats stats;
   stats.device = ctx.info().name;
   const vk::raii::QueryPool queries(ctx.device,
                                     vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, 2));
   const double tickSeconds = double(ctx.limits.timestampPeriod) * 1e-9;
-  const uint32_t perPass = uint32_t(std::max(1, options.samplesPerPass));
-  const uint64_t batch = uint64_t(perPass) * uint64_t(std::max(1, options.passesPerFlush));
+  uint32_t perPass = uint32_t(std::max(1, options.samplesPerPass));
+  const uint64_t batch = vulkanBatchSize(options);
   const uint32_t first = options.firstSample;
   const uint32_t end = first + uint32_t(options.spp);
   const size_t pixels = film.pixelCount();
@@ -321,12 +359,19 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
       const uint32_t count = std::min(perPass, batchEnd - next);
       passes.dispatch(next, count);
       cmd.writeTimestamp(S::eBottomOfPipe, *queries, 1);
+      passes.copyLoopIterations();
       commands.submitAndWait(ctx);
       const auto [result, ticks] = queries.getResults<uint64_t>(
           0, 2, 2 * sizeof(uint64_t), sizeof(uint64_t),
           vk::QueryResultFlagBits::e64 | vk::QueryResultFlagBits::eWait);
       PT_CHECK(result == vk::Result::eSuccess);
-      stats.seconds += double(ticks[1] - ticks[0]) * tickSeconds;
+      const double seconds = double(ticks[1] - ticks[0]) * tickSeconds;
+      stats.seconds += seconds;
+      const uint32_t loopIterations = passes.loopIterations();
+      stats.maxLoopIterations = std::max(stats.maxLoopIterations, loopIterations);
+      if (options.samplesPerPass <= 0) {
+        perPass = nextSamplesPerPass(count, seconds, loopIterations, batch);
+      }
       next += count;
       if (options.progress) options.progress(double(next - first) / double(options.spp));
     }
@@ -376,14 +421,13 @@ KeyValues vulkanImageSettings(const VulkanRenderOptions& options) {
   const std::span<const uint32_t> spirv = options.context.debugPrintf
                                               ? std::span<const uint32_t>(kPathtraceDebugSpv)
                                               : std::span<const uint32_t>(kPathtraceSpv);
-  return {{"samples_per_pass", std::to_string(std::max(1, options.samplesPerPass))},
-          {"passes_per_fold", std::to_string(std::max(1, options.passesPerFlush))},
+  return {{"samples_per_fold", std::to_string(vulkanBatchSize(options))},
           {"specialize", options.specialize ? "on" : "off"},
           {"shader", hexHash(hashBytes(spirv.data(), spirv.size_bytes()))}};
 }
 
 uint32_t vulkanBatchSize(const VulkanRenderOptions& options) {
-  return uint32_t(std::max(1, options.samplesPerPass) * std::max(1, options.passesPerFlush));
+  return uint32_t(std::max(1, options.samplesPerFold));
 }
 
 }  // namespace pt

@@ -17,8 +17,10 @@ namespace pt {
 
 struct VulkanRenderOptions : RenderOptions {
   ContextOptions context;
-  int samplesPerPass = 1;   // samples per pixel in one dispatch (see --samples-per-pass)
-  int passesPerFlush = 16;  // passes accumulated in float on the device before a fold
+  // Samples per pixel in one dispatch (see --samples-per-pass); 0: chosen as the render goes,
+  // as many as keep a dispatch short (see renderVulkan). The image does not depend on it.
+  int samplesPerPass = 0;
+  int samplesPerFold = 16;  // samples summed in float on the device before a fold (a batch)
   bool specialize = true;   // false: every effect compiled in (to measure what it saves)
   int debugPixelX = -1, debugPixelY = -1;  // print this pixel's paths (needs debugPrintf)
   // A batch a previous render left open (from a film state): it must end at firstSample; its
@@ -44,12 +46,11 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
                                Film& film);
 
 // What of `options` determines the image's bits beyond the scene's settings, for film state
-// files: the batch structure (samples per pass, passes per fold), specialisation, and a hash
-// of the shader's SPIR-V.
+// files: the batch size (samples per fold), specialisation, and a hash of the shader's SPIR-V.
 KeyValues vulkanImageSettings(const VulkanRenderOptions& options);
 
-// Sample indices per batch (samplesPerPass * passesPerFlush): a render split where no batch
-// is split sums to the bits of one render.
+// Sample indices per batch (samplesPerFold): a render split where no batch is split sums to
+// the bits of one render.
 uint32_t vulkanBatchSize(const VulkanRenderOptions& options);
 
 }  // namespace pt
