@@ -4,7 +4,9 @@
 #  - the agreement and device traversal tests (validation off: the layers may be missing);
 #  - the Cornell box and the seed's scene (bunny and dragon, when its meshes are at hand) at
 #    1024x1024, each on the GPU (GPU_SPP) and on the CPU reference with every core (CPU_SPP),
-#    so that the GPU/CPU ratio is taken on one machine in one run;
+#    so that the GPU/CPU ratio is taken on one machine in one run; and on the GPU once more
+#    with one sample per dispatch (--samples-per-pass 1: no path regeneration), to tell what
+#    regeneration is worth there;
 #  - `pt diff` of the GPU's image against the CPU's at CPU_SPP: the same samples, so what
 #    differs is floating-point divergence.
 #
@@ -101,6 +103,8 @@ for scene in "${scenes[@]}"; do
   common=("$out/$scene.json" --width "$size" --height "$size")
   run build/pt render "${common[@]}" --spp "$gpu_spp" --out "$out/$scene-gpu.exr" |
     tee "$out/$scene-gpu.txt"
+  run build/pt render "${common[@]}" --spp "$gpu_spp" --samples-per-pass 1 \
+    --out "$out/$scene-gpu-k1.exr" >"$out/$scene-gpu-k1.txt"
   run build/pt render "${common[@]}" --spp "$cpu_spp" --out "$out/$scene-gpu-$cpu_spp.exr" \
     >"$out/$scene-gpu-$cpu_spp.txt"
   run build/pt render "${common[@]}" --backend cpu --spp "$cpu_spp" \
@@ -111,16 +115,18 @@ for scene in "${scenes[@]}"; do
   relmse=$(sed -n 's/.* relmse=\([^ ]*\).*/\1/p' "$out/$scene-diff.txt")
   device=$(sed -n 's/.* device="\([^"]*\)".*/\1/p' "$out/$scene-gpu.txt" | tr ' ' '_')
   rows+=("$scene $(field 'Mrays/s' "$out/$scene-gpu.txt") $(field 'Mrays/s' "$out/$scene-cpu.txt") \
-${device:-?} ${relmse:-?}")
+${device:-?} ${relmse:-?} $(field 'Mrays/s' "$out/$scene-gpu-k1.txt")")
 done
 
-printf '\n%-14s %12s %12s %9s %12s  %s\n' scene 'GPU Grays/s' 'CPU Grays/s' 'GPU/CPU' \
-  'relMSE' device
+printf '\n%-14s %12s %12s %9s %12s %16s  %s\n' scene 'GPU Grays/s' 'CPU Grays/s' 'GPU/CPU' \
+  'relMSE' 'GPU 1/dispatch' device
 for row in "${rows[@]}"; do
   awk -v r="$row" 'BEGIN {
     split(r, f, " ")
-    printf "%-14s %12.3f %12.4f %9.1f %12s  %s\n", f[1], f[2] / 1000, f[3] / 1000, f[2] / f[3], f[5], f[4]
+    printf "%-14s %12.3f %12.4f %9.1f %12s %16.3f  %s\n", f[1], f[2] / 1000, f[3] / 1000, f[2] / f[3],
+      f[5], f[6] / 1000, f[4]
   }'
 done
 echo "GPU at $gpu_spp spp, CPU reference at $cpu_spp spp on every core, ${size}x$size; relMSE:" \
-  "GPU against CPU at $cpu_spp spp. Files in $out"
+  "GPU against CPU at $cpu_spp spp; GPU 1/dispatch: Grays/s with one sample per dispatch." \
+  "Files in $out"
