@@ -234,18 +234,33 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
   std::barrier sync(stats.threads);
   int passIndex = 0;      // written by the main thread between passes only
   bool finished = false;  // likewise
-  std::atomic<int> nextTile{0}, tilesDone{0};
+  // Each thread has its share of the tiles, the same in every pass, so that the film entries
+  // it adds to stay in its own core's caches (two cores may not even share a last-level
+  // cache); a thread done with its share helps with the others'. Tiles are numbered column by
+  // column: tiles traced at the same time lie one above the other, so their pixels' film
+  // entries share no cache line, as those of neighbours in a row do at their common edge.
+  struct alignas(64) Share {
+    std::atomic<int> next{0};  // the share's next tile number
+    int end = 0;
+  };
+  std::vector<Share> shares(size_t(stats.threads));
+  std::atomic<int> tilesDone{0};
   std::atomic<bool> dropped{false};
   std::atomic<uint64_t> totalRays{0};
   std::mutex progressMutex;
 
-  auto trace = [&](uint64_t& rays) {
+  auto nextTile = [&](int thread) {
+    for (int s = 0; s < stats.threads; ++s) {
+      Share& share = shares[size_t((thread + s) % stats.threads)];
+      if (share.next.load(std::memory_order_relaxed) >= share.end) continue;
+      const int k = share.next.fetch_add(1, std::memory_order_relaxed);
+      if (k < share.end) return (k % tilesY) * tilesX + k / tilesY;
+    }
+    return -1;  // the pass is done
+  };
+  auto trace = [&](int thread, uint64_t& rays) {
     const uint32_t sampleIndex = options.firstSample + uint32_t(passIndex);
-    for (int k; (k = nextTile.fetch_add(1)) < tileCount;) {
-      // Column by column: the tiles that threads take at the same time lie one above the
-      // other, so their pixels' film entries share no cache line, as those of neighbours in a
-      // row do at their common edge (5 % faster with two threads on the Cornell box).
-      const int tile = (k % tilesY) * tilesX + k / tilesY;
+    for (int tile; (tile = nextTile(thread)) >= 0;) {
       if (stopRequested()) {
         dropped = true;
         break;
@@ -273,18 +288,18 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
       }
     }
   };
-  auto worker = [&] {
+  auto worker = [&](int thread) {
     uint64_t rays = 0;
     for (;;) {
       sync.arrive_and_wait();
       if (finished) break;
-      trace(rays);
+      trace(thread, rays);
       sync.arrive_and_wait();
     }
     totalRays += rays;
   };
   std::vector<std::thread> threads;
-  for (int i = 1; i < stats.threads; ++i) threads.emplace_back(worker);
+  for (int i = 1; i < stats.threads; ++i) threads.emplace_back(worker, i);
 
   // The main thread traces too, and between passes reports progress and checkpoints.
   // However it leaves the loop (a stop, or a checkpoint that throws), the workers are released.
@@ -296,11 +311,14 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
   };
   try {
     for (; passIndex < options.spp && !stopRequested(); ++passIndex) {
-      nextTile = 0;
+      for (int t = 0; t < stats.threads; ++t) {
+        shares[size_t(t)].next = int(int64_t(tileCount) * t / stats.threads);
+        shares[size_t(t)].end = int(int64_t(tileCount) * (t + 1) / stats.threads);
+      }
       tilesDone = 0;
       std::fill(traced.begin(), traced.end(), 0);
       sync.arrive_and_wait();
-      trace(rays);
+      trace(0, rays);
       sync.arrive_and_wait();
       if (dropped) {
         for (int tile = 0; tile < tileCount; ++tile) {
