@@ -154,20 +154,25 @@ bool intersectBox(RayData r, vec3 lo, vec3 hi, float tMax, out float tNear) {
 // the binary traversal's order (host/bvh/traverse.cpp: near child first, the left one on a
 // tie; a child pushed is visited without testing its box again), each box against the
 // closest hit found by then, so the answer is the binary traversal's: the same distance and,
-// where two hits tie, the same triangle. One loop iteration visits an interior node (one
-// fetch serves both children's boxes), then tests the leaf it chose, if any, at once, with
-// the sibling leaf when that is the next to visit, and pops the next thing to visit when
-// nothing is left here. Every loop records how it ended: one that ends other than by its own
-// break was cut short by lavapipe's silent loop-iteration cap, and sets gTruncated.
+// where two hits tie, the same triangle. A node visit (one fetch serves both children's
+// boxes) chooses what comes next: the leaves it meets are tested at once, the near one, then
+// the far one when that is the next to visit, and when nothing is left here the next thing
+// to visit comes off the stack. One loop iteration takes one step of that: it visits a node
+// or tests one triangle, both read by the same four texel fetches from the traversal's
+// buffer (a node's four, or a triangle's three and one more; see gpuTraversalTexels), so a
+// lavapipe vector's lanes share the fetches and the two steps' arithmetic whichever step each
+// takes. Every loop records how it ended: one that ends other than by its own break was cut
+// short by lavapipe's silent loop-iteration cap, and sets gTruncated.
 bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData best) {
   RayData r = prepareRay(origin, direction);
   best.t = tMax;
   best.barycentrics = vec3(0.0);
   best.triangle = 0u;
   float tNear;
-  // Node 0 holds the root's box and reference.
+  // Node 0 holds the root's box and reference, and where the triangles start.
   GpuBvhNode root = loadNode(0u);
   if (!intersectBox(r, root.leftMin, root.leftMax, tMax, tNear)) return false;
+  int triangleTexels = int(root.reserved0);
   // The stack of what to visit later, in variables rather than an array: stack0.x is the top,
   // then stack0.y, ..., stack1.x, ...; a push shifts every entry down one place, a pop up.
   // Lavapipe reads and writes a local array lane by lane, with a branch on each lane's mask,
@@ -179,76 +184,91 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
   uvec4 stack8 = uvec4(0u), stack9 = uvec4(0u), stack10 = uvec4(0u), stack11 = uvec4(0u);
   uvec4 stack12 = uvec4(0u), stack13 = uvec4(0u), stack14 = uvec4(0u), stack15 = uvec4(0u);
   uint stackSize = 0u;
-  uint ref = root.left;  // what to visit next: an interior node or a leaf, never 0 here
+  uint ref = root.left;  // the interior node to visit once no triangle is left, or 0
+  // The triangles to test first: [first, end), then [first2, end2) (a leaf, then its sibling).
+  uint first = 0u, end = 0u, first2 = 0u, end2 = 0u;
+  if ((ref & kGpuBvhLeaf) != 0u) {
+    first = (ref & ~kGpuBvhLeaf) >> kGpuBvhCountBits;
+    end = first + (ref & kGpuBvhMaxLeafCount);
+    ref = 0u;
+  }
   bool found = false;
   for (;;) {
     gLoopIterations++;
-    uint near = ref;  // to go on with: an interior node, a leaf, or 0 for none
-    uint far = 0u;    // to visit after near and everything below it, or 0
-    if ((ref & kGpuBvhLeaf) == 0u) {
-      // Interior: the children that the ray enters, nearer first.
-      GpuBvhNode node = loadNode(ref);
+    bool testing = first < end;
+    int at = testing ? triangleTexels + 3 * int(first) : 4 * int(ref);
+    uvec4 a = texelFetch(nodeTexels, at);
+    uvec4 b = texelFetch(nodeTexels, at + 1);
+    uvec4 c = texelFetch(nodeTexels, at + 2);
+    uvec4 d = texelFetch(nodeTexels, at + 3);
+    if (testing) {
+      // Test the next triangle, shrinking the search range if it is hit.
+      Triangle tri = Triangle(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
+                              uintBitsToFloat(c.xyz), c.w);
+      HitData hit;
+      bool hitTriangle = PT_WATERTIGHT ? intersectTriangle(r, tri, best.t, hit)
+                                       : intersectTriangleFast(r, tri, best.t, hit);
+      hit.triangle = first;
+      best = hitTriangle ? hit : best;
+      found = found || hitTriangle;
+      if (anyHit && found) break;
+      first++;
+      if (first == end) {  // the sibling leaf next, if any
+        first = first2;
+        end = end2;
+        first2 = 0u;
+        end2 = 0u;
+      }
+    } else {
+      // Visit an interior node: the children that the ray enters, nearer first.
+      GpuBvhNode node = GpuBvhNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
+                                   uintBitsToFloat(c.xyz), c.w, uintBitsToFloat(d.xyz), d.w);
       float tLeft, tRight;
       bool hitLeft = intersectBox(r, node.leftMin, node.leftMax, best.t, tLeft);
       bool hitRight = intersectBox(r, node.rightMin, node.rightMax, best.t, tRight);
       bool leftFirst = hitLeft && (!hitRight || tLeft <= tRight);
-      near = hitLeft || hitRight ? (leftFirst ? node.left : node.right) : 0u;
-      far = hitLeft && hitRight ? (leftFirst ? node.right : node.left) : 0u;
-    }
-    // A leaf to go on with is tested in this iteration, and so is the far child when it is a
-    // leaf too, as it is the next thing the binary traversal visits: up to two ranges of
-    // triangles. An interior far child of a leaf is visited next, without a push.
-    uint first = 0u, count = 0u, first2 = 0u, count2 = 0u;
-    if ((near & kGpuBvhLeaf) != 0u) {
-      first = (near & ~kGpuBvhLeaf) >> kGpuBvhCountBits;
-      count = near & kGpuBvhMaxLeafCount;
-      if ((far & kGpuBvhLeaf) != 0u) {
-        first2 = (far & ~kGpuBvhLeaf) >> kGpuBvhCountBits;
-        count2 = far & kGpuBvhMaxLeafCount;
+      uint near = hitLeft || hitRight ? (leftFirst ? node.left : node.right) : 0u;
+      uint far = hitLeft && hitRight ? (leftFirst ? node.right : node.left) : 0u;
+      // A near leaf is tested next, and so is the far child when it is a leaf too, as it is
+      // the next thing the binary traversal visits; an interior far child of a leaf is
+      // visited after them, without a push.
+      if ((near & kGpuBvhLeaf) != 0u) {
+        first = (near & ~kGpuBvhLeaf) >> kGpuBvhCountBits;
+        end = first + (near & kGpuBvhMaxLeafCount);
+        if ((far & kGpuBvhLeaf) != 0u) {
+          first2 = (far & ~kGpuBvhLeaf) >> kGpuBvhCountBits;
+          end2 = first2 + (far & kGpuBvhMaxLeafCount);
+          far = 0u;
+        }
+        near = far;
         far = 0u;
       }
-      near = far;
-      far = 0u;
+      if (far != 0u) {
+        // Push. (The host sizes the stack from the tree; a push that would drop the bottom
+        // entry all the same is reported as a traversal cut short.)
+        if (stackSize == 4u * kStackRows) gTruncated = true;
+        if (kStackRows > 15u) stack15 = uvec4(stack14.w, stack15.xyz);
+        if (kStackRows > 14u) stack14 = uvec4(stack13.w, stack14.xyz);
+        if (kStackRows > 13u) stack13 = uvec4(stack12.w, stack13.xyz);
+        if (kStackRows > 12u) stack12 = uvec4(stack11.w, stack12.xyz);
+        if (kStackRows > 11u) stack11 = uvec4(stack10.w, stack11.xyz);
+        if (kStackRows > 10u) stack10 = uvec4(stack9.w, stack10.xyz);
+        if (kStackRows > 9u) stack9 = uvec4(stack8.w, stack9.xyz);
+        if (kStackRows > 8u) stack8 = uvec4(stack7.w, stack8.xyz);
+        if (kStackRows > 7u) stack7 = uvec4(stack6.w, stack7.xyz);
+        if (kStackRows > 6u) stack6 = uvec4(stack5.w, stack6.xyz);
+        if (kStackRows > 5u) stack5 = uvec4(stack4.w, stack5.xyz);
+        if (kStackRows > 4u) stack4 = uvec4(stack3.w, stack4.xyz);
+        if (kStackRows > 3u) stack3 = uvec4(stack2.w, stack3.xyz);
+        if (kStackRows > 2u) stack2 = uvec4(stack1.w, stack2.xyz);
+        if (kStackRows > 1u) stack1 = uvec4(stack0.w, stack1.xyz);
+        stack0 = uvec4(far, stack0.xyz);
+        stackSize++;
+      }
+      ref = near;
     }
-    if (far != 0u) {
-      // Push. (The host sizes the stack from the tree; a push that would drop the bottom
-      // entry all the same is reported as a traversal cut short.)
-      if (stackSize == 4u * kStackRows) gTruncated = true;
-      if (kStackRows > 15u) stack15 = uvec4(stack14.w, stack15.xyz);
-      if (kStackRows > 14u) stack14 = uvec4(stack13.w, stack14.xyz);
-      if (kStackRows > 13u) stack13 = uvec4(stack12.w, stack13.xyz);
-      if (kStackRows > 12u) stack12 = uvec4(stack11.w, stack12.xyz);
-      if (kStackRows > 11u) stack11 = uvec4(stack10.w, stack11.xyz);
-      if (kStackRows > 10u) stack10 = uvec4(stack9.w, stack10.xyz);
-      if (kStackRows > 9u) stack9 = uvec4(stack8.w, stack9.xyz);
-      if (kStackRows > 8u) stack8 = uvec4(stack7.w, stack8.xyz);
-      if (kStackRows > 7u) stack7 = uvec4(stack6.w, stack7.xyz);
-      if (kStackRows > 6u) stack6 = uvec4(stack5.w, stack6.xyz);
-      if (kStackRows > 5u) stack5 = uvec4(stack4.w, stack5.xyz);
-      if (kStackRows > 4u) stack4 = uvec4(stack3.w, stack4.xyz);
-      if (kStackRows > 3u) stack3 = uvec4(stack2.w, stack3.xyz);
-      if (kStackRows > 2u) stack2 = uvec4(stack1.w, stack2.xyz);
-      if (kStackRows > 1u) stack1 = uvec4(stack0.w, stack1.xyz);
-      stack0 = uvec4(far, stack0.xyz);
-      stackSize++;
-    }
-    // The leaves' triangles in order, shrinking the search range as hits are found.
-    uint k = 0u;
-    for (; k < count + count2; ++k) {
-      gLoopIterations++;
-      uint i = k < count ? first + k : first2 + (k - count);
-      HitData hit;
-      bool hitTriangle = PT_WATERTIGHT ? intersectTriangle(r, loadTriangle(i), best.t, hit)
-                                       : intersectTriangleFast(r, loadTriangle(i), best.t, hit);
-      hit.triangle = i;
-      best = hitTriangle ? hit : best;
-      found = found || hitTriangle;
-      if (anyHit && found) break;
-    }
-    if (anyHit && found) break;
-    if (k < count + count2) gTruncated = true;
-    ref = near;
-    if (ref == 0u) {
+    if (first == end && ref == 0u) {
+      // Nothing left here: the next thing to visit comes off the stack; a leaf is tested next.
       if (stackSize == 0u) break;
       // Pop.
       ref = stack0.x;
@@ -269,10 +289,15 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
       if (kStackRows > 14u) stack14 = uvec4(stack14.yzw, stack15.x);
       if (kStackRows > 15u) stack15 = uvec4(stack15.yzw, 0u);
       stackSize--;
+      if ((ref & kGpuBvhLeaf) != 0u) {
+        first = (ref & ~kGpuBvhLeaf) >> kGpuBvhCountBits;
+        end = first + (ref & kGpuBvhMaxLeafCount);
+        ref = 0u;
+      }
     }
   }
   // Ended by a break: a hit found for any-hit, or nothing left. (A flag set at each break
   // would not do: the compiler folds it to true, having seen no other way out.)
-  if (!(anyHit && found) && !(ref == 0u && stackSize == 0u)) gTruncated = true;
+  if (!(anyHit && found) && !(first == end && ref == 0u && stackSize == 0u)) gTruncated = true;
   return found;
 }

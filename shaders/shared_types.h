@@ -57,7 +57,7 @@ struct GpuBvhNode {
   vec3 leftMax;    // 12 bytes: upper corner
   uint right;      //  4 bytes: reference to the right child
   vec3 rightMin;   // 12 bytes: the right child's box, lower corner
-  uint reserved0;  //  4 bytes: zero
+  uint reserved0;  //  4 bytes: zero; node 0: the traversal texel where the triangles start
   vec3 rightMax;   // 12 bytes: upper corner
   uint reserved1;  //  4 bytes: zero
 };                 // 64 bytes
@@ -149,7 +149,7 @@ struct RenderParams {
 // takes a loop over the lanes with a branch per lane and component. The rest are storage
 // buffers.
 #define PT_BINDING_PARAMS 0     // RenderParams
-#define PT_BINDING_NODES 1      // GpuBvhNode[], texels
+#define PT_BINDING_NODES 1      // GpuBvhNode[], then Triangle[] (gpuTraversalTexels), texels
 #define PT_BINDING_TRIANGLES 2  // Triangle[], texels
 #define PT_BINDING_MATERIALS 3  // Material[], texels
 #define PT_BINDING_EMITTERS 4   // Emitter[], texels (one dummy entry when the scene has none)

@@ -170,6 +170,24 @@ TEST(GpuBvhLayout, IsDeterministic) {
   EXPECT_EQ(a.maxDepth, b.maxDepth);
 }
 
+TEST(GpuBvhLayout, TraversalTexelsHoldTheNodesThenTheTrianglesThenAZeroTexel) {
+  const Bvh bvh = buildBvh(test::loadBunny());
+  const GpuBvh gpu = buildGpuBvh(bvh);
+  const std::vector<uint32_t> words = gpuTraversalTexels(gpu, bvh.triangles);
+  const size_t nodeWords = gpu.nodes.size() * 16, triangleWords = bvh.triangles.size() * 12;
+  ASSERT_EQ(words.size(), nodeWords + triangleWords + 4);
+  std::vector<GpuBvhNode> nodes(gpu.nodes.size());
+  std::memcpy(nodes.data(), words.data(), nodeWords * sizeof(uint32_t));
+  // Node 0's reserved0: the texel where the triangles start; every other word as built.
+  EXPECT_EQ(nodes[0].reserved0, uint32_t(nodeWords / 4));
+  nodes[0].reserved0 = gpu.nodes[0].reserved0;
+  EXPECT_EQ(std::memcmp(nodes.data(), gpu.nodes.data(), nodeWords * sizeof(uint32_t)), 0);
+  EXPECT_EQ(std::memcmp(words.data() + nodeWords, bvh.triangles.data(),
+                        triangleWords * sizeof(uint32_t)),
+            0);
+  for (size_t i = nodeWords + triangleWords; i < words.size(); ++i) EXPECT_EQ(words[i], 0u);
+}
+
 // A binary tree of `depth` interior nodes in a chain, each with a one-triangle leaf on the
 // right, ending in a leaf of `lastLeaf` triangles (boxes: the unit cube).
 Bvh chainTree(int depth, uint32_t lastLeaf) {

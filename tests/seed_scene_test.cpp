@@ -11,6 +11,7 @@
 #include "test_util.h"
 #include "vulkan/backend.h"
 #include "vulkan/context.h"
+#include "vulkan/gpu_bvh.h"
 
 namespace pt {
 namespace {
@@ -29,10 +30,11 @@ TEST(SeedScene, BunnyAndDragonRenderAndAgreeOnBothBackends) {
   expectAgreement(c);
 }
 
-// A generated mesh whose triangle buffer (3M x 48 bytes = 137 MiB) is larger than
-// lavapipe's 128 MiB maxStorageBufferRange is refused with the sizes and the limit before
-// any buffer is allocated; a device with a larger limit renders it instead.
-TEST(VulkanLimits, TriangleBufferBeyondTheDeviceLimitIsRefusedWithTheNumbers) {
+// A generated mesh whose buffers (the triangles: 3M x 48 bytes = 137 MiB; the traversal's
+// nodes and triangles: 188 MiB) are larger than lavapipe's 128 MiB maxStorageBufferRange is
+// refused with the sizes and the limit before any buffer is allocated; a device with a
+// larger limit renders it instead.
+TEST(VulkanLimits, SceneBuffersBeyondTheDeviceLimitAreRefusedWithTheNumbers) {
   constexpr int kSide = 1225;  // 2 * 1225^2 = 3,001,250 triangles
   Scene scene;
   scene.camera.position = vec3(0.5f, 0.5f, -2.0f);
@@ -53,11 +55,13 @@ TEST(VulkanLimits, TriangleBufferBeyondTheDeviceLimitIsRefusedWithTheNumbers) {
   test::addQuad(scene, vec3(0.5f, 0.5f, -1.0f), vec3(0.2f, 0, 0), vec3(0, 0.2f, 0), 1);
   for (uint i = 0; i < scene.triangles.size(); ++i) scene.triangles[i].primitive = i;
   const SceneData data = prepareScene(scene, RenderSettings{});
-  const uint64_t triangleBytes = data.bvh.triangles.size() * sizeof(Triangle);
+  // The largest buffer: the traversal's, nodes and triangles (gpu_bvh.h).
+  const uint64_t traversalBytes =
+      gpuTraversalTexels(buildGpuBvh(data.bvh), data.bvh.triangles).size() * sizeof(uint32_t);
 
   VulkanContext ctx(ContextOptions{});
   Film film(8, 8);
-  if (ctx.limits.maxStorageBufferRange >= triangleBytes) {
+  if (ctx.limits.maxStorageBufferRange >= traversalBytes) {
     const VulkanRenderStats stats = renderVulkan(data, validatedOptions(1), film);
     EXPECT_EQ(stats.invalidSamples, 0u);
     return;
@@ -67,7 +71,8 @@ TEST(VulkanLimits, TriangleBufferBeyondTheDeviceLimitIsRefusedWithTheNumbers) {
     FAIL() << "expected an error";
   } catch (const InputError& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("the triangle buffer is " + std::to_string(triangleBytes >> 20) + " MiB"),
+    EXPECT_NE(m.find("the BVH node and triangle buffer is " + std::to_string(traversalBytes >> 20) +
+                     " MiB"),
               std::string::npos)
         << m;
     EXPECT_NE(m.find("maxStorageBufferRange is " +

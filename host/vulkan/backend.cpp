@@ -55,6 +55,7 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   const std::vector<Emitter> emitters =
       scene.emitters.empty() ? std::vector<Emitter>{Emitter{}} : scene.emitters;
   const GpuBvh bvh = buildGpuBvh(scene.bvh);
+  const std::vector<uint32_t> traversal = gpuTraversalTexels(bvh, scene.bvh.triangles);
   struct Upload {
     const char* what;
     const void* data;
@@ -64,7 +65,7 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   // In PT_BINDING_* order, followed by the accumulation and the counters.
   const Upload uploads[] = {
       {"parameter", &scene.params, sizeof(RenderParams), false},
-      {"BVH node", bvh.nodes.data(), bvh.nodes.size() * sizeof(GpuBvhNode), true},
+      {"BVH node and triangle", traversal.data(), traversal.size() * sizeof(uint32_t), true},
       {"triangle", scene.bvh.triangles.data(), scene.bvh.triangles.size() * sizeof(Triangle), true},
       {"material", scene.materials.data(), scene.materials.size() * sizeof(Material), true},
       {"emitter", emitters.data(), emitters.size() * sizeof(Emitter), true},

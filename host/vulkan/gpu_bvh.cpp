@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <string>
 
 #include "common/check.h"
@@ -91,6 +94,24 @@ GpuBvh buildGpuBvh(const Bvh& bvh) {
                      std::to_string(kBvhStackSize) + " (use a smaller --leaf-size)");
   }
   return gpu;
+}
+
+std::vector<uint32_t> gpuTraversalTexels(const GpuBvh& gpu,
+                                         const std::vector<Triangle>& triangles) {
+  static_assert(sizeof(GpuBvhNode) == 64 && sizeof(Triangle) == 48);
+  const size_t nodeWords = gpu.nodes.size() * 16, triangleWords = triangles.size() * 12;
+  if ((nodeWords + triangleWords) / 4 + 1 > size_t(INT32_MAX)) {
+    throw InputError("scene too large for the Vulkan backend: " + std::to_string(triangles.size()) +
+                     " triangles and " + std::to_string(gpu.nodes.size()) +
+                     " BVH nodes exceed 2^31 texels");
+  }
+  std::vector<uint32_t> words(nodeWords + triangleWords + 4, 0u);
+  std::memcpy(words.data(), gpu.nodes.data(), nodeWords * sizeof(uint32_t));
+  std::memcpy(words.data() + nodeWords, triangles.data(), triangleWords * sizeof(uint32_t));
+  // node 0's reserved0 (word 11): the first texel of the triangles.
+  static_assert(offsetof(GpuBvhNode, reserved0) == 11 * sizeof(uint32_t));
+  words[11] = uint32_t(nodeWords / 4);
+  return words;
 }
 
 }  // namespace pt

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "bvh/bvh.h"
@@ -28,6 +29,14 @@ struct GpuBvh {
 // Throws InputError for a tree the layout cannot address (more than 2^27 triangles) or
 // whose split leaves make it deeper than the traversal stack.
 GpuBvh buildGpuBvh(const Bvh& bvh);
+
+// The buffer the shader's traversal reads (PT_BINDING_NODES), as 32-bit words: the nodes,
+// then a copy of the triangles, then one zero texel; node 0's reserved0 holds the texel
+// where the triangles start. Each step of the traversal reads four texels at one place, a
+// node's four or a triangle's three and the next (the zero texel after the last triangle),
+// so that a node visit and a triangle test share the fetches (bvh.glsl). Throws InputError
+// when the texels cannot be addressed by a 32-bit int.
+std::vector<uint32_t> gpuTraversalTexels(const GpuBvh& gpu, const std::vector<Triangle>& triangles);
 
 // The rows of four stack entries the shader's traversal needs for this tree (its
 // specialization constant PT_SPEC_STACK_ROWS): one entry per interior node above the one

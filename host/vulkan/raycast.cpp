@@ -16,12 +16,13 @@ std::vector<RayResult> traceRaysVulkan(const Bvh& bvh, const std::vector<RayQuer
   if (queries.empty()) return results;
   VulkanContext ctx(options);
   const GpuBvh gpu = buildGpuBvh(bvh);
+  const std::vector<uint32_t> traversal = gpuTraversalTexels(gpu, bvh.triangles);
   using U = vk::BufferUsageFlagBits;
   const vk::DeviceSize sizes[] = {
-      gpu.nodes.size() * sizeof(GpuBvhNode), bvh.triangles.size() * sizeof(Triangle),
+      traversal.size() * sizeof(uint32_t), bvh.triangles.size() * sizeof(Triangle),
       queries.size() * sizeof(RayQuery), queries.size() * sizeof(RayResult)};
-  const char* names[] = {"BVH node", "triangle", "ray query", "ray result"};
-  const void* data[] = {gpu.nodes.data(), bvh.triangles.data(), queries.data()};
+  const char* names[] = {"BVH node and triangle", "triangle", "ray query", "ray result"};
+  const void* data[] = {traversal.data(), bvh.triangles.data(), queries.data()};
   // The nodes and the triangles are read as texels, as in the path tracer (shared_types.h).
   const bool texels[] = {true, true, false, false};
   for (int i = 0; i < 4; ++i) {
