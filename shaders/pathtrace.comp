@@ -1,5 +1,5 @@
-// The GPU path tracer: one invocation traces a pass's samples of one pixel (one by default)
-// and adds them to the accumulation buffer. The same integrator as host/cpu/integrator.cpp
+// The GPU path tracer: one invocation traces a pass's samples of one pixel (as many as the
+// host chose for the dispatch) and adds them to the accumulation buffer's sums. The same integrator as host/cpu/integrator.cpp
 // (NEE + BSDF sampling with MIS, Russian roulette, Lambertian and mirror), written
 // separately in GLSL; the layouts (shared_types.h) and random numbers (sampling.h) are shared.
 #version 460
