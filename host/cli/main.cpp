@@ -389,14 +389,24 @@ int runDiff(const DiffArgs& args) {
   return agree ? kExitOk : kExitFailure;
 }
 
+// CLI11's PositiveNumber, with a message a user can read ("must be a positive number, not 0")
+// rather than its range up to the largest double.
+const CLI::Validator kPositive(
+    [](std::string& value) -> std::string {
+      double number = 0.0;
+      if (!CLI::detail::lexical_cast(value, number) || !(number > 0.0)) {
+        return "must be a positive number, not " + value;
+      }
+      return {};
+    },
+    "POSITIVE");
+
 // Options both `render` and `converge` take: overrides of the scene's settings.
 void addOverrideOptions(CLI::App* cmd, SceneOverrides& o) {
   cmd->add_option("--seed", o.seed, "Random seed (default: the scene's)")
       ->check(CLI::Range(0LL, 4294967295LL));
-  cmd->add_option("--width", o.width, "Image width (default: the scene's)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--height", o.height, "Image height (default: the scene's)")
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--width", o.width, "Image width (default: the scene's)")->check(kPositive);
+  cmd->add_option("--height", o.height, "Image height (default: the scene's)")->check(kPositive);
   cmd->add_option("--max-depth", o.maxDepth, "Maximum scattering events per path")
       ->check(CLI::Range(0, 100000));
   cmd->add_option(
@@ -440,15 +450,13 @@ int main(int argc, char** argv) {
   render->add_flag("--validation", r.validation, "Enable the Vulkan validation layers");
   render->add_flag("--no-specialize", r.noSpecialize,
                    "Compile every effect into the shader (to measure what specialization saves)");
-  render->add_option("--spp", r.spp, "Samples per pixel (default: the scene's)")
-      ->check(CLI::PositiveNumber);
-  render->add_option("--threads", r.threads, "CPU threads (default: all)")
-      ->check(CLI::PositiveNumber);
+  render->add_option("--spp", r.spp, "Samples per pixel (default: the scene's)")->check(kPositive);
+  render->add_option("--threads", r.threads, "CPU threads (default: all)")->check(kPositive);
   render
       ->add_option("--samples-per-pass", r.samplesPerPass,
                    "Vulkan: samples per pixel in one dispatch (default: as many as keep a "
                    "dispatch to about half a second; lavapipe's loop cap limits it)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   addOverrideOptions(render, r.overrides);
   render->add_option("--debug-pixel", r.debugPixel,
                      "Print pixel X,Y's paths from the CPU reference and from the shader");
@@ -460,7 +468,7 @@ int main(int argc, char** argv) {
   render
       ->add_option("--checkpoint-every", r.checkpointEvery,
                    "Seconds between checkpoints of the film state")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   render->add_option("--resume", r.resume,
                      "Continue the render in this film state to the target spp (checkpoints go "
@@ -476,7 +484,7 @@ int main(int argc, char** argv) {
           ->check(CLI::NonNegativeNumber);
   CLI::Option* taskCount =
       render->add_option("--task-count", r.taskCount, "Number of slices the spp is split into")
-          ->check(CLI::PositiveNumber);
+          ->check(kPositive);
   samples->excludes(taskIndex)->excludes(taskCount)->excludes("--spp");
 
   DiffArgs d;
@@ -510,10 +518,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   converge->add_option("--device", c.device, "Vulkan device: index or part of the name");
   converge->add_option("--max-spp", c.maxSpp, "Largest samples per pixel")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
-  converge->add_option("--threads", c.threads, "CPU threads (default: all)")
-      ->check(CLI::PositiveNumber);
+  converge->add_option("--threads", c.threads, "CPU threads (default: all)")->check(kPositive);
   addOverrideOptions(converge, c.overrides);
   converge->add_flag("--no-specialize", c.noSpecialize, "Vulkan: compile every effect in");
 
