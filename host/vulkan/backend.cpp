@@ -261,14 +261,12 @@ void uploadOpenBatch(const VulkanContext& ctx, const vk::raii::CommandBuffer& cm
           A::eShaderRead | A::eShaderWrite);
 }
 
-}  // namespace
-
 // Samples per pass when the options leave it open: as many as keep a dispatch to about
 // kDispatchSeconds (a stop waits for the dispatch under way) and an invocation's loop
 // iterations to a quarter of lavapipe's cap, judged by the last dispatch (`count` samples,
 // `seconds`, `loopIterations` in its busiest invocation); at most four times the last count
-// and at most a batch. More samples per pass save dispatches and keep a SIMD group's lanes busy:
-// each lane goes on with its next sample as soon as a path ends.
+// and at most a batch. More samples per pass save dispatches and keep a SIMD group's lanes
+// busy: each lane goes on with its next sample as soon as a path ends.
 uint32_t nextSamplesPerPass(uint32_t count, double seconds, uint32_t loopIterations,
                             uint64_t batch) {
   constexpr double kDispatchSeconds = 0.5;
@@ -278,6 +276,8 @@ uint32_t nextSamplesPerPass(uint32_t count, double seconds, uint32_t loopIterati
   const double k = std::min({byTime, byLoops, 4.0 * count, double(batch)});
   return uint32_t(std::max(1.0, std::floor(k)));
 }
+
+}  // namespace
 
 VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions& options,
                                Film& film) {
