@@ -3,9 +3,10 @@
 // with a fixed stack, near child first, closest-hit and any-hit. The same algorithms as
 // host/bvh/traverse.cpp, written for the GPU on the GPU's layout of the same tree
 // (GpuBvhNode, host/vulkan/gpu_bvh.h); the constants kMinDirection and kFarScale come from
-// sampling.h, shared with it. Expects sampling.h, the texel buffers `nodeTexels` and
-// `triangleTexels`, the globals `gLoopIterations` and `gTruncated`, and PT_WATERTIGHT (a
-// boolean expression) to be declared by the including shader.
+// sampling.h, shared with it. Expects sampling.h, the texel buffers `nodeTexels` (the nodes,
+// then the triangles: gpuTraversalTexels) and `triangleTexels`, the globals
+// `gLoopIterations` and `gTruncated`, and PT_WATERTIGHT (a boolean expression) to be
+// declared by the including shader.
 //
 // Written for lavapipe as much as for GPUs: lavapipe runs eight invocations in the lanes of
 // one vector and runs every statement of a loop body on every iteration, both sides of each
