@@ -53,22 +53,33 @@ HWY_INLINE void pcg4d(V& x, V& y, V& z, V& w) {
   // (pcg4d's last step updates w, which no caller reads.)
 }
 
-// bitfieldReverse of each lane: a byte swap by table lookup (within each 128-bit block, so
-// the table repeats), then the nibbles, pairs and bits within each byte, as shared_types.h's
-// C++ version does.
+// bitfieldReverse of each lane: its bytes swapped, then each byte's bits reversed by looking
+// up each of its nibbles in a table of their reversals (byte lookups work within each 128-bit
+// block, so the tables repeat).
 template <class V>
 HWY_INLINE V reverseBits(V v) {
   const hn::DFromV<V> d;
   const hn::Repartition<uint8_t, decltype(d)> d8;
+  const hn::Repartition<uint16_t, decltype(d)> d16;
   alignas(32) static constexpr uint8_t kByteSwap[32] = {3, 2,  1,  0,  7,  6, 5,  4,  11, 10, 9,
                                                         8, 15, 14, 13, 12, 3, 2,  1,  0,  7,  6,
                                                         5, 4,  11, 10, 9,  8, 15, 14, 13, 12};
+  // Nibble n reversed, in a byte's low half (kLow) and its high half (kHigh).
+  alignas(32) static constexpr uint8_t kLow[32] = {
+      0x0, 0x8, 0x4, 0xC, 0x2, 0xA, 0x6, 0xE, 0x1, 0x9, 0x5, 0xD, 0x3, 0xB, 0x7, 0xF,
+      0x0, 0x8, 0x4, 0xC, 0x2, 0xA, 0x6, 0xE, 0x1, 0x9, 0x5, 0xD, 0x3, 0xB, 0x7, 0xF};
+  alignas(32) static constexpr uint8_t kHigh[32] = {0x00, 0x80, 0x40, 0xC0, 0x20, 0xA0, 0x60, 0xE0,
+                                                    0x10, 0x90, 0x50, 0xD0, 0x30, 0xB0, 0x70, 0xF0,
+                                                    0x00, 0x80, 0x40, 0xC0, 0x20, 0xA0, 0x60, 0xE0,
+                                                    0x10, 0x90, 0x50, 0xD0, 0x30, 0xB0, 0x70, 0xF0};
   static_assert(hn::MaxLanes(d8) <= 32);
-  v = hn::BitCast(d, hn::TableLookupBytes(hn::BitCast(d8, v), hn::Load(d8, kByteSwap)));
-  const V m4 = hn::Set(d, 0x0F0F0F0Fu), m2 = hn::Set(d, 0x33333333u), m1 = hn::Set(d, 0x55555555u);
-  v = hn::Or(hn::ShiftLeft<4>(hn::And(v, m4)), hn::And(hn::ShiftRight<4>(v), m4));
-  v = hn::Or(hn::ShiftLeft<2>(hn::And(v, m2)), hn::And(hn::ShiftRight<2>(v), m2));
-  return hn::Or(hn::ShiftLeft<1>(hn::And(v, m1)), hn::And(hn::ShiftRight<1>(v), m1));
+  const auto bytes = hn::TableLookupBytes(hn::BitCast(d8, v), hn::Load(d8, kByteSwap));
+  const auto nibble = hn::Set(d8, uint8_t{0x0F});
+  const auto low = hn::And(bytes, nibble);
+  const auto high = hn::And(hn::BitCast(d8, hn::ShiftRight<4>(hn::BitCast(d16, bytes))), nibble);
+  // The low nibble reversed becomes the high one, and the other way round.
+  return hn::BitCast(d, hn::Or(hn::TableLookupBytes(hn::Load(d8, kHigh), low),
+                               hn::TableLookupBytes(hn::Load(d8, kLow), high)));
 }
 
 template <class V>
