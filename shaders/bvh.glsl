@@ -151,11 +151,13 @@ bool intersectBox(RayData r, vec3 lo, vec3 hi, float tMax, out float tNear) {
   return enter <= exit;
 }
 
-// Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax. The leaves are tested in
-// the binary traversal's order (host/bvh/traverse.cpp: near child first, the left one on a
-// tie; a child pushed is visited without testing its box again), each box against the
-// closest hit found by then, so the answer is the binary traversal's: the same distance and,
-// where two hits tie, the same triangle. A node visit (one fetch serves both children's
+// Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax. The closest hit is the one
+// isCloserHit (sampling.h) prefers, which does not depend on the order the triangles are
+// tested in, so the answer is that of every CPU traversal, on any tree: the same distance
+// and, where two hits tie, the same triangle. Boxes and triangles are tested against
+// searchRange of the closest hit so far. The leaves are visited as host/bvh/traverse.cpp
+// visits them (near child first, the left one on a tie; a child pushed is visited without
+// testing its box again). A node visit (one fetch serves both children's
 // boxes) chooses what comes next: the leaves it meets are tested at once, the near one, then
 // the far one when that is the next to visit, and when nothing is left here the next thing
 // to visit comes off the stack. One loop iteration takes one step of that: it visits a node
@@ -194,6 +196,8 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
     ref = 0u;
   }
   bool found = false;
+  uint bestPrimitive = kNoPrimitive;
+  float range = tMax;  // searchRange of the closest hit so far
   for (;;) {
     gLoopIterations++;
     bool testing = first < end;
@@ -203,15 +207,18 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
     uvec4 c = texelFetch(nodeTexels, at + 2);
     uvec4 d = texelFetch(nodeTexels, at + 3);
     if (testing) {
-      // Test the next triangle, shrinking the search range if it is hit.
+      // Test the next triangle; a hit that isCloserHit prefers shrinks the search range.
       Triangle tri = Triangle(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
                               uintBitsToFloat(c.xyz), c.w);
       HitData hit;
-      bool hitTriangle = PT_WATERTIGHT ? intersectTriangle(r, tri, best.t, hit)
-                                       : intersectTriangleFast(r, tri, best.t, hit);
+      bool hitTriangle = PT_WATERTIGHT ? intersectTriangle(r, tri, range, hit)
+                                       : intersectTriangleFast(r, tri, range, hit);
       hit.triangle = first;
-      best = hitTriangle ? hit : best;
-      found = found || hitTriangle;
+      bool closer = hitTriangle && isCloserHit(hit.t, tri.primitive, best.t, bestPrimitive);
+      best = closer ? hit : best;
+      bestPrimitive = closer ? tri.primitive : bestPrimitive;
+      range = closer ? searchRange(hit.t, tMax) : range;
+      found = found || closer;
       if (anyHit && found) break;
       first++;
       if (first == end) {  // the sibling leaf next, if any
@@ -225,8 +232,8 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
       GpuBvhNode node = GpuBvhNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
                                    uintBitsToFloat(c.xyz), c.w, uintBitsToFloat(d.xyz), d.w);
       float tLeft, tRight;
-      bool hitLeft = intersectBox(r, node.leftMin, node.leftMax, best.t, tLeft);
-      bool hitRight = intersectBox(r, node.rightMin, node.rightMax, best.t, tRight);
+      bool hitLeft = intersectBox(r, node.leftMin, node.leftMax, range, tLeft);
+      bool hitRight = intersectBox(r, node.rightMin, node.rightMax, range, tRight);
       bool leftFirst = hitLeft && (!hitRight || tLeft <= tRight);
       uint near = hitLeft || hitRight ? (leftFirst ? node.left : node.right) : 0u;
       uint far = hitLeft && hitRight ? (leftFirst ? node.right : node.left) : 0u;

@@ -222,6 +222,30 @@ PT_CONST float kMinDirection = 1e-30f;
 PT_CONST float kGamma3 = 3.0f * 5.9604644775390625e-8f / (1.0f - 3.0f * 5.9604644775390625e-8f);
 PT_CONST float kFarScale = 1.0f + 2.0f * kGamma3;
 
+// Which hit a closest-hit query reports, in every traversal (host/bvh/traverse.cpp, the wide
+// tree's host/bvh/wide_traverse.cpp, shaders/bvh.glsl): of the triangles hit with
+// 0 < t < tMax, the one with the smallest t as the triangle test reports it, and of those at
+// the same t the one listed first in the scene (the smallest Triangle::primitive). The rule
+// names one hit of the set whatever order the triangles are tested in, so the answer does
+// not depend on the tree (builder, leaf size, binary or wide) or on the order a traversal
+// visits it in: a ray through an edge shared by two triangles reports the same one on every
+// backend. `t`, `primitive`: a hit; `bestT`, `bestPrimitive`: the closest so far (tMax and
+// kNoPrimitive before the first).
+PT_CONST uint kNoPrimitive = 0xFFFFFFFFu;
+PT_HOT_INLINE bool isCloserHit(float t, uint primitive, float bestT, uint bestPrimitive) {
+  return t < bestT || (t == bestT && primitive < bestPrimitive);
+}
+
+// The range to test boxes and triangles against once the closest hit so far is at `closest`.
+// The triangle tests compare t * det with range * det and report t * det times 1 / det, so
+// a triangle whose reported t equals `closest` (a tie that isCloserHit may still prefer) can
+// fail a test against `closest` itself; widened by kFarScale (1 + 2 gamma(3), more than the
+// three roundings between them) none is lost. Never beyond the query's tMax, which stays
+// exact: what lies at tMax or beyond is not hit.
+PT_HOT_INLINE float searchRange(float closest, float tMax) {
+  return min(closest * kFarScale, tMax);
+}
+
 // ---- Ray origins -----------------------------------------------------------------------
 
 // Moves a ray origin p off its surface along n (unit, on the side the new ray leaves from)

@@ -440,6 +440,154 @@ TEST(WideBvh, WatertightOnAClosedScannedMesh) {
   EXPECT_EQ(differ, 0u);
 }
 
+// A closest-hit answer by the scene's triangles: which one (Triangle::primitive), where and
+// with which barycentrics, bit for bit.
+struct SceneHit {
+  bool found = false;
+  uint32_t tBits = 0, primitive = 0, bary[3] = {0, 0, 0};
+  bool operator==(const SceneHit&) const = default;
+};
+SceneHit sceneHit(const Bvh& bvh, const std::optional<Hit>& hit) {
+  SceneHit h;
+  if (!hit) return h;
+  h.found = true;
+  h.tBits = std::bit_cast<uint32_t>(hit->t);
+  h.primitive = bvh.triangles[hit->triangle].primitive;
+  for (int k = 0; k < 3; ++k) h.bary[k] = std::bit_cast<uint32_t>(hit->barycentrics[k]);
+  return h;
+}
+
+// isCloserHit's rule by brute force: every triangle in scene order, a hit taken when the rule
+// prefers it. (`mesh` is in scene order: mesh[k].primitive == k.)
+SceneHit ruleByBruteForce(const std::vector<Triangle>& mesh, const Ray& ray) {
+  const RayPrecomputed r(ray);
+  Hit best;
+  best.t = INFINITY;
+  uint32_t bestPrimitive = kNoPrimitive;
+  for (const Triangle& tri : mesh) {
+    Hit hit;
+    if (intersectTriangle(r, tri, INFINITY, hit) &&
+        isCloserHit(hit.t, tri.primitive, best.t, bestPrimitive)) {
+      best = hit;
+      bestPrimitive = tri.primitive;
+    }
+  }
+  SceneHit h;
+  if (bestPrimitive == kNoPrimitive) return h;
+  h.found = true;
+  h.tBits = std::bit_cast<uint32_t>(best.t);
+  h.primitive = bestPrimitive;
+  for (int k = 0; k < 3; ++k) h.bary[k] = std::bit_cast<uint32_t>(best.barycentrics[k]);
+  return h;
+}
+
+// The closest-hit rule (isCloserHit, sampling.h: the smallest t, then the triangle listed
+// first) names one hit whatever order a traversal tests the triangles in. So every tree
+// (builder, leaf size), binary or wide, on every instruction set, gives the same answer bit
+// for bit, on rays through the bunny's shared vertices and edges, where two triangles often
+// report the same distance; and it is the rule's answer by brute force.
+TEST(ClosestHitRule, TheSameHitOnEveryTreeAndEveryTraversal) {
+  const std::vector<Triangle> bunny = loadBunny();
+  for (uint32_t k = 0; k < bunny.size(); ++k) ASSERT_EQ(bunny[k].primitive, k);
+  const Bvh reference = buildBvh(bunny, BvhBuildOptions{4, BvhBuilder::kPloc});
+  std::vector<Ray> rays;
+  for (const RayQuery& q :
+       test::aimedRays(reference.triangles, test::interiorPoints(reference, 4, 2))) {
+    rays.push_back(Ray{q.origin, q.direction});
+  }
+  ASSERT_GE(rays.size(), 100000u);
+  rays.resize(size_t(test::kBruteForceRays));  // 100k (20k under the sanitizers)
+  std::vector<SceneHit> expected(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i)
+    expected[i] = sceneHit(reference, closestHit(reference, rays[i]));
+  // The rule by brute force on every 200th ray, and how many of those tie.
+  size_t ties = 0, wrong = 0;
+  for (size_t i = 0; i < rays.size(); i += 200) {
+    const SceneHit rule = ruleByBruteForce(bunny, rays[i]);
+    wrong += !(rule == expected[i]);
+    const RayPrecomputed r(rays[i]);
+    int atClosest = 0;
+    for (const Triangle& tri : bunny) {
+      Hit hit;
+      atClosest +=
+          intersectTriangle(r, tri, INFINITY, hit) && std::bit_cast<uint32_t>(hit.t) == rule.tBits;
+    }
+    ties += atClosest > 1;
+  }
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_GT(ties, 50u);  // the rays do tie
+  struct Tree {
+    BvhBuilder builder;
+    int leafSize;
+  };
+  for (const Tree tree : {Tree{BvhBuilder::kPloc, 1}, Tree{BvhBuilder::kPloc, 8},
+                          Tree{BvhBuilder::kLbvh, 3}, Tree{BvhBuilder::kBinnedSah, 2}}) {
+    SCOPED_TRACE(builderName(tree.builder) + ", leaf size " + std::to_string(tree.leafSize));
+    const Bvh bvh = buildBvh(bunny, BvhBuildOptions{tree.leafSize, tree.builder});
+    const WideBvh wide = buildWideBvh(bvh);
+    size_t binaryDiffers = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      binaryDiffers += !(sceneHit(bvh, closestHit(bvh, rays[i])) == expected[i]);
+    }
+    EXPECT_EQ(binaryDiffers, 0u);
+    forEachTarget([&] {
+      size_t wideDiffers = 0;
+      for (size_t i = 0; i < rays.size(); ++i) {
+        wideDiffers += !(sceneHit(bvh, closestHit(wide, rays[i])) == expected[i]);
+      }
+      EXPECT_EQ(wideDiffers, 0u);
+    });
+  }
+}
+
+// Where two triangles coincide (the same vertices, so every ray meets both at the same t),
+// every traversal reports the one listed first in the scene, whichever of the pair the tree
+// puts first: half the pairs list the copy first.
+TEST(ClosestHitRule, CoincidentTrianglesGoToTheOneListedFirst) {
+  std::vector<Triangle> grid;
+  const int n = 24;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const vec3 a(i, j, 0), b(i + 1, j, 0), c(i, j + 1, 0), d(i + 1, j + 1, 0);
+      for (const Triangle& t :
+           {Triangle{a, 0, b, kNoEmitter, d, 0}, Triangle{a, 0, d, kNoEmitter, c, 0}}) {
+        // The pair: original (material 0) and copy (material 1), in either order.
+        Triangle copy = t;
+        copy.material = 1;
+        const bool copyFirst = (i + j) % 2 == 1;
+        grid.push_back(copyFirst ? copy : t);
+        grid.push_back(copyFirst ? t : copy);
+      }
+    }
+  }
+  for (uint32_t k = 0; k < grid.size(); ++k) grid[k].primitive = k;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 20000; ++i) {
+    const vec3 target(uni(rng) * n, uni(rng) * n, 0.0f);
+    const vec3 origin(uni(rng) * n, uni(rng) * n, i % 2 ? 3.0f : -3.0f);
+    rays.push_back(Ray{origin, target - origin});
+  }
+  for (int leafSize : {1, 2, 4}) {
+    for (BvhBuilder builder : kBuilders) {
+      SCOPED_TRACE(builderName(builder) + ", leaf size " + std::to_string(leafSize));
+      const Bvh bvh = buildBvh(grid, BvhBuildOptions{leafSize, builder});
+      const WideBvh wide = buildWideBvh(bvh);
+      size_t notFirst = 0, missed = 0;
+      for (const Ray& ray : rays) {
+        for (const auto& hit : {closestHit(bvh, ray), closestHit(wide, ray)}) {
+          missed += !hit.has_value();
+          // The first of its pair: an even primitive (pairs are 2k, 2k + 1).
+          notFirst += hit && bvh.triangles[hit->triangle].primitive % 2 != 0;
+        }
+      }
+      EXPECT_EQ(missed, 0u);
+      EXPECT_EQ(notFirst, 0u);
+    }
+  }
+}
+
 TEST(WideBvh, SceneDataBuildsItOnceAndCopiesBuildTheirOwn) {
   Scene scene;
   scene.materials = {Material{vec3(0.5f), kMaterialDiffuse, vec3(0.0f), 0}};

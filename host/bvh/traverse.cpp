@@ -113,23 +113,19 @@ bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best) {
   uint32_t stack[kBvhStackSize];
   uint32_t stackSize = 0;
   uint32_t nodeIndex = 0;
-  bool found = false;
-  float closest = tMax;
+  HitSearch search(tMax);
   for (;;) {
     const BvhNode& node = bvh.nodes[nodeIndex];
     if (node.count > 0) {
-      // Leaf: test its triangles, shrinking the search range as hits are found.
+      // Leaf: test its triangles, taking each hit that isCloserHit prefers.
       for (uint32_t i = node.offset; i < node.offset + node.count; ++i) {
+        const Triangle& tri = bvh.triangles[i];
         Hit hit;
-        const bool hitTriangle = kWatertight
-                                     ? intersectTriangle(r, bvh.triangles[i], closest, hit)
-                                     : intersectTriangleFast(r, bvh.triangles[i], closest, hit);
-        if (hitTriangle) {
-          hit.triangle = i;
-          best = hit;
-          closest = hit.t;
-          found = true;
-          if constexpr (kAnyHit) return true;
+        const bool hitTriangle = kWatertight ? intersectTriangle(r, tri, search.range, hit)
+                                             : intersectTriangleFast(r, tri, search.range, hit);
+        if (hitTriangle && search.offer(hit, i, tri.primitive) && kAnyHit) {
+          best = search.best;
+          return true;
         }
       }
     } else {
@@ -137,10 +133,10 @@ bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best) {
       const uint32_t left = nodeIndex + 1;
       const uint32_t right = node.offset;
       float tLeft = 0.0f, tRight = 0.0f;
-      const bool hitLeft =
-          intersectBox(r, bvh.nodes[left].boundsMin, bvh.nodes[left].boundsMax, closest, tLeft);
-      const bool hitRight =
-          intersectBox(r, bvh.nodes[right].boundsMin, bvh.nodes[right].boundsMax, closest, tRight);
+      const bool hitLeft = intersectBox(r, bvh.nodes[left].boundsMin, bvh.nodes[left].boundsMax,
+                                        search.range, tLeft);
+      const bool hitRight = intersectBox(r, bvh.nodes[right].boundsMin, bvh.nodes[right].boundsMax,
+                                         search.range, tRight);
       if (hitLeft && hitRight) {
         const bool leftFirst = tLeft <= tRight;
         stack[stackSize++] = leftFirst ? right : left;
@@ -155,7 +151,8 @@ bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best) {
     if (stackSize == 0) break;
     nodeIndex = stack[--stackSize];
   }
-  return found;
+  best = search.best;
+  return search.found;
 }
 
 }  // namespace

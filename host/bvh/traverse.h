@@ -5,6 +5,7 @@
 // in GLSL; this is the CPU reference's own copy.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 
 #include "bvh/bvh.h"
@@ -31,6 +32,30 @@ struct Hit {
   float t = 0.0f;
   vec3 barycentrics{0.0f};  // weights of v0, v1, v2
   uint triangle = 0;        // index into Bvh::triangles
+};
+
+// A query's state as its triangle tests update it, for the CPU traversals: the closest hit
+// by the rule every traversal follows (isCloserHit in sampling.h: the answer does not depend
+// on the tree or the visiting order), and the range that boxes and triangles are tested
+// against (searchRange).
+struct HitSearch {
+  float tMax;                             // the query's range, exact
+  float range;                            // what boxes and triangles are tested against
+  Hit best;                               // the closest hit so far (t = tMax before the first)
+  uint32_t bestPrimitive = kNoPrimitive;  // its Triangle::primitive
+  bool found = false;
+  explicit HitSearch(float queryTMax) : tMax(queryTMax), range(queryTMax) { best.t = queryTMax; }
+  // Offers a hit on Bvh::triangles[index], whose Triangle::primitive is `primitive`; takes it
+  // and returns true if isCloserHit prefers it to the closest so far.
+  bool offer(const Hit& hit, uint32_t index, uint32_t primitive) {
+    if (!isCloserHit(hit.t, primitive, best.t, bestPrimitive)) return false;
+    best = hit;
+    best.triangle = index;
+    bestPrimitive = primitive;
+    range = searchRange(best.t, tMax);
+    found = true;
+    return true;
+  }
 };
 
 // Watertight intersection; accepts hits from both sides with 0 < t < tMax.

@@ -100,6 +100,7 @@ class Collapse {
       p.count = std::min(uint32_t(kPacketLanes), first + count - begin);
       for (uint32_t lane = 0; lane < uint32_t(kPacketLanes); ++lane) {
         const Triangle& t = bvh_.triangles[begin + std::min(lane, p.count - 1)];
+        p.primitive[lane] = t.primitive;
         for (int axis = 0; axis < 3; ++axis) {
           p.v[0][axis][lane] = t.v0[axis];
           p.v[1][axis][lane] = t.v1[axis];

@@ -41,26 +41,7 @@ constexpr uint32_t kWideStackSize = 7 * (kBvhStackSize / 3 + 1);
 struct ChildLanes {
   uint32_t hit;             // bit i: the ray enters child i's box within the range
   float enter[kWideLanes];  // entry distances (tNear of intersectBox)
-  // With two or more hits (closest hit only), the binary traversal's order (wide_bvh.h):
-  // bit i of each says whether child i's group comes second at that level: the lane within
-  // its pair (lanes 2k, 2k + 1, under one binary node), its pair within its quad (the two
-  // pairs under one binary node), its quad (lanes 0-3 and 4-7, under N's two children).
-  // The nearer comes first, the left one on a tie, as in traverse.cpp.
-  uint32_t pairSecond = 0, quadSecond = 0, topSecond = 0;
-  // Sort key of child i: its position in that order.
-  uint32_t key(int i) const {
-    return (topSecond >> i & 1u) << 2 | (quadSecond >> i & 1u) << 1 | (pairSecond >> i & 1u);
-  }
 };
-
-// The lanes whose group comes second, from each lane's comparisons of its partner group's
-// entry distance with its own group's, partner < own (partnerLess) and partner <= own
-// (partnerLessEqual): a left group (its lanes in leftLanes) comes second when its partner is
-// nearer, a right group when its partner is nearer or as near, since a tie goes left.
-constexpr uint32_t comesSecond(uint32_t partnerLess, uint32_t partnerLessEqual,
-                               uint32_t leftLanes) {
-  return (partnerLess & leftLanes) | (partnerLessEqual & ~leftLanes & 0xFFu);
-}
 
 #if HWY_TARGET == HWY_SCALAR
 
@@ -73,57 +54,32 @@ struct RayLanes {
   const RayPrecomputed& ray;
 };
 
-template <bool kOrder>
 ChildLanes intersectBoxes(const WideNode& node, const RayLanes& lanes, float tMax) {
   const RayPrecomputed& r = lanes.ray;
   ChildLanes box{};
-  float tMin[3][kWideLanes];
   for (int i = 0; i < kWideLanes; ++i) {
-    float tFar[3];
+    float tMin[3], tFar[3];
     for (int axis = 0; axis < 3; ++axis) {
       // The near plane's distance is min(t0, t1) of intersectBox for a box with lo <= hi
       // (see RayLanes below); an unused lane's inverted box never hits.
       const bool positive = r.invDirection[axis] > 0.0f;
       const float nearPlane = node.bounds[positive ? axis : axis + 3][i];
       const float farPlane = node.bounds[positive ? axis + 3 : axis][i];
-      tMin[axis][i] = (nearPlane - r.origin[axis]) * r.invDirection[axis];
+      tMin[axis] = (nearPlane - r.origin[axis]) * r.invDirection[axis];
       tFar[axis] = (farPlane - r.origin[axis]) * r.invDirection[axis];
     }
-    box.enter[i] = std::max(std::max(tMin[0][i], tMin[1][i]), std::max(tMin[2][i], 0.0f));
+    box.enter[i] = std::max(std::max(tMin[0], tMin[1]), std::max(tMin[2], 0.0f));
     const float exit = std::min(std::min(tFar[0], tFar[1]), std::min(tFar[2], tMax)) * kFarScale;
     if (box.enter[i] <= exit) box.hit |= 1u << i;
-  }
-  if constexpr (kOrder) {
-    // Entry distances of the binary nodes over each pair and each quad of lanes.
-    auto groupEnter = [&](int first, int count) {
-      float m[3];
-      for (int axis = 0; axis < 3; ++axis) {
-        m[axis] = *std::min_element(tMin[axis] + first, tMin[axis] + first + count);
-      }
-      return std::max(std::max(m[0], m[1]), std::max(m[2], 0.0f));
-    };
-    uint32_t less[3] = {0, 0, 0}, lessEqual[3] = {0, 0, 0};
-    for (int level = 0; level < 3; ++level) {
-      const int size = 1 << level;  // lanes per group: 1, 2, 4
-      for (int i = 0; i < kWideLanes; ++i) {
-        const float mine = groupEnter(i & ~(size - 1), size);
-        const float partner = groupEnter((i ^ size) & ~(size - 1), size);
-        less[level] |= (partner < mine ? 1u : 0u) << i;
-        lessEqual[level] |= (partner <= mine ? 1u : 0u) << i;
-      }
-    }
-    box.pairSecond = comesSecond(less[0], lessEqual[0], 0x55u);
-    box.quadSecond = comesSecond(less[1], lessEqual[1], 0x33u);
-    box.topSecond = comesSecond(less[2], lessEqual[2], 0x0Fu);
   }
   return box;
 }
 
 template <bool kAnyHit>
 bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket, uint32_t packetCount,
-                             const RayLanes& lanes, float& closest, Hit& best) {
+                             const RayLanes& lanes, HitSearch& search) {
   return wide_detail::intersectLeafLaneByLane<kAnyHit, /*kWatertight=*/true>(
-      bvh, firstPacket, packetCount, lanes.ray, closest, best);
+      bvh, firstPacket, packetCount, lanes.ray, search);
 }
 
 #else  // vector instructions
@@ -175,78 +131,31 @@ struct RayLanes {
   VB farScale;
 };
 
-// Lane for lane, the values of the other quad (lanes 4-7 for lanes 0-3 and back).
-HWY_INLINE VB otherQuad(const VB (&quads)[kBoxParts], int part) {
-#if HWY_MAX_BYTES >= 32
-  return hn::SwapAdjacentBlocks(quads[part]);
-#else
-  return quads[1 - part];
-#endif
-}
-
 // The slab test of intersectBox on the eight children at once. Unused lanes hold an
-// inverted box (lo = +inf, hi = -inf): its near planes are at +inf, so it never hits and
-// leaves the minima over its group to the other lanes. (The short loops over parts, axes
-// and levels are unrolled by pragma: GCC at -O2 would otherwise keep the arrays of vectors
-// in memory, which measured a third slower.)
-template <bool kOrder>
+// inverted box (lo = +inf, hi = -inf): its near planes are at +inf, so it never hits. (The
+// short loops over parts and axes are unrolled by pragma: GCC at -O2 would otherwise keep
+// the arrays of vectors in memory, which measured a third slower.)
 HWY_INLINE ChildLanes intersectBoxes(const WideNode& node, const RayLanes& ray, float tMax) {
   const DB d;
   const VB zero = hn::Zero(d);
-  VB tMin[kBoxParts][3], enter[kBoxParts];
   ChildLanes box;
   box.hit = 0;
 #pragma GCC unroll 2
   for (int p = 0; p < kBoxParts; ++p) {
     const float* bounds = node.bounds[0] + p * kBoxPartLanes;
-    VB tFar[3];
+    VB tMin[3], tFar[3];
 #pragma GCC unroll 3
     for (int axis = 0; axis < 3; ++axis) {
-      tMin[p][axis] = hn::Mul(hn::Sub(hn::Load(d, bounds + ray.nearRow[axis]), ray.origin[axis]),
-                              ray.invDirection[axis]);
+      tMin[axis] = hn::Mul(hn::Sub(hn::Load(d, bounds + ray.nearRow[axis]), ray.origin[axis]),
+                           ray.invDirection[axis]);
       tFar[axis] = hn::Mul(hn::Sub(hn::Load(d, bounds + ray.farRow[axis]), ray.origin[axis]),
                            ray.invDirection[axis]);
     }
-    enter[p] = hn::Max(hn::Max(tMin[p][0], tMin[p][1]), hn::Max(tMin[p][2], zero));
+    const VB enter = hn::Max(hn::Max(tMin[0], tMin[1]), hn::Max(tMin[2], zero));
     const VB exit = hn::Mul(hn::Min(hn::Min(tFar[0], tFar[1]), hn::Min(tFar[2], hn::Set(d, tMax))),
                             ray.farScale);
-    box.hit |= laneBits(d, hn::Le(enter[p], exit)) << (p * kBoxPartLanes);
-    hn::StoreU(enter[p], d, box.enter + p * kBoxPartLanes);
-  }
-  if constexpr (kOrder) {
-    if ((box.hit & (box.hit - 1u)) != 0) {  // only a choice needs the order
-      // Entry distances of the binary nodes over each pair and each quad of lanes: the
-      // per-axis minima over the group, clamped as intersectBox clamps.
-      VB pairEnter[kBoxParts], quadEnter[kBoxParts];
-#pragma GCC unroll 2
-      for (int p = 0; p < kBoxParts; ++p) {
-        VB pairMin[3], quadMin[3];
-#pragma GCC unroll 3
-        for (int axis = 0; axis < 3; ++axis) {
-          pairMin[axis] = hn::Min(tMin[p][axis], hn::Shuffle2301(tMin[p][axis]));
-          quadMin[axis] = hn::Min(pairMin[axis], hn::Shuffle1032(pairMin[axis]));
-        }
-        pairEnter[p] = hn::Max(hn::Max(pairMin[0], pairMin[1]), hn::Max(pairMin[2], zero));
-        quadEnter[p] = hn::Max(hn::Max(quadMin[0], quadMin[1]), hn::Max(quadMin[2], zero));
-      }
-      // Each lane's group (the lane itself, its pair, its quad) against the partner group.
-      uint32_t less[3] = {0, 0, 0}, lessEqual[3] = {0, 0, 0};
-#pragma GCC unroll 2
-      for (int p = 0; p < kBoxParts; ++p) {
-        const VB mine[3] = {enter[p], pairEnter[p], quadEnter[p]};
-        const VB partner[3] = {hn::Shuffle2301(enter[p]), hn::Shuffle1032(pairEnter[p]),
-                               otherQuad(quadEnter, p)};
-#pragma GCC unroll 3
-        for (int level = 0; level < 3; ++level) {
-          less[level] |= laneBits(d, hn::Lt(partner[level], mine[level])) << (p * kBoxPartLanes);
-          lessEqual[level] |= laneBits(d, hn::Le(partner[level], mine[level]))
-                              << (p * kBoxPartLanes);
-        }
-      }
-      box.pairSecond = comesSecond(less[0], lessEqual[0], 0x55u);
-      box.quadSecond = comesSecond(less[1], lessEqual[1], 0x33u);
-      box.topSecond = comesSecond(less[2], lessEqual[2], 0x0Fu);
-    }
+    box.hit |= laneBits(d, hn::Le(enter, exit)) << (p * kBoxPartLanes);
+    hn::StoreU(enter, d, box.enter + p * kBoxPartLanes);
   }
   return box;
 }
@@ -279,14 +188,14 @@ HWY_NOINLINE void recomputeEdgesInDouble(uint32_t lanes, V ax, V ay, V bx, V by,
 }
 
 // The watertight test (intersectTriangle) on the triangles of one leaf, its packets in
-// order. Each packet's lanes are tested against the closest distance so far, then the
-// accepted ones are taken in lane order against the closest distance as it shrinks, as the
-// scalar loop takes them: a lane that fails against the larger distance fails against a
-// smaller one too (tMax * det is monotonic in tMax), so the result is the scalar loop's.
+// order, each packet's four lanes against the search range at once; the lanes it accepts are
+// then offered to the search in lane order, as the scalar loop offers them. (The range only
+// filters: a lane that the range of a hit taken in between would have rejected is not one
+// that isCloserHit prefers to that hit.)
 template <bool kAnyHit>
 HWY_INLINE bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket,
-                                        uint32_t packetCount, const RayLanes& ray, float& closest,
-                                        Hit& best) {
+                                        uint32_t packetCount, const RayLanes& ray,
+                                        HitSearch& search) {
   const D d;
   const V zero = hn::Zero(d);
   bool found = false;
@@ -327,7 +236,7 @@ HWY_INLINE bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket
     const V bz = hn::Mul(ray.sz, bkz);
     const V cz = hn::Mul(ray.sz, ckz);
     const V t = hn::Add(hn::Add(hn::Mul(u, az), hn::Mul(v, bz)), hn::Mul(w, cz));
-    const V range = hn::Mul(hn::Set(d, closest), det);
+    const V range = hn::Mul(hn::Set(d, search.range), det);
     const M detPositive = hn::Gt(det, zero);
     const M outPositive = hn::Or(hn::Le(t, zero), hn::Ge(t, range));
     const M outNegative = hn::Or(hn::Ge(t, zero), hn::Le(t, range));
@@ -344,25 +253,13 @@ HWY_INLINE bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket
     hn::Store(u, d, ul);
     hn::Store(v, d, vl);
     hn::Store(w, d, wl);
-    // Until a lane is taken, `closest` is the distance the vector test used: its lanes pass
-    // again, and only later ones are tested against the shrunk distance.
-    bool shrunk = false;
     for (uint32_t rest = accepted; rest != 0; rest &= rest - 1u) {
       const int i = std::countr_zero(rest);
-      if (shrunk) {
-        const float laneRange = closest * dl[i];
-        if (dl[i] > 0.0f ? (tl[i] <= 0.0f || tl[i] >= laneRange)
-                         : (tl[i] >= 0.0f || tl[i] <= laneRange)) {
-          continue;
-        }
-      }
-      shrunk = true;
       const float invDet = 1.0f / dl[i];
-      best.t = tl[i] * invDet;
-      best.barycentrics = vec3(ul[i], vl[i], wl[i]) * invDet;
-      best.triangle = packet.first + uint32_t(i);
-      closest = best.t;
-      found = true;
+      Hit hit;
+      hit.t = tl[i] * invDet;
+      hit.barycentrics = vec3(ul[i], vl[i], wl[i]) * invDet;
+      if (search.offer(hit, packet.first + uint32_t(i), packet.primitive[i])) found = true;
     }
   }
   return found;
@@ -374,14 +271,43 @@ HWY_INLINE bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket
 // watertight test costs, so it is left scalar.
 template <bool kAnyHit>
 HWY_NOINLINE bool intersectLeafFast(const WideBvh& bvh, uint32_t firstPacket, uint32_t packetCount,
-                                    const RayPrecomputed& ray, float& closest, Hit& best) {
+                                    const RayPrecomputed& ray, HitSearch& search) {
   return wide_detail::intersectLeafLaneByLane<kAnyHit, /*kWatertight=*/false>(
-      bvh, firstPacket, packetCount, ray, closest, best);
+      bvh, firstPacket, packetCount, ray, search);
+}
+
+// The hit children of a node in the order to visit them: closest-hit queries take them by
+// entry distance, nearest first (its low three bits replaced by the lane, so that keys differ
+// and equal distances go in lane order), any-hit queries, which stop at the first hit
+// wherever it is, as they come. byOrder[k] is the lane visited k-th; returns how many.
+template <bool kAnyHit>
+HWY_INLINE int visitOrder(const ChildLanes& box, uint8_t (&byOrder)[kWideLanes]) {
+  int count = 0;
+  if (kAnyHit || (box.hit & (box.hit - 1u)) == 0) {
+    for (uint32_t rest = box.hit; rest != 0; rest &= rest - 1u) {
+      byOrder[count++] = uint8_t(std::countr_zero(rest));
+    }
+    return count;
+  }
+  uint32_t key[kWideLanes];
+  for (uint32_t rest = box.hit; rest != 0; rest &= rest - 1u) {
+    const int i = std::countr_zero(rest);
+    key[i] = (std::bit_cast<uint32_t>(box.enter[i]) & ~7u) | uint32_t(i);  // enter >= 0
+    ++count;
+  }
+  for (uint32_t rest = box.hit; rest != 0; rest &= rest - 1u) {
+    const int i = std::countr_zero(rest);
+    int rank = 0;
+    for (uint32_t other = box.hit; other != 0; other &= other - 1u) {
+      rank += key[std::countr_zero(other)] < key[i] ? 1 : 0;
+    }
+    byOrder[rank] = uint8_t(i);
+  }
+  return count;
 }
 
 // One loop for both query kinds, as in traverse.cpp, over references to nodes and leaves.
-// The children that the ray enters go on the stack in the binary order (any-hit queries,
-// which stop at the first hit wherever it is, take them as they come), the first on top,
+// The children that the ray enters go on the stack in visitOrder's order, the first on top,
 // and the first is taken off at once; a lone child is visited without the stack. A child
 // taken off the stack is skipped when its entry distance lies beyond the range, which has
 // shrunk since its box was tested: a box test now would miss it.
@@ -395,30 +321,22 @@ bool traverseFromRoot(const WideBvh& bvh, const RayPrecomputed& r, float tMax, H
   };
   Entry stack[kWideStackSize];
   uint32_t stackSize = 0;
-  bool found = false;
-  float closest = tMax;
-  float cull = closest * kFarScale;  // entry distances beyond it: a box test would miss
-  Entry next{0u, 0u, 0.0f};          // the root node (never on the stack: its entry unused)
+  HitSearch search(tMax);
+  float cull = tMax * kFarScale;  // entry distances beyond it: a box test would miss
+  Entry next{0u, 0u, 0.0f};       // the root node (never on the stack: its entry unused)
   for (;;) {
     if (!(next.child & kWideLeaf)) {
       const WideNode& node = bvh.nodes[next.child];
-      const ChildLanes box = intersectBoxes</*kOrder=*/!kAnyHit>(node, lanes, closest);
+      const ChildLanes box = intersectBoxes(node, lanes, search.range);
       if (box.hit != 0) {
-        // The children hit, by their place in the order (their lane, for any-hit queries).
-        uint8_t byKey[kWideLanes];
-        uint32_t keys = 0;
-        for (uint32_t rest = box.hit; rest != 0; rest &= rest - 1u) {
-          const int i = std::countr_zero(rest);
-          const uint32_t key = kAnyHit ? uint32_t(i) : box.key(i);
-          byKey[key] = uint8_t(i);
-          keys |= 1u << key;
-        }
+        uint8_t byOrder[kWideLanes];
+        const int count = visitOrder<kAnyHit>(box, byOrder);
         // All but the first onto the stack, the last first; the first is next.
-        for (; (keys & (keys - 1u)) != 0; keys &= ~(0x80000000u >> std::countl_zero(keys))) {
-          const int i = byKey[31 - std::countl_zero(keys)];
+        for (int k = count - 1; k > 0; --k) {
+          const int i = byOrder[k];
           stack[stackSize++] = Entry{node.child[i], node.packetCount[i], box.enter[i]};
         }
-        const int i = byKey[std::countr_zero(keys)];
+        const int i = byOrder[0];
         next = Entry{node.child[i], node.packetCount[i], box.enter[i]};
         continue;
       }
@@ -426,17 +344,22 @@ bool traverseFromRoot(const WideBvh& bvh, const RayPrecomputed& r, float tMax, H
       const uint32_t first = next.child & ~kWideLeaf;
       const bool hit =
           kWatertight
-              ? intersectLeafWatertight<kAnyHit>(bvh, first, next.packetCount, lanes, closest, best)
-              : intersectLeafFast<kAnyHit>(bvh, first, next.packetCount, r, closest, best);
+              ? intersectLeafWatertight<kAnyHit>(bvh, first, next.packetCount, lanes, search)
+              : intersectLeafFast<kAnyHit>(bvh, first, next.packetCount, r, search);
       if (hit) {
-        if constexpr (kAnyHit) return true;
-        found = true;
-        cull = closest * kFarScale;
+        if constexpr (kAnyHit) {
+          best = search.best;
+          return true;
+        }
+        cull = search.range * kFarScale;
       }
     }
     // Take the next child off the stack.
     do {
-      if (stackSize == 0) return found;
+      if (stackSize == 0) {
+        best = search.best;
+        return search.found;
+      }
       next = stack[--stackSize];
     } while (!kAnyHit && next.enter > cull);
   }
@@ -482,8 +405,8 @@ HWY_AFTER_NAMESPACE();
 namespace pt {
 
 // The traversal above relies on every distance it computes being a number: the near plane
-// standing for min(t0, t1), the minima over lanes for the entry distances of the binary
-// nodes in between, the boxes of those nodes left untested. A ray with a NaN or an infinity
+// standing for min(t0, t1), the entry distances ordering the visits, the boxes of the binary
+// nodes in between left untested. A ray with a NaN or an infinity
 // in it, or without a direction (|d| below kMinDirection on every axis: its sheared
 // coordinates are NaN, and every triangle takes it at t = NaN), breaks that; for those
 // this runs traverse.cpp's loop itself over the wide tree. A binary node is a range of one
@@ -544,28 +467,23 @@ bool traverseAsBinary(const WideBvh& bvh, const Ray& ray, float tMax, Intersecti
   BinaryNode stack[kBvhStackSize];
   uint32_t stackSize = 0;
   BinaryNode node = resolve(bvh, BinaryNode{0, 0, kWideLanes});
-  bool found = false;
-  float closest = tMax;
+  HitSearch search(tMax);
   for (;;) {
     if (node.isLeaf(bvh)) {
       const uint32_t first = bvh.nodes[node.node].child[node.first] & ~kWideLeaf;
       const uint32_t count = bvh.nodes[node.node].packetCount[node.first];
-      const bool hit = test == Intersection::kWatertight
-                           ? wide_detail::intersectLeafLaneByLane<kAnyHit, true>(bvh, first, count,
-                                                                                 r, closest, best)
-                           : wide_detail::intersectLeafLaneByLane<kAnyHit, false>(bvh, first, count,
-                                                                                  r, closest, best);
-      if (hit) {
-        found = true;
-        if constexpr (kAnyHit) return true;
-      }
+      const bool hit =
+          test == Intersection::kWatertight
+              ? wide_detail::intersectLeafLaneByLane<kAnyHit, true>(bvh, first, count, r, search)
+              : wide_detail::intersectLeafLaneByLane<kAnyHit, false>(bvh, first, count, r, search);
+      if (hit && kAnyHit) return true;
     } else {
       const int half = node.size / 2;
       const BinaryNode left = resolve(bvh, BinaryNode{node.node, node.first, half});
       const BinaryNode right = resolve(bvh, BinaryNode{node.node, node.first + half, half});
       float tLeft = 0.0f, tRight = 0.0f;
-      const bool hitLeft = intersectBinaryNode(bvh, r, left, closest, tLeft);
-      const bool hitRight = intersectBinaryNode(bvh, r, right, closest, tRight);
+      const bool hitLeft = intersectBinaryNode(bvh, r, left, search.range, tLeft);
+      const bool hitRight = intersectBinaryNode(bvh, r, right, search.range, tRight);
       if (hitLeft && hitRight) {
         const bool leftFirst = tLeft <= tRight;
         stack[stackSize++] = leftFirst ? right : left;
@@ -580,7 +498,8 @@ bool traverseAsBinary(const WideBvh& bvh, const Ray& ray, float tMax, Intersecti
     if (stackSize == 0) break;
     node = stack[--stackSize];
   }
-  return found;
+  best = search.best;
+  return search.found;
 }
 
 }  // namespace
