@@ -458,16 +458,20 @@ SceneHit sceneHit(const Bvh& bvh, const std::optional<Hit>& hit) {
 }
 
 // isCloserHit's rule by brute force: every triangle in scene order, a hit taken when the rule
-// prefers it. (`mesh` is in scene order: mesh[k].primitive == k.)
-SceneHit ruleByBruteForce(const std::vector<Triangle>& mesh, const Ray& ray) {
+// prefers it; `atBest`: how many triangles the ray meets at the chosen hit's t (2 or more: a
+// tie). (`mesh` is in scene order: mesh[k].primitive == k.)
+SceneHit ruleByBruteForce(const std::vector<Triangle>& mesh, const Ray& ray, int& atBest) {
   const RayPrecomputed r(ray);
   Hit best;
   best.t = INFINITY;
   uint32_t bestPrimitive = kNoPrimitive;
+  atBest = 0;
   for (const Triangle& tri : mesh) {
     Hit hit;
-    if (intersectTriangle(r, tri, INFINITY, hit) &&
-        isCloserHit(hit.t, tri.primitive, best.t, bestPrimitive)) {
+    if (!intersectTriangle(r, tri, INFINITY, hit)) continue;
+    if (hit.t == best.t) ++atBest;
+    if (isCloserHit(hit.t, tri.primitive, best.t, bestPrimitive)) {
+      if (hit.t != best.t) atBest = 1;
       best = hit;
       bestPrimitive = tri.primitive;
     }
@@ -500,22 +504,16 @@ TEST(ClosestHitRule, TheSameHitOnEveryTreeAndEveryTraversal) {
   std::vector<SceneHit> expected(rays.size());
   for (size_t i = 0; i < rays.size(); ++i)
     expected[i] = sceneHit(reference, closestHit(reference, rays[i]));
-  // The rule by brute force on every 200th ray, and how many of those tie.
+  // The rule by brute force on 400 of the rays, and how many of those tie.
   size_t ties = 0, wrong = 0;
-  for (size_t i = 0; i < rays.size(); i += 200) {
-    const SceneHit rule = ruleByBruteForce(bunny, rays[i]);
-    wrong += !(rule == expected[i]);
-    const RayPrecomputed r(rays[i]);
-    int atClosest = 0;
-    for (const Triangle& tri : bunny) {
-      Hit hit;
-      atClosest +=
-          intersectTriangle(r, tri, INFINITY, hit) && std::bit_cast<uint32_t>(hit.t) == rule.tBits;
-    }
-    ties += atClosest > 1;
+  for (size_t i = 0; i < rays.size(); i += rays.size() / 400) {
+    int atBest = 0;
+    wrong += !(ruleByBruteForce(bunny, rays[i], atBest) == expected[i]);
+    ties += atBest > 1;
   }
   EXPECT_EQ(wrong, 0u);
-  EXPECT_GT(ties, 50u);  // the rays do tie
+  EXPECT_GT(ties, 15u);  // the rays do tie
+  std::printf("%zu of 400 rays checked by brute force tie\n", ties);
   struct Tree {
     BvhBuilder builder;
     int leafSize;
