@@ -22,8 +22,9 @@ struct GpuBvh {
 };
 
 // Builds the GPU layout of `bvh`: the same boxes, the same triangle order, so that the
-// shader visits the leaves in the binary traversal's order (host/bvh/traverse.cpp) and gives
-// the same answer to every query. A leaf of more triangles than a reference holds
+// shader visits the leaves in the binary traversal's order (host/bvh/traverse.cpp). (Its
+// answers would be the same in any order: the closest-hit rule, isCloserHit in sampling.h,
+// does not depend on it.) A leaf of more triangles than a reference holds
 // (kGpuBvhMaxLeafCount) is split under nodes whose children's boxes are infinite, which the
 // traversal enters left first at distance 0, so its triangles are still tested in order.
 // Throws InputError for a tree the layout cannot address (more than 2^27 triangles) or
