@@ -1,7 +1,8 @@
 // The GPU path tracer: one invocation traces a pass's samples of one pixel (as many as the
-// host chose for the dispatch) and adds them to the accumulation buffer's sums. The same integrator as host/cpu/integrator.cpp
-// (NEE + BSDF sampling with MIS, Russian roulette, Lambertian and mirror), written
-// separately in GLSL; the layouts (shared_types.h) and random numbers (sampling.h) are shared.
+// host chose for the dispatch) and adds them to the accumulation buffer's sums. The same
+// integrator as host/cpu/integrator.cpp (NEE + BSDF sampling with MIS, Russian roulette,
+// Lambertian and mirror), written separately in GLSL; the layouts (shared_types.h) and random
+// numbers (sampling.h) are shared.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #ifdef PT_DEBUG_PRINTF
