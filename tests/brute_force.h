@@ -33,6 +33,8 @@ struct BruteHit {
   bool found = false;
   float t = INFINITY;
   uint primitive = 0;
+  vec3 barycentrics{0.0f};
+  int atClosest = 0;  // triangles the ray meets at distance t (2 or more: a tie)
 };
 
 struct RandomRays {
@@ -66,8 +68,9 @@ inline RandomRays raysAroundMesh(const std::vector<Triangle>& mesh, int count, u
   return set;
 }
 
-// The closest hit of every ray, every triangle considered (the watertight test), on all
-// cores. A conservative bounding-sphere test skips the exact test where it cannot hit.
+// The closest hit of every ray, every triangle considered (the watertight test), chosen by
+// the traversals' rule (isCloserHit: the smallest t, then the smallest Triangle::primitive),
+// on all cores. A conservative bounding-sphere test skips the exact test where it cannot hit.
 inline std::vector<BruteHit> bruteForceClosestHits(const std::vector<Triangle>& mesh,
                                                    const std::vector<Ray>& rays) {
   std::vector<vec4> spheres;  // centre, squared radius
@@ -80,13 +83,23 @@ inline std::vector<BruteHit> bruteForceClosestHits(const std::vector<Triangle>& 
   auto closest = [&](const Ray& ray) {
     const RayPrecomputed r(ray);
     BruteHit best;
+    const float invLength2 = 1.0f / dot(ray.direction, ray.direction);  // any length
     for (size_t k = 0; k < mesh.size(); ++k) {
       const vec3 v = vec3(spheres[k]) - ray.origin;
       const float vv = dot(v, v), tc = dot(v, ray.direction);
       // Squared distance of the centre from the ray's line, with slack for rounding.
-      if (vv - tc * tc > spheres[k].w + 1e-5f * vv) continue;
+      if (vv - tc * tc * invLength2 > spheres[k].w + 1e-5f * vv) continue;
       Hit h;
-      if (intersectTriangle(r, mesh[k], best.t, h)) best = {true, h.t, mesh[k].primitive};
+      if (!intersectTriangle(r, mesh[k], INFINITY, h)) continue;
+      const bool tie = best.found && h.t == best.t;
+      if (isCloserHit(h.t, mesh[k].primitive, best.t, best.found ? best.primitive : kNoPrimitive)) {
+        best.found = true;
+        best.t = h.t;
+        best.primitive = mesh[k].primitive;
+        best.barycentrics = h.barycentrics;
+        if (!tie) best.atClosest = 0;
+      }
+      if (best.t == h.t) ++best.atClosest;
     }
     return best;
   };

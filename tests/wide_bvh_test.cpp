@@ -457,34 +457,6 @@ SceneHit sceneHit(const Bvh& bvh, const std::optional<Hit>& hit) {
   return h;
 }
 
-// isCloserHit's rule by brute force: every triangle in scene order, a hit taken when the rule
-// prefers it; `atBest`: how many triangles the ray meets at the chosen hit's t (2 or more: a
-// tie). (`mesh` is in scene order: mesh[k].primitive == k.)
-SceneHit ruleByBruteForce(const std::vector<Triangle>& mesh, const Ray& ray, int& atBest) {
-  const RayPrecomputed r(ray);
-  Hit best;
-  best.t = INFINITY;
-  uint32_t bestPrimitive = kNoPrimitive;
-  atBest = 0;
-  for (const Triangle& tri : mesh) {
-    Hit hit;
-    if (!intersectTriangle(r, tri, INFINITY, hit)) continue;
-    if (hit.t == best.t) ++atBest;
-    if (isCloserHit(hit.t, tri.primitive, best.t, bestPrimitive)) {
-      if (hit.t != best.t) atBest = 1;
-      best = hit;
-      bestPrimitive = tri.primitive;
-    }
-  }
-  SceneHit h;
-  if (bestPrimitive == kNoPrimitive) return h;
-  h.found = true;
-  h.tBits = std::bit_cast<uint32_t>(best.t);
-  h.primitive = bestPrimitive;
-  for (int k = 0; k < 3; ++k) h.bary[k] = std::bit_cast<uint32_t>(best.barycentrics[k]);
-  return h;
-}
-
 // The closest-hit rule (isCloserHit, sampling.h: the smallest t, then the triangle listed
 // first) names one hit whatever order a traversal tests the triangles in. So every tree
 // (builder, leaf size), binary or wide, on every instruction set, gives the same answer bit
@@ -505,15 +477,28 @@ TEST(ClosestHitRule, TheSameHitOnEveryTreeAndEveryTraversal) {
   for (size_t i = 0; i < rays.size(); ++i)
     expected[i] = sceneHit(reference, closestHit(reference, rays[i]));
   // The rule by brute force on 400 of the rays, and how many of those tie.
-  size_t ties = 0, wrong = 0;
+  std::vector<Ray> sample;
+  std::vector<SceneHit> sampleExpected;
   for (size_t i = 0; i < rays.size(); i += rays.size() / 400) {
-    int atBest = 0;
-    wrong += !(ruleByBruteForce(bunny, rays[i], atBest) == expected[i]);
-    ties += atBest > 1;
+    sample.push_back(rays[i]);
+    sampleExpected.push_back(expected[i]);
+  }
+  size_t ties = 0, wrong = 0;
+  const std::vector<test::BruteHit> brute = test::bruteForceClosestHits(bunny, sample);
+  for (size_t i = 0; i < sample.size(); ++i) {
+    SceneHit rule;
+    if (brute[i].found) {
+      rule.found = true;
+      rule.tBits = std::bit_cast<uint32_t>(brute[i].t);
+      rule.primitive = brute[i].primitive;
+      for (int k = 0; k < 3; ++k) rule.bary[k] = std::bit_cast<uint32_t>(brute[i].barycentrics[k]);
+    }
+    wrong += !(rule == sampleExpected[i]);
+    ties += brute[i].atClosest > 1;
   }
   EXPECT_EQ(wrong, 0u);
   EXPECT_GT(ties, 15u);  // the rays do tie
-  std::printf("%zu of 400 rays checked by brute force tie\n", ties);
+  std::printf("%zu of %zu rays checked by brute force tie\n", ties, sample.size());
   struct Tree {
     BvhBuilder builder;
     int leafSize;
