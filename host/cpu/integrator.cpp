@@ -270,7 +270,10 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
       uvec2 tilePixels[kTile * kTile];
       vec3 samples[kTile * kTile];
       size_t count = 0;
-      forTilePixels(tile, [&](int x, int y, vec3&) { tilePixels[count++] = uvec2(x, y); });
+      forTilePixels(tile, [&](int x, int y, vec3&) {
+        film.prefetch(x, y);  // on its way while the tile's paths are traced
+        tilePixels[count++] = uvec2(x, y);
+      });
       sampleRadianceLanes(scene, tilePixels, count, sampleIndex, samples, rays);
       count = 0;
       forTilePixels(tile, [&](int x, int y, vec3& sample) {

@@ -117,6 +117,19 @@ struct Film {
     }
   }
 
+  // Asks the processor to bring pixel (x, y)'s entries into its caches ahead of an add():
+  // a render adds to each pixel once per pass, so they are rarely still there, and add()
+  // waits for them (a tenth of the CPU's time on the Cornell box, measured). Only a hint.
+  // Always inlined: GCC 12 deletes calls to a function that only prefetches.
+  [[gnu::always_inline]] void prefetch(int x, int y) const {
+    const size_t i = size_t(y) * size_t(width) + size_t(x);
+    const char* sums = reinterpret_cast<const char*>(&exact[i]);  // 120 bytes: 2 or 3 lines
+    __builtin_prefetch(sums, /*write=*/1);
+    __builtin_prefetch(sums + 64, 1);
+    __builtin_prefetch(sums + sizeof(exact[i]) - 1, 1);
+    __builtin_prefetch(&sampleCount[i], 1);
+  }
+
   // Undoes add(x, y, radiance) exactly, as if it had never been called (the sums are exact
   // integers underneath, so subtracting restores their bits): how a stopped render drops the
   // samples of a pass it did not finish.
