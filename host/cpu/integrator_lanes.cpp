@@ -336,7 +336,10 @@ HWY_INLINE void drawRandom2(bool sobol, const Paths& path, uint sampleIndex, uin
 }
 
 void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t count,
-                             uint32_t sampleIndex, vec3* out, uint64_t& rays) {
+                             uint32_t sampleIndex, vec3* out, uint64_t& raysTraced) {
+  // Counted here and added once at the end: the caller's counter may share a cache line with
+  // what another thread reads, and a store to it per ray moved that line between cores.
+  uint64_t rays = 0;
   const D d;
   const hn::RebindToUnsigned<D> du;
   const size_t lanes = hn::Lanes(d);
@@ -593,6 +596,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
     });
     active = live;
   }
+  raysTraced += rays;
 }
 
 }  // namespace HWY_NAMESPACE
