@@ -241,9 +241,9 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
   // cache); a thread done with its share helps with the others'. Tiles are numbered column by
   // column: tiles traced at the same time lie one above the other, so their pixels' film
   // entries share no cache line, as those of neighbours in a row do at their common edge.
-  // What a thread writes once per tile lies in its own cache line: a line that two cores
-  // write in turn moves between them each time (counting the tiles in one shared counter and
-  // taking a shared lock for progress cost the second thread 8 %).
+  // What a thread writes once per tile lies in its own cache line (a line that two cores
+  // write in turn moves between them each time), so the tiles are counted per thread and only
+  // the main thread reports progress.
   struct alignas(64) Share {
     std::atomic<int> next{0};  // the share's next tile number
     int end = 0;
