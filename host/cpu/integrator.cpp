@@ -215,9 +215,7 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
   const int tilesY = (film.height + kTile - 1) / kTile;
   const int tileCount = tilesX * tilesY;
   std::vector<vec3> pass(film.pixelCount());
-  // Tile k of the shares' numbering (see Share below): tiles are numbered column by column.
-  auto tileOf = [tilesX, tilesY](int k) { return (k % tilesY) * tilesX + k / tilesY; };
-  std::vector<char> traced(static_cast<size_t>(tileCount));  // by k: in the film this pass
+  std::vector<char> traced(static_cast<size_t>(tileCount));  // tiles of this pass in the film
   auto forTilePixels = [&](int tile, auto&& f) {
     const int x0 = (tile % tilesX) * kTile;
     const int y0 = (tile / tilesX) * kTile;
@@ -241,33 +239,28 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
   // cache); a thread done with its share helps with the others'. Tiles are numbered column by
   // column: tiles traced at the same time lie one above the other, so their pixels' film
   // entries share no cache line, as those of neighbours in a row do at their common edge.
-  // What a thread writes once per tile lies in its own cache line (a line that two cores
-  // write in turn moves between them each time), so the tiles are counted per thread and only
-  // the main thread reports progress.
   struct alignas(64) Share {
     std::atomic<int> next{0};  // the share's next tile number
     int end = 0;
-    std::atomic<int> tilesTraced{0};  // by the share's thread, in this pass (for progress)
   };
   std::vector<Share> shares(size_t(stats.threads));
+  std::atomic<int> tilesDone{0};
   std::atomic<bool> dropped{false};
   std::atomic<uint64_t> totalRays{0};
+  std::mutex progressMutex;
 
-  auto nextTile = [&shares, threads = stats.threads](int thread) {
-    for (int s = 0; s < threads; ++s) {
-      Share& share = shares[size_t((thread + s) % threads)];
+  auto nextTile = [&](int thread) {
+    for (int s = 0; s < stats.threads; ++s) {
+      Share& share = shares[size_t((thread + s) % stats.threads)];
       if (share.next.load(std::memory_order_relaxed) >= share.end) continue;
       const int k = share.next.fetch_add(1, std::memory_order_relaxed);
-      if (k < share.end) return k;
+      if (k < share.end) return (k % tilesY) * tilesX + k / tilesY;
     }
     return -1;  // the pass is done
   };
   auto trace = [&](int thread, uint64_t& rays) {
     const uint32_t sampleIndex = options.firstSample + uint32_t(passIndex);
-    Share& own = shares[size_t(thread)];
-    int untold = 0;  // tiles traced since progress was last reported
-    for (int k; (k = nextTile(thread)) >= 0;) {
-      const int tile = tileOf(k);
+    for (int tile; (tile = nextTile(thread)) >= 0;) {
       if (stopRequested()) {
         dropped = true;
         break;
@@ -287,16 +280,14 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
         sample = samples[count++];
         film.add(x, y, sample);
       });
-      traced[size_t(k)] = 1;
-      own.tilesTraced.store(own.tilesTraced.load(std::memory_order_relaxed) + 1,
-                            std::memory_order_relaxed);
-      // The main thread reports progress, every few tiles.
-      if (thread == 0 && options.progress && ++untold == 8) {
-        untold = 0;
-        int done = 0;
-        for (const Share& share : shares) done += share.tilesTraced.load(std::memory_order_relaxed);
-        options.progress((double(passIndex) + double(done) / double(tileCount)) /
-                         double(options.spp));
+      traced[size_t(tile)] = 1;
+      const int done = tilesDone.fetch_add(1) + 1;
+      if (options.progress) {
+        std::unique_lock lock(progressMutex, std::try_to_lock);
+        if (lock.owns_lock()) {
+          options.progress((double(passIndex) + double(done) / double(tileCount)) /
+                           double(options.spp));
+        }
       }
     }
   };
@@ -326,17 +317,16 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
       for (int t = 0; t < stats.threads; ++t) {
         shares[size_t(t)].next = int(int64_t(tileCount) * t / stats.threads);
         shares[size_t(t)].end = int(int64_t(tileCount) * (t + 1) / stats.threads);
-        shares[size_t(t)].tilesTraced = 0;
       }
+      tilesDone = 0;
       std::fill(traced.begin(), traced.end(), 0);
       sync.arrive_and_wait();
       trace(0, rays);
       sync.arrive_and_wait();
       if (dropped) {
-        for (int k = 0; k < tileCount; ++k) {
-          if (traced[size_t(k)]) {
-            forTilePixels(tileOf(k),
-                          [&](int x, int y, vec3& sample) { film.takeBack(x, y, sample); });
+        for (int tile = 0; tile < tileCount; ++tile) {
+          if (traced[size_t(tile)]) {
+            forTilePixels(tile, [&](int x, int y, vec3& sample) { film.takeBack(x, y, sample); });
           }
         }
         break;
