@@ -116,13 +116,8 @@ std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax = I
 bool anyHit(const WideBvh& bvh, const Ray& ray, float tMax,
             Intersection test = Intersection::kWatertight);
 
-// The queries above after their first steps, for callers that take those steps for several
-// rays at once (the lanes integrator): `ray` is RayPrecomputed of a ray that enters the
-// root's box (intersectBox with rootMin, rootMax and tMax) and is not degenerate (no NaN or
-// infinity in it, and a direction: see above; the queries above take those elsewhere).
-bool closestHitPrepared(const WideBvh& bvh, const RayPrecomputed& ray, float tMax,
-                        Intersection test, Hit& hit);
-bool anyHitPrepared(const WideBvh& bvh, const RayPrecomputed& ray, float tMax, Intersection test);
+// (Code compiled per Highway target can call the queries after their first steps, without
+// dispatching: wide_traversal::closestHitFromRoot and anyHitFromRoot in wide_traverse-inl.h.)
 
 // The instruction sets (Highway target bits, best first) that the queries above are compiled
 // for and this CPU runs; the queries use the first. For tests, which make them use each in

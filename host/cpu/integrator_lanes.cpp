@@ -28,6 +28,7 @@
 #include <hwy/highway.h>
 
 #include "bvh/wide_bvh.h"
+#include "bvh/wide_traverse-inl.h"
 #include "cpu/integrator_lanes.h"
 #include "cpu/random_lanes-inl.h"
 
@@ -224,8 +225,8 @@ HWY_INLINE V glmMin(V a, V b) {
 // The wide traversal's first steps for the rays of several lanes at once: RayPrecomputed
 // (traverse.cpp; its six divisions become six vector divisions) and intersectBox against the
 // root's box. Returns the lanes whose ray enters it, their `prepared` filled in for
-// closestHitPrepared or anyHitPrepared; a lane whose ray misses it misses every triangle.
-// Degenerate rays (wide_bvh.h) are neither: they go to `degenerate`, for the ordinary
+// wide_traversal::closestHitFromRoot or anyHitFromRoot; a lane whose ray misses it misses every
+// triangle. Degenerate rays (wide_bvh.h) are neither: they go to `degenerate`, for the ordinary
 // queries.
 HWY_INLINE uint32_t setUpRays(const WideBvh& bvh, const Lanes3& originLanes,
                               const Lanes3& directionLanes, float tMax, uint32_t lanes,
@@ -420,7 +421,8 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
                          intersection);
       } else if (enters >> i & 1u) {
         Hit found;
-        if (closestHitPrepared(copies.wide, prepared[i], INFINITY, intersection, found)) {
+        if (wide_traversal::closestHitFromRoot(copies.wide, prepared[i], INFINITY, intersection,
+                                               found)) {
           hit = found;
         }
       }
@@ -544,7 +546,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
             (shadowDegenerate >> i & 1u)
                 ? anyHit(copies.wide, Ray{shadowFrom.get(i), shadowDir.get(i)}, 1.0f, intersection)
                 : (shadowEnters >> i & 1u) &&
-                      anyHitPrepared(copies.wide, prepared[i], 1.0f, intersection);
+                      wide_traversal::anyHitFromRoot(copies.wide, prepared[i], 1.0f, intersection);
         unoccluded |= uint32_t(!occluded) << i;
       });
       if (unoccluded != 0) {
