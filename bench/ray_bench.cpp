@@ -69,7 +69,7 @@ struct Options {
   int threads = 0;                    // CPU backends; 0: every CPU this process may run on
   std::string device;                 // Vulkan device: index or part of the name
   std::string builder{nameOf(kBuilderNames, kDefaultBuilder)};
-  int leafSize = 4;
+  int leafSize = kDefaultLeafSizeCpu;  // the CPU renderer's tree, for every backend
   double minTime = 0.5;                 // Google Benchmark: least seconds per repetition
   int repetitions = 3;                  // the summary takes the median over these
   size_t gpuMinRays = size_t(1) << 20;  // see RayQueryBackend
@@ -999,7 +999,9 @@ int main(int argc, char** argv) {
                  "BVH builder of our tree (default: the renderer's, " +
                      std::string(pt::nameOf(pt::kBuilderNames, pt::kDefaultBuilder)) + ")")
       ->check(CLI::IsMember(pt::namesOf(pt::kBuilderNames)));
-  app.add_option("--leaf-size", o.leafSize, "Maximum triangles per leaf of our tree")
+  app.add_option("--leaf-size", o.leafSize,
+                 "Maximum triangles per leaf of our tree (default: the CPU renderer's, " +
+                     std::to_string(pt::kDefaultLeafSizeCpu) + ")")
       ->check(CLI::Range(1, 64));
   app.add_option("--min-time", o.minTime, "Least seconds per timed repetition");
   app.add_option("--repetitions", o.repetitions, "Timed repetitions (the median is reported)")

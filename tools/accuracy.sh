@@ -30,17 +30,17 @@ scenes=(cornell-box bunny-box)
 
 # Configurations: label and `pt converge` flags. "baseline" is the scenes' own settings:
 # NEE+MIS, Russian roulette on (from depth 3), max depth 64, Owen-scrambled Sobol numbers,
-# PLOC BVH with the backend's default leaf size (4 on the CPU, 3 with Vulkan), watertight
+# PLOC BVH with the backend's default leaf size (8 on the CPU, 3 with Vulkan), watertight
 # intersection, specialized.
 declare -A flags=(
   [baseline]="" [nee]="--strategy nee" [bsdf]="--strategy bsdf" [rr-off]="--rr off"
   [depth-1]="--max-depth 1" [depth-2]="--max-depth 2" [depth-4]="--max-depth 4"
   [independent]="--sampler independent"
-  [leaf-1]="--leaf-size 1" [leaf-8]="--leaf-size 8" [leaf-16]="--leaf-size 16"
+  [leaf-1]="--leaf-size 1" [leaf-4]="--leaf-size 4" [leaf-16]="--leaf-size 16"
   [lbvh]="--builder lbvh" [sah]="--builder sah" [fast-isect]="--intersection fast"
   [unspecialized]="--no-specialize"
 )
-cpu_labels="baseline nee bsdf rr-off depth-1 depth-2 depth-4 independent leaf-1 leaf-8 leaf-16"
+cpu_labels="baseline nee bsdf rr-off depth-1 depth-2 depth-4 independent leaf-1 leaf-4 leaf-16"
 cpu_labels="$cpu_labels lbvh sah fast-isect"
 vulkan_labels="$cpu_labels unspecialized"
 # Knob groups: file name, title, labels (each plot and table shows one group).
@@ -48,7 +48,7 @@ groups=(
   "strategy|Direct light: NEE+MIS (baseline) vs NEE only vs BSDF only|baseline nee bsdf"
   "depth|Russian roulette on (baseline) / off, max depth 64 (baseline), 4, 2, 1|baseline rr-off depth-4 depth-2 depth-1"
   "sampler|Random numbers: Owen-scrambled Sobol (baseline) vs independent|baseline independent"
-  "leaf|BVH leaf size 1, the default (baseline: 4 on the CPU, 3 with Vulkan), 8, 16|leaf-1 baseline leaf-8 leaf-16"
+  "leaf|BVH leaf size 1, 4, the default (baseline: 8 on the CPU, 3 with Vulkan), 16|leaf-1 leaf-4 baseline leaf-16"
   "builder|BVH builder: PLOC (baseline) vs LBVH vs binned SAH (trace time; build time below)|baseline lbvh sah"
   "intersection|Ray/triangle test: watertight (baseline) vs Moller-Trumbore (not watertight)|baseline fast-isect"
   "specialize|Specialization constants on (baseline) / off, Vulkan only|baseline unspecialized"

@@ -418,7 +418,9 @@ How it is measured:
   camera at 3.4 radii and a small light out of view; it is convex, so its shadow rays are
   rarely occluded and must prove that nothing is in the way.
 - **cpu**: \`closestHit\` / \`anyHit\` of \`host/bvh/traverse.h\` over the tree the renderer builds
-  (the default builder, leaf size 4, unless \`BENCH_ARGS\` says otherwise), the batch spread over the threads.
+  for the CPU (the default builder and leaf size, 8, unless \`BENCH_ARGS\` says otherwise; every
+  backend here traces that tree, though the Vulkan renderer's own default is 3 per leaf), the
+  batch spread over the threads.
 - **cpu-wide**: the same queries over the 8-wide tree collapsed from it (\`host/bvh/wide_bvh.h\`),
   which the CPU renderer traverses.
 - **vulkan**: the ray-query shader (\`shaders/raycast.comp\`, the path tracer's traversal) through
