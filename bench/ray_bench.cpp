@@ -69,7 +69,7 @@ struct Options {
   int threads = 0;                    // CPU backends; 0: every CPU this process may run on
   std::string device;                 // Vulkan device: index or part of the name
   std::string builder{nameOf(kBuilderNames, kDefaultBuilder)};
-  int leafSize = kDefaultLeafSizeCpu;  // the CPU renderer's tree, for every backend
+  int leafSize = kDefaultLeafSizeCpu;   // the CPU renderer's tree, for every backend
   double minTime = 0.5;                 // Google Benchmark: least seconds per repetition
   int repetitions = 3;                  // the summary takes the median over these
   size_t gpuMinRays = size_t(1) << 20;  // see RayQueryBackend
