@@ -223,7 +223,7 @@ PT_CONST float kGamma3 = 3.0f * 5.9604644775390625e-8f / (1.0f - 3.0f * 5.960464
 PT_CONST float kFarScale = 1.0f + 2.0f * kGamma3;
 
 // Which hit a closest-hit query reports, in every traversal (host/bvh/traverse.cpp, the wide
-// tree's host/bvh/wide_traverse.cpp, shaders/bvh.glsl): of the triangles hit with
+// tree's host/bvh/wide_traverse-inl.h, shaders/bvh.glsl): of the triangles hit with
 // 0 < t < tMax, the one with the smallest t as the triangle test reports it, and of those at
 // the same t the one listed first in the scene (the smallest Triangle::primitive). The rule
 // names one hit of the set whatever order the triangles are tested in, so the answer does
