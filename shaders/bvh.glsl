@@ -85,8 +85,14 @@ RayData prepareRay(vec3 origin, vec3 direction) {
 // rejections are combined into the returned condition rather than taken as early returns
 // (each a masked branch on lavapipe), so `hit` means something only when it returns true;
 // the values computed, and so the answer, are those of host/bvh/traverse.cpp, operation for
-// operation. The rare recomputation in double stays a branch, which GPUs skip.
-bool intersectTriangle(RayData r, Triangle tri, float tMax, out HitData hit) {
+// operation. An edge function of exactly zero may be rounding, and the paper recomputes the
+// three in double then. With `exact` this does so (a branch, which GPUs skip); without it,
+// it sets `inexact` instead, and the caller traverses again with `exact` (traceRay), so
+// that the answer is the same either way. Lavapipe runs a branch's body whether a lane takes
+// it or not: the double arithmetic would cost it on every test, and costs it once per ray
+// this way.
+bool intersectTriangle(RayData r, Triangle tri, float tMax, bool exact, out HitData hit,
+                       out bool inexact) {
   precise vec3 a = tri.v0 - r.origin;
   precise vec3 b = tri.v1 - r.origin;
   precise vec3 c = tri.v2 - r.origin;
@@ -99,13 +105,14 @@ bool intersectTriangle(RayData r, Triangle tri, float tMax, out HitData hit) {
   precise float u = cx * by - cy * bx;
   precise float v = ax * cy - ay * cx;
   precise float w = bx * ay - by * ax;
-  // An edge function of exactly zero may be rounding: recompute in double, as the paper does.
-  if (u == 0.0 || v == 0.0 || w == 0.0) {
+  bool zero = u == 0.0 || v == 0.0 || w == 0.0;
+  if (exact && zero) {
     u = float(double(cx) * double(by) - double(cy) * double(bx));
     v = float(double(ax) * double(cy) - double(ay) * double(cx));
     w = float(double(bx) * double(ay) - double(by) * double(ax));
   }
   bool mixed = (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
+  inexact = !exact && zero;
   precise float det = u + v + w;
   precise float az = r.sz * a[r.kz];
   precise float bz = r.sz * b[r.kz];
@@ -165,17 +172,17 @@ bool intersectBox(RayData r, vec3 lo, vec3 hi, float tMax, out float tNear) {
 // buffer (a node's four, or a triangle's three and one more; see gpuTraversalTexels), so a
 // lavapipe vector's lanes share the fetches and the two steps' arithmetic whichever step each
 // takes. Every loop records how it ended: one that ends other than by its own break was cut
-// short by lavapipe's silent loop-iteration cap, and sets gTruncated.
-bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData best) {
-  RayData r = prepareRay(origin, direction);
+// short by lavapipe's silent loop-iteration cap, and sets gTruncated. Without `exact` it
+// gives up (returns with `inexact` set) at the first triangle whose test would need the
+// recomputation in double (intersectTriangle), and traceRay traverses again with it.
+// `rootRef` is the root's reference and `triangleTexels` where the triangles start, from
+// node 0; the ray enters the root's box.
+bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyHit, bool exact,
+              out HitData best, out bool inexact) {
+  inexact = false;
   best.t = tMax;
   best.barycentrics = vec3(0.0);
   best.triangle = 0u;
-  float tNear;
-  // Node 0 holds the root's box and reference, and where the triangles start.
-  GpuBvhNode root = loadNode(0u);
-  if (!intersectBox(r, root.leftMin, root.leftMax, tMax, tNear)) return false;
-  int triangleTexels = int(root.reserved0);
   // The stack of what to visit later, in variables rather than an array: stack0.x is the top,
   // then stack0.y, ..., stack1.x, ...; a push shifts every entry down one place, a pop up.
   // Lavapipe reads and writes a local array lane by lane, with a branch on each lane's mask,
@@ -187,7 +194,7 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
   uvec4 stack8 = uvec4(0u), stack9 = uvec4(0u), stack10 = uvec4(0u), stack11 = uvec4(0u);
   uvec4 stack12 = uvec4(0u), stack13 = uvec4(0u), stack14 = uvec4(0u), stack15 = uvec4(0u);
   uint stackSize = 0u;
-  uint ref = root.left;  // the interior node to visit once no triangle is left, or 0
+  uint ref = rootRef;  // the interior node to visit once no triangle is left, or 0
   // The triangles to test first: [first, end), then [first2, end2) (a leaf, then its sibling).
   uint first = 0u, end = 0u, first2 = 0u, end2 = 0u;
   if ((ref & kGpuBvhLeaf) != 0u) {
@@ -211,8 +218,11 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
       Triangle tri = Triangle(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
                               uintBitsToFloat(c.xyz), c.w);
       HitData hit;
-      bool hitTriangle = PT_WATERTIGHT ? intersectTriangle(r, tri, range, hit)
+      bool zeroEdge = false;
+      bool hitTriangle = PT_WATERTIGHT ? intersectTriangle(r, tri, range, exact, hit, zeroEdge)
                                        : intersectTriangleFast(r, tri, range, hit);
+      inexact = zeroEdge;
+      if (inexact) break;
       hit.triangle = first;
       bool closer = hitTriangle && isCloserHit(hit.t, tri.primitive, best.t, bestPrimitive);
       best = closer ? hit : best;
@@ -304,8 +314,33 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
       }
     }
   }
-  // Ended by a break: a hit found for any-hit, or nothing left. (A flag set at each break
-  // would not do: the compiler folds it to true, having seen no other way out.)
-  if (!(anyHit && found) && !(first == end && ref == 0u && stackSize == 0u)) gTruncated = true;
+  // Ended by a break: a hit found for any-hit, a test to redo exactly, or nothing left. (A
+  // flag set at each break would not do: the compiler folds it to true, having seen no other
+  // way out.)
+  if (!(anyHit && found) && !inexact && !(first == end && ref == 0u && stackSize == 0u)) {
+    gTruncated = true;
+  }
+  return found;
+}
+
+// Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax, as traverse finds it with
+// the exact triangle test. A ray meets an edge function of exactly zero rarely, so it is
+// traversed with the test that skips the recomputation in double first (see
+// intersectTriangle), and again with it when that gave up.
+bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData best) {
+  RayData r = prepareRay(origin, direction);
+  // Node 0 holds the root's box and reference, and where the triangles start.
+  GpuBvhNode root = loadNode(0u);
+  float tNear;
+  if (!intersectBox(r, root.leftMin, root.leftMax, tMax, tNear)) {
+    best = HitData(tMax, vec3(0.0), 0u);
+    return false;
+  }
+  int triangleTexels = int(root.reserved0);
+  bool inexact;
+  bool found = traverse(r, root.left, triangleTexels, tMax, anyHit, /*exact=*/false, best, inexact);
+  if (inexact) {
+    found = traverse(r, root.left, triangleTexels, tMax, anyHit, /*exact=*/true, best, inexact);
+  }
   return found;
 }
