@@ -263,17 +263,33 @@ void uploadOpenBatch(const VulkanContext& ctx, const vk::raii::CommandBuffer& cm
 
 // Samples per pass when the options leave it open: as many as keep a dispatch to about
 // kDispatchSeconds (a stop waits for the dispatch under way) and an invocation's loop
-// iterations to a quarter of lavapipe's cap, judged by the last dispatch (`count` samples,
-// `seconds`, `loopIterations` in its busiest invocation); at most four times the last count
-// and at most a batch. More samples per pass save dispatches and keep a SIMD group's lanes
-// busy: each lane goes on with its next sample as soon as a path ends.
+// iterations to kLoopIterations, a quarter of lavapipe's cap, judged by the last dispatch
+// (`count` samples, `seconds`, `loopIterations` in its busiest invocation); at most four times
+// the last count and at most a batch. More samples per pass save dispatches and keep a SIMD
+// group's lanes busy: each lane goes on with its next sample as soon as a path ends, where
+// with one sample per pass the group waits for its longest path (lavapipe, Cornell box 256²:
+// 0.70 of the speed at 16 samples per pass, 0.87 at 4).
+constexpr double kDispatchSeconds = 0.5;
+constexpr double kLoopIterations = 65535.0 / 4.0;
+
 uint32_t nextSamplesPerPass(uint32_t count, double seconds, uint32_t loopIterations,
                             uint64_t batch) {
-  constexpr double kDispatchSeconds = 0.5;
-  constexpr double kLoopIterations = 65535.0 / 4.0;
   const double byTime = kDispatchSeconds * count / std::max(seconds, 1e-6);
   const double byLoops = kLoopIterations * count / std::max(loopIterations, 1u);
   const double k = std::min({byTime, byLoops, 4.0 * count, double(batch)});
+  return uint32_t(std::max(1.0, std::floor(k)));
+}
+
+// The first pass, which no dispatch has timed yet: four samples (what a first pass of one
+// would grow to), fewer where that is more paths than one sample of a 512 x 512 image (what
+// a pass of one sample would cost there) or where the warm-up's loop iterations
+// (`warmUpLoopIterations`, one sample of the first workgroup's pixels) say the loop cap is
+// near.
+uint32_t firstSamplesPerPass(size_t pixels, uint32_t warmUpLoopIterations, uint64_t batch) {
+  constexpr double kFirstPassPaths = 512.0 * 512.0;
+  const double byPaths = kFirstPassPaths / double(std::max<size_t>(pixels, 1));
+  const double byLoops = kLoopIterations / std::max(warmUpLoopIterations, 1u);
+  const double k = std::min({byPaths, byLoops, 4.0, double(batch)});
   return uint32_t(std::max(1.0, std::floor(k)));
 }
 
@@ -303,9 +319,11 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   passes.clearAccumulators();
   program.bind(cmd);
   passes.dispatch(0u, 1u, /*wholeImage=*/false);
+  passes.copyLoopIterations();
   barrier(cmd, S::eComputeShader, A::eShaderWrite, S::eTransfer, A::eTransferWrite);
   passes.clearAccumulators();
   commands.submitAndWait(ctx);
+  const uint32_t warmUpLoopIterations = passes.loopIterations();
 
   // Batches of samplesPerFold samples per pixel, summed in float on the device in the order of
   // their sample indices, then folded into the film. Batches cover the sample indices
@@ -320,8 +338,10 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   const vk::raii::QueryPool queries(ctx.device,
                                     vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, 2));
   const double tickSeconds = double(ctx.limits.timestampPeriod) * 1e-9;
-  uint32_t perPass = uint32_t(std::max(1, options.samplesPerPass));
   const uint64_t batch = vulkanBatchSize(options);
+  uint32_t perPass = options.samplesPerPass > 0
+                         ? uint32_t(options.samplesPerPass)
+                         : firstSamplesPerPass(film.pixelCount(), warmUpLoopIterations, batch);
   const uint32_t first = options.firstSample;
   const uint32_t end = first + uint32_t(options.spp);
   const size_t pixels = film.pixelCount();
