@@ -323,24 +323,30 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
   return found;
 }
 
-// Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax, as traverse finds it with
-// the exact triangle test. A ray meets an edge function of exactly zero rarely, so it is
-// traversed with the test that skips the recomputation in double first (see
-// intersectTriangle), and again with it when that gave up.
-bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData best) {
+// Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax by traverse, with the exact
+// triangle test or (exact = false) with the one that gives up on an edge function of exactly
+// zero: then `inexact` is set and the answer means nothing.
+bool traceRayWith(bool exact, vec3 origin, vec3 direction, float tMax, bool anyHit,
+                  out HitData best, out bool inexact) {
   RayData r = prepareRay(origin, direction);
   // Node 0 holds the root's box and reference, and where the triangles start.
   GpuBvhNode root = loadNode(0u);
   float tNear;
   if (!intersectBox(r, root.leftMin, root.leftMax, tMax, tNear)) {
     best = HitData(tMax, vec3(0.0), 0u);
+    inexact = false;
     return false;
   }
-  int triangleTexels = int(root.reserved0);
+  return traverse(r, root.left, int(root.reserved0), tMax, anyHit, exact, best, inexact);
+}
+
+// Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax, as traverse finds it with
+// the exact triangle test. A ray meets an edge function of exactly zero rarely, so it is
+// traversed with the test that skips the recomputation in double first (see
+// intersectTriangle), and again with it when that gave up.
+bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData best) {
   bool inexact;
-  bool found = traverse(r, root.left, triangleTexels, tMax, anyHit, /*exact=*/false, best, inexact);
-  if (inexact) {
-    found = traverse(r, root.left, triangleTexels, tMax, anyHit, /*exact=*/true, best, inexact);
-  }
+  bool found = traceRayWith(/*exact=*/false, origin, direction, tMax, anyHit, best, inexact);
+  if (inexact) found = traceRayWith(/*exact=*/true, origin, direction, tMax, anyHit, best, inexact);
   return found;
 }

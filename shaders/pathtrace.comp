@@ -73,13 +73,30 @@ Emitter loadEmitter(uint i) {
   return Emitter(a.x, uintBitsToFloat(a.y), uintBitsToFloat(a.z), a.w);
 }
 
+// A ray whose first traversal gave up at an edge function of exactly zero (traceRayWith in
+// bvh.glsl), traced again with the exact test once the bounce is done (main): a shadow ray,
+// whose light sample then adds `contribution` to the path's radiance unless occluded, or the
+// path's next ray, whose hit the next bounce takes. The bounce does without the answer: it
+// adds nothing for the shadow ray (the contribution comes after every other addition of the
+// bounce, as it would have come after the light sample), or it stops before the hit is used.
+// One exact traversal per bounce, for either kind, rather than one after each traversal:
+// lavapipe runs a loop's body at least once whether a lane needs it or not.
+struct Retrace {
+  bool pending;
+  bool shadow;
+  vec3 origin;
+  vec3 direction;
+  vec3 contribution;
+};
+
 // Samples direct illumination at diffuse vertex p with shading normal n (next-event
 // estimation, pbrt's SampleLd): picks an emitter from the alias table with uChoose, a uniform
 // point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
 // contribution to L, beta * f * Le * cos / pdf, weighted by the power heuristic against BSDF
-// sampling when misOn; zero when the point faces away or is occluded.
+// sampling when misOn; zero when the point faces away or is occluded, and zero with `retrace`
+// set when the shadow ray is to be traced again.
 vec3 sampleDirectLight(vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f, vec2 uChoose,
-                       vec2 uLight, bool misOn, uint depth) {
+                       vec2 uLight, bool misOn, uint depth, inout Retrace retrace) {
   // Pick an emitter from the alias table, then a uniform point on its triangle.
   uint slot = aliasTableSlot(uChoose.x, params.emitterCount);
   Emitter emitter = loadEmitter(aliasTablePick(slot, loadEmitter(slot), uChoose.y));
@@ -103,7 +120,10 @@ vec3 sampleDirectLight(vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f, vec2 
       offsetRayOrigin(lightPoint, lightNormal, triangleMagnitude(light.v0, light.v1, light.v2));
   gRays++;
   HitData blocker;
-  if (traceRay(from, to - from, 1.0, /*anyHit=*/true, blocker)) return vec3(0.0);
+  bool inexact;
+  bool occluded =
+      traceRayWith(/*exact=*/false, from, to - from, 1.0, /*anyHit=*/true, blocker, inexact);
+  if (occluded && !inexact) return vec3(0.0);
 
   float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
   float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0;
@@ -114,7 +134,12 @@ vec3 sampleDirectLight(vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f, vec2 
                    depth, emitter.triangle, light.primitive, lightPdf, weight);
   }
 #endif
-  return beta * f * Le * (cosSurface * weight / lightPdf);
+  vec3 contribution = beta * f * Le * (cosSurface * weight / lightPdf);
+  if (inexact) {
+    retrace = Retrace(true, true, from, to - from, contribution);
+    return vec3(0.0);
+  }
+  return contribution;
 }
 
 // What sampleRadiance (host/cpu/integrator.cpp) keeps across its loop: one sample's path,
@@ -128,6 +153,9 @@ struct Path {
   vec3 beta;            // path throughput
   bool specularBounce;  // the ray leaves a specular bounce (or the camera)
   float bsdfPdf;        // solid-angle pdf of the BSDF sample that produced the ray
+  bool hitReady;        // the ray's closest hit is hitFound and hit already (see Retrace)
+  bool hitFound;
+  HitData hit;
 };
 
 // The effects in use. Those switched off by a specialization constant fold away here; the
@@ -160,19 +188,34 @@ Path startPath(uvec2 pixel, uint sampleIndex) {
   // The camera ray counts as specular: emission it finds is taken at full weight.
   path.specularBounce = true;
   path.bsdfPdf = 0.0;
+  path.hitReady = false;
+  path.hitFound = false;
+  path.hit = HitData(0.0, vec3(0.0), 0u);
   return path;
 }
 
 // One iteration of sampleRadiance's loop: traces the path's ray, adds the emission it finds,
-// scatters. Returns true when the path has ended, its radiance then being path.L.
-bool extendPath(inout Path path, uvec2 pixel) {
+// scatters. Returns true when the path has ended, its radiance then being path.L once
+// `retrace` is done (main).
+bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   uint seed = params.seed;
   bool sobol = PT_SOBOL;  // else independent random numbers
   uint sampleIndex = path.sampleIndex;
   // Find the closest surface along the ray; the background is black.
-  gRays++;
-  HitData hit;
-  if (!traceRay(path.origin, path.direction, 1.0 / 0.0, /*anyHit=*/false, hit)) return true;
+  HitData hit = path.hit;
+  bool found = path.hitFound;
+  if (!path.hitReady) {
+    gRays++;
+    bool inexact;
+    found = traceRayWith(/*exact=*/false, path.origin, path.direction, 1.0 / 0.0,
+                         /*anyHit=*/false, hit, inexact);
+    if (inexact) {
+      retrace = Retrace(true, false, path.origin, path.direction, vec3(0.0));
+      return false;
+    }
+  }
+  path.hitReady = false;
+  if (!found) return true;
   Triangle tri = loadTriangle(hit.triangle);
   Material material = loadMaterial(tri.material);
   // Hit point from barycentrics (more accurate than origin + t * direction).
@@ -229,7 +272,7 @@ bool extendPath(inout Path path, uvec2 pixel) {
       path.L += sampleDirectLight(p, n, magnitude, path.beta, f,
                                   random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
                                   random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
-                                  misOn(), path.depth);
+                                  misOn(), path.depth, retrace);
     }
     // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
     wi = localToWorld(
@@ -278,7 +321,24 @@ void main() {
   gTruncated = false;
   while (!finished) {
     gLoopIterations++;
-    if (!extendPath(path, pixel)) continue;
+    Retrace retrace = Retrace(false, false, vec3(0.0), vec3(0.0), vec3(0.0));
+    bool ended = extendPath(path, pixel, retrace);
+    // The rare ray to trace again with the exact test (see Retrace).
+    if (retrace.pending) {
+      HitData exactHit;
+      bool inexact;
+      bool found =
+          traceRayWith(/*exact=*/true, retrace.origin, retrace.direction,
+                       retrace.shadow ? 1.0 : 1.0 / 0.0, retrace.shadow, exactHit, inexact);
+      if (retrace.shadow) {
+        if (!found) path.L += retrace.contribution;
+      } else {
+        path.hitReady = true;
+        path.hitFound = found;
+        path.hit = exactHit;
+      }
+    }
+    if (!ended) continue;
     vec3 L = path.L;
 #ifdef PT_DEBUG_PRINTF
     if (gDebug) {
