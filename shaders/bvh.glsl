@@ -323,21 +323,30 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
   return found;
 }
 
+// The ray prepared, with what traverse needs from node 0 (the root's reference and where the
+// triangles start); false, with `best` holding no hit, when the ray misses the root's box.
+bool enterRoot(vec3 origin, vec3 direction, float tMax, out RayData r, out uint rootRef,
+               out int triangleTexels, out HitData best) {
+  r = prepareRay(origin, direction);
+  GpuBvhNode root = loadNode(0u);
+  rootRef = root.left;
+  triangleTexels = int(root.reserved0);
+  best = HitData(tMax, vec3(0.0), 0u);
+  float tNear;
+  return intersectBox(r, root.leftMin, root.leftMax, tMax, tNear);
+}
+
 // Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax by traverse, with the exact
 // triangle test or (exact = false) with the one that gives up on an edge function of exactly
 // zero: then `inexact` is set and the answer means nothing.
 bool traceRayWith(bool exact, vec3 origin, vec3 direction, float tMax, bool anyHit,
                   out HitData best, out bool inexact) {
-  RayData r = prepareRay(origin, direction);
-  // Node 0 holds the root's box and reference, and where the triangles start.
-  GpuBvhNode root = loadNode(0u);
-  float tNear;
-  if (!intersectBox(r, root.leftMin, root.leftMax, tMax, tNear)) {
-    best = HitData(tMax, vec3(0.0), 0u);
-    inexact = false;
-    return false;
-  }
-  return traverse(r, root.left, int(root.reserved0), tMax, anyHit, exact, best, inexact);
+  RayData r;
+  uint rootRef;
+  int triangleTexels;
+  inexact = false;
+  if (!enterRoot(origin, direction, tMax, r, rootRef, triangleTexels, best)) return false;
+  return traverse(r, rootRef, triangleTexels, tMax, anyHit, exact, best, inexact);
 }
 
 // Closest hit (anyHit = false) or any hit (true) in 0 < t < tMax, as traverse finds it with
@@ -345,8 +354,14 @@ bool traceRayWith(bool exact, vec3 origin, vec3 direction, float tMax, bool anyH
 // traversed with the test that skips the recomputation in double first (see
 // intersectTriangle), and again with it when that gave up.
 bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData best) {
+  RayData r;
+  uint rootRef;
+  int triangleTexels;
+  if (!enterRoot(origin, direction, tMax, r, rootRef, triangleTexels, best)) return false;
   bool inexact;
-  bool found = traceRayWith(/*exact=*/false, origin, direction, tMax, anyHit, best, inexact);
-  if (inexact) found = traceRayWith(/*exact=*/true, origin, direction, tMax, anyHit, best, inexact);
+  bool found = traverse(r, rootRef, triangleTexels, tMax, anyHit, /*exact=*/false, best, inexact);
+  if (inexact) {
+    found = traverse(r, rootRef, triangleTexels, tMax, anyHit, /*exact=*/true, best, inexact);
+  }
   return found;
 }
