@@ -202,11 +202,12 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
     end = first + (ref & kGpuBvhMaxLeafCount);
     ref = 0u;
   }
-  bool found = false;
-  uint bestPrimitive = kNoPrimitive;
-  float range = tMax;  // searchRange of the closest hit so far
+  uint bestPrimitive = kNoPrimitive;  // kNoPrimitive until a hit is found
   for (;;) {
     gLoopIterations++;
+    // searchRange of the closest hit so far (recomputed rather than kept: lavapipe keeps fewer
+    // values across iterations in registers)
+    float range = bestPrimitive == kNoPrimitive ? tMax : searchRange(best.t, tMax);
     bool testing = first < end;
     int at = testing ? triangleTexels + 3 * int(first) : 4 * int(ref);
     uvec4 a = texelFetch(nodeTexels, at);
@@ -227,9 +228,7 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
       bool closer = hitTriangle && isCloserHit(hit.t, tri.primitive, best.t, bestPrimitive);
       best = closer ? hit : best;
       bestPrimitive = closer ? tri.primitive : bestPrimitive;
-      range = closer ? searchRange(hit.t, tMax) : range;
-      found = found || closer;
-      if (anyHit && found) break;
+      if (anyHit && closer) break;
       first++;
       if (first == end) {  // the sibling leaf next, if any
         first = first2;
@@ -314,6 +313,7 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
       }
     }
   }
+  bool found = bestPrimitive != kNoPrimitive;
   // Ended by a break: a hit found for any-hit, a test to redo exactly, or nothing left. (A
   // flag set at each break would not do: the compiler folds it to true, having seen no other
   // way out.)
