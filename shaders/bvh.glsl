@@ -14,7 +14,7 @@
 // all the code in its body, whatever each lane needs; what a fetch costs is how lavapipe
 // gathers it (see PT_BINDING_NODES in shared_types.h).
 
-// Rows of four stack entries that traceRay keeps (1 to 16): enough for the tree's depth, set
+// Rows of four stack entries that traverse keeps (1 to 16): enough for the tree's depth, set
 // by the host from it (host/vulkan/gpu_bvh.h, gpuStackRows).
 layout(constant_id = PT_SPEC_STACK_ROWS) const uint kStackRows = 16u;
 
@@ -87,10 +87,10 @@ RayData prepareRay(vec3 origin, vec3 direction) {
 // the values computed, and so the answer, are those of host/bvh/traverse.cpp, operation for
 // operation. An edge function of exactly zero may be rounding, and the paper recomputes the
 // three in double then. With `exact` this does so (a branch, which GPUs skip); without it,
-// it sets `inexact` instead, and the caller traverses again with `exact` (traceRay), so
-// that the answer is the same either way. Lavapipe runs a branch's body whether a lane takes
-// it or not: the double arithmetic would cost it on every test, and costs it once per ray
-// this way.
+// it sets `inexact` instead, and the ray is traversed again with `exact` (traceRay here,
+// the path tracer's Retrace), so that the answer is the same either way. Lavapipe runs a
+// branch's body whether a lane takes it or not: the double arithmetic would cost it on every
+// test, and costs it once per ray this way.
 bool intersectTriangle(RayData r, Triangle tri, float tMax, bool exact, out HitData hit,
                        out bool inexact) {
   precise vec3 a = tri.v0 - r.origin;
@@ -174,7 +174,7 @@ bool intersectBox(RayData r, vec3 lo, vec3 hi, float tMax, out float tNear) {
 // takes. Every loop records how it ended: one that ends other than by its own break was cut
 // short by lavapipe's silent loop-iteration cap, and sets gTruncated. Without `exact` it
 // gives up (returns with `inexact` set) at the first triangle whose test would need the
-// recomputation in double (intersectTriangle), and traceRay traverses again with it.
+// recomputation in double (intersectTriangle), and the caller traverses again with it.
 // `rootRef` is the root's reference and `triangleTexels` where the triangles start, from
 // node 0; the ray enters the root's box.
 bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyHit, bool exact,
