@@ -49,10 +49,18 @@ struct RayData {
   float sx, sy, sz;  // shear constants
 };
 
-struct HitData {
+// What a triangle test reports.
+struct TriangleHit {
   float t;
   vec3 barycentrics;  // weights of v0, v1, v2
-  uint triangle;      // index into the triangle buffer (leaf order)
+};
+
+// What a traversal reports: the hit's distance and triangle. The barycentric weights are
+// computed again from these once the traversal is done (hitBarycentrics): carried through
+// the loop, they were three more values in its state, which lavapipe spills.
+struct HitData {
+  float t;
+  uint triangle;  // index into the triangle buffer (leaf order)
 };
 
 float safeInverse(float d) {
@@ -91,7 +99,7 @@ RayData prepareRay(vec3 origin, vec3 direction) {
 // the path tracer's Retrace), so that the answer is the same either way. Lavapipe runs a
 // branch's body whether a lane takes it or not: the double arithmetic would cost it on every
 // test, and costs it once per ray this way.
-bool intersectTriangle(RayData r, Triangle tri, float tMax, bool exact, out HitData hit,
+bool intersectTriangle(RayData r, Triangle tri, float tMax, bool exact, out TriangleHit hit,
                        out bool inexact) {
   precise vec3 a = tri.v0 - r.origin;
   precise vec3 b = tri.v1 - r.origin;
@@ -127,7 +135,7 @@ bool intersectTriangle(RayData r, Triangle tri, float tMax, bool exact, out HitD
 
 // Moller and Trumbore (1997): fewer operations, not watertight. Only for measuring what
 // watertightness costs (--intersection fast).
-bool intersectTriangleFast(RayData r, Triangle tri, float tMax, out HitData hit) {
+bool intersectTriangleFast(RayData r, Triangle tri, float tMax, out TriangleHit hit) {
   vec3 e1 = tri.v1 - tri.v0;
   vec3 e2 = tri.v2 - tri.v0;
   vec3 p = cross(r.direction, e2);
@@ -181,7 +189,6 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
               out HitData best, out bool inexact) {
   inexact = false;
   best.t = tMax;
-  best.barycentrics = vec3(0.0);
   best.triangle = 0u;
   // The stack of what to visit later, in variables rather than an array: stack0.x is the top,
   // then stack0.y, ..., stack1.x, ...; a push shifts every entry down one place, a pop up.
@@ -218,15 +225,15 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
       // Test the next triangle; a hit that isCloserHit prefers shrinks the search range.
       Triangle tri = Triangle(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
                               uintBitsToFloat(c.xyz), c.w);
-      HitData hit;
+      TriangleHit hit;
       bool zeroEdge = false;
       bool hitTriangle = PT_WATERTIGHT ? intersectTriangle(r, tri, range, exact, hit, zeroEdge)
                                        : intersectTriangleFast(r, tri, range, hit);
       inexact = zeroEdge;
       if (inexact) break;
-      hit.triangle = first;
       bool closer = hitTriangle && isCloserHit(hit.t, tri.primitive, best.t, bestPrimitive);
-      best = closer ? hit : best;
+      best.t = closer ? hit.t : best.t;
+      best.triangle = closer ? first : best.triangle;
       bestPrimitive = closer ? tri.primitive : bestPrimitive;
       if (anyHit && closer) break;
       first++;
@@ -331,7 +338,7 @@ bool enterRoot(vec3 origin, vec3 direction, float tMax, out RayData r, out uint 
   GpuBvhNode root = loadNode(0u);
   rootRef = root.left;
   triangleTexels = int(root.reserved0);
-  best = HitData(tMax, vec3(0.0), 0u);
+  best = HitData(tMax, 0u);
   float tNear;
   return intersectBox(r, root.leftMin, root.leftMax, tMax, tNear);
 }
@@ -364,4 +371,20 @@ bool traceRay(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData 
     found = traverse(r, rootRef, triangleTexels, tMax, anyHit, /*exact=*/true, best, inexact);
   }
   return found;
+}
+
+// The barycentric weights of the hit of the ray from `origin` along `direction` on `tri`, as
+// the traversal's triangle test computed them: the same operations on the same values. The
+// exact test gives them either way: its recomputation in double changes something only where
+// an edge function is exactly zero, and a traversal that met one was redone exactly.
+vec3 hitBarycentrics(vec3 origin, vec3 direction, Triangle tri) {
+  RayData r = prepareRay(origin, direction);
+  TriangleHit hit;
+  bool inexact;
+  if (PT_WATERTIGHT) {
+    intersectTriangle(r, tri, 1.0 / 0.0, /*exact=*/true, hit, inexact);
+  } else {
+    intersectTriangleFast(r, tri, 1.0 / 0.0, hit);
+  }
+  return hit.barycentrics;
 }

@@ -190,7 +190,7 @@ Path startPath(uvec2 pixel, uint sampleIndex) {
   path.bsdfPdf = 0.0;
   path.hitReady = false;
   path.hitFound = false;
-  path.hit = HitData(0.0, vec3(0.0), 0u);
+  path.hit = HitData(0.0, 0u);
   return path;
 }
 
@@ -219,7 +219,8 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   Triangle tri = loadTriangle(hit.triangle);
   Material material = loadMaterial(tri.material);
   // Hit point from barycentrics (more accurate than origin + t * direction).
-  vec3 p = hit.barycentrics.x * tri.v0 + hit.barycentrics.y * tri.v1 + hit.barycentrics.z * tri.v2;
+  vec3 b = hitBarycentrics(path.origin, path.direction, tri);
+  vec3 p = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
   vec3 edgeCross = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
   vec3 ng = normalize(edgeCross);
   vec3 wo = -path.direction;
