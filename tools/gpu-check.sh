@@ -36,6 +36,12 @@ if [ "${1:-}" = "--bundle" ]; then
   while read -r name path; do cp -L "$path" "$bundle/lib/$name"; done <<<"$libs
 libvulkan.so.1 $vulkan"
   cp -L /lib64/ld-linux-x86-64.so.2 "$bundle/lib/"
+  # glibc's other libraries, which the binaries do not load but NVIDIA's driver may: from the
+  # bundled glibc, not the machine's, whose version may differ.
+  libc_dir=$(dirname "$(awk '$1 == "libc.so.6" {print $2}' <<<"$libs")")
+  for name in libdl.so.2 libpthread.so.0 librt.so.1; do
+    [ -f "$libc_dir/$name" ] && cp -L "$libc_dir/$name" "$bundle/lib/"
+  done
   if [ -f assets/dragon_vrip.ply ] && [ -f /usr/share/glmark2/models/bunny.obj ]; then
     gzip -c assets/dragon_vrip.ply >"$bundle/dragon_vrip.ply.gz"
     gzip -c /usr/share/glmark2/models/bunny.obj >"$bundle/bunny.obj.gz"
