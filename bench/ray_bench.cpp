@@ -257,8 +257,8 @@ class TraversalBackend {
   virtual void prepareForTiming() {}
   // Rays traced by one call on n rays (a backend may trace copies of a small batch).
   virtual size_t raysPerCall(size_t n) const { return n; }
-  // Seconds of the last call that were tracing, for backends with a fixed cost per call that
-  // is not tracing; none: the wall time of the call.
+  // Seconds of the last call that were tracing, for backends that time their own tracing (the
+  // GPU's dispatch, without the set-up and copies around it); none: the wall time of the call.
   virtual std::optional<double> lastTraceSeconds() const { return std::nullopt; }
   // Rays of the last call that the backend gave up on (lavapipe's loop cap).
   virtual uint64_t lastTruncated() const { return 0; }
@@ -323,12 +323,11 @@ std::unique_ptr<TraversalBackend> makeWideBackend(const BenchScene& scene, const
 
 // A GPU backend that traces a whole batch of RayQuery in one call of `trace` (results in
 // Bvh::triangles indices), such as traceRaysVulkan, which sets up a Vulkan context, compiles
-// the shader, uploads the BVH and the rays into host-visible buffers, dispatches and reads
-// the results back, on every call. For timing, that fixed part (measured before the timed
-// runs: the median of three calls on a single ray) is subtracted from each call, and a batch
-// smaller than --gpu-min-rays is traced as that many copies of itself, so that what is left
-// is mostly tracing (with the copies of the rays in and of the results out, which scale with
-// the batch). The agreement check traces each batch once, without copies.
+// the shader, uploads the BVH and the rays, dispatches and reads the results back, on every
+// call. What is timed is the dispatch alone (RaycastStats::deviceSeconds, from timestamp
+// queries: reading the rays from device memory, tracing, writing the hits), and a batch
+// smaller than --gpu-min-rays is traced as that many copies of itself, enough rays to fill a
+// GPU. The agreement check traces each batch once, without copies.
 class RayQueryBackend : public TraversalBackend {
  public:
   using Trace = std::function<std::vector<RayResult>(const std::vector<RayQuery>&, RaycastStats&)>;
@@ -350,24 +349,9 @@ class RayQueryBackend : public TraversalBackend {
     for (size_t i = 0; i < rays.size(); ++i) occluded[i] = results[i].found != 0u ? 1 : 0;
   }
 
-  void prepareForTiming() override {
-    std::vector<double> seconds;
-    const std::vector<Ray> one = {Ray{vec3(0.0f), vec3(0.0f, 0.0f, 1.0f)}};
-    for (int i = 0; i < 3; ++i) {
-      trace(one, INFINITY, false);
-      seconds.push_back(lastCall_);
-    }
-    overhead_ = bench::median(seconds);
-    timing_ = true;
-    std::printf("%s: fixed cost per call %.1f ms (subtracted from the timings)\n", name_.c_str(),
-                overhead_ * 1e3);
-  }
+  void prepareForTiming() override { timing_ = true; }
   size_t raysPerCall(size_t n) const override { return n * copies(n); }
-  std::optional<double> lastTraceSeconds() const override {
-    // Never below a tenth of the call: on a busy machine the fixed part can come out larger
-    // than measured before, and a rate must stay finite.
-    return std::max(lastCall_ - overhead_, 0.1 * lastCall_);
-  }
+  std::optional<double> lastTraceSeconds() const override { return lastDispatch_; }
   uint64_t lastTruncated() const override { return truncated_; }
 
  private:
@@ -382,9 +366,8 @@ class RayQueryBackend : public TraversalBackend {
       for (const Ray& r : rays) queries.push_back(RayQuery{r.origin, tMax, r.direction, anyHit});
     }
     RaycastStats stats;
-    const auto start = Clock::now();
     std::vector<RayResult> results = trace_(queries, stats);
-    lastCall_ = secondsSince(start);
+    lastDispatch_ = stats.deviceSeconds;
     truncated_ = stats.truncated;
     return results;
   }
@@ -394,7 +377,7 @@ class RayQueryBackend : public TraversalBackend {
   size_t minRays_;
   Trace trace_;
   bool timing_ = false;
-  double overhead_ = 0.0, lastCall_ = 0.0;
+  double lastDispatch_ = 0.0;
   uint64_t truncated_ = 0;
 };
 

@@ -424,20 +424,18 @@ How it is measured:
 - **cpu-wide**: the same queries over the 8-wide tree collapsed from it (\`host/bvh/wide_bvh.h\`),
   which the CPU renderer traverses.
 - **vulkan**: the ray-query shader (\`shaders/raycast.comp\`, the path tracer's traversal) through
-  \`traceRaysVulkan\`. That call sets up a context, compiles the shader and uploads the BVH every
-  time, so the bench subtracts that fixed cost (the median of three one-ray calls, printed in the
-  log) and traces copies of a set up to 2^20 rays per call, so that the rest is mostly tracing.
-  What is left includes copying the rays in and the hits out of host-visible memory. On
-  lavapipe this is the CPU again, through LLVM-compiled SPIR-V, eight rays to a vector. Note
-  that \`raycast.cpp\` keeps every buffer host-visible (it is a test tool): on a discrete GPU
-  the shader would read the BVH across the bus, so there this column would say little about
-  the path tracer's own traversal, which reads device-local buffers.
+  \`traceRaysVulkan\`, which sets up a context, compiles the shader and uploads the BVH and the
+  rays into device-local buffers on every call; what is timed is the dispatch alone (timestamp
+  queries around it: reading the rays from device memory, tracing, writing the hits), as the
+  path tracer's Vulkan times are. A set is traced as copies of itself up to 2^20 rays per
+  dispatch, enough to fill a GPU. On lavapipe this is the CPU again, through LLVM-compiled
+  SPIR-V, eight rays to a vector, with a few milliseconds per dispatch of its own.
 - **embree**: \`rtcIntersect1\` / \`rtcOccluded1\` one ray at a time over Embree's own BVH
   (default scene flags and build quality), on the same threads.
-- Time per repetition is Google Benchmark's (manual time: the call's wall clock, or the GPU's
-  net time), at least \`--min-time\` (0.5 s unless quick) per repetition; repetitions of all
-  backends of a scene run in random order, so that a slow spell of the machine does not fall
-  on one backend only.
+- Time per repetition is Google Benchmark's (manual time: the call's wall clock, or the
+  dispatch's device time), at least \`--min-time\` (0.5 s unless quick) per repetition;
+  repetitions of all backends of a scene run in random order, so that a slow spell of the
+  machine does not fall on one backend only.
 
 ### Do the backends find the same hits?
 

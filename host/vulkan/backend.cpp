@@ -56,12 +56,6 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       scene.emitters.empty() ? std::vector<Emitter>{Emitter{}} : scene.emitters;
   const GpuBvh bvh = buildGpuBvh(scene.bvh);
   const std::vector<uint32_t> traversal = gpuTraversalTexels(bvh, scene.bvh.triangles);
-  struct Upload {
-    const char* what;
-    const void* data;
-    vk::DeviceSize size;
-    bool texels;  // read as texels (a uniform texel buffer), else a storage buffer
-  };
   // In PT_BINDING_* order, followed by the accumulation and the counters.
   const Upload uploads[] = {
       {"parameter", &scene.params, sizeof(RenderParams), false},
@@ -83,33 +77,15 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   buffers.stackRows = gpuStackRows(bvh);
   buffers.accumSize = vk::DeviceSize(cam.width) * cam.height * sizeof(AccumPixel);
   checkRange(ctx, "accumulation", buffers.accumSize);
-  for (const Upload& u : uploads) {
-    checkRange(ctx, u.what, u.size);
-    if (u.texels) checkTexelRange(ctx, u.what, u.size);
-  }
-  vk::DeviceSize stagingSize = 0;
-  for (const Upload& u : uploads) {
-    const auto usage = u.texels ? U::eUniformTexelBuffer : U::eStorageBuffer;
-    buffers.bound.push_back(makeBuffer(ctx, u.size, usage | U::eTransferDst, false));
-    if (u.texels) makeTexelView(ctx, buffers.bound.back());
-    buffers.texels.push_back(u.texels);
-    stagingSize += u.size;
-  }
+  checkUploads(ctx, uploads);
+  buffers.bound = recordUploads(ctx, cmd, uploads, {}, staging);
+  for (const Upload& u : uploads) buffers.texels.push_back(u.texels);
   const auto readWrite = U::eStorageBuffer | U::eTransferSrc | U::eTransferDst;
   buffers.bound.push_back(makeBuffer(ctx, buffers.accumSize, readWrite, false));
   buffers.bound.push_back(makeBuffer(ctx, sizeof(DeviceCounters), readWrite, false));
   buffers.texels.resize(buffers.bound.size(), false);
   buffers.readback =
       makeBuffer(ctx, buffers.accumSize + sizeof(DeviceCounters), U::eTransferDst, true);
-
-  staging = makeBuffer(ctx, stagingSize, U::eTransferSrc, true);
-  vk::DeviceSize offset = 0;
-  for (size_t i = 0; i < std::size(uploads); ++i) {
-    std::memcpy(static_cast<char*>(staging.mapped) + offset, uploads[i].data, uploads[i].size);
-    cmd.copyBuffer(*staging.buffer, *buffers.bound[i].buffer,
-                   vk::BufferCopy(offset, 0, uploads[i].size));
-    offset += uploads[i].size;
-  }
   return buffers;
 }
 
@@ -335,9 +311,7 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   // change the sums.
   VulkanRenderStats stats;
   stats.device = ctx.info().name;
-  const vk::raii::QueryPool queries(ctx.device,
-                                    vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, 2));
-  const double tickSeconds = double(ctx.limits.timestampPeriod) * 1e-9;
+  const DeviceTimer timer(ctx);
   const uint64_t batch = vulkanBatchSize(options);
   uint32_t perPass = options.samplesPerPass > 0
                          ? uint32_t(options.samplesPerPass)
@@ -374,19 +348,14 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
         uploadOpenBatch(ctx, cmd, buffers, *carried, openStaging);
         carried = nullptr;
       }
-      cmd.resetQueryPool(*queries, 0, 2);
       program.bind(cmd);
-      cmd.writeTimestamp(S::eTopOfPipe, *queries, 0);
+      timer.start(cmd);
       const uint32_t count = std::min(perPass, batchEnd - next);
       passes.dispatch(next, count);
-      cmd.writeTimestamp(S::eBottomOfPipe, *queries, 1);
+      timer.stop(cmd);
       passes.copyLoopIterations();
       commands.submitAndWait(ctx);
-      const auto [result, ticks] = queries.getResults<uint64_t>(
-          0, 2, 2 * sizeof(uint64_t), sizeof(uint64_t),
-          vk::QueryResultFlagBits::e64 | vk::QueryResultFlagBits::eWait);
-      PT_CHECK(result == vk::Result::eSuccess);
-      const double seconds = double(ticks[1] - ticks[0]) * tickSeconds;
+      const double seconds = timer.seconds();
       stats.seconds += seconds;
       const uint32_t loopIterations = passes.loopIterations();
       stats.maxLoopIterations = std::max(stats.maxLoopIterations, loopIterations);

@@ -12,7 +12,8 @@ namespace pt {
 
 struct RaycastStats {
   uint32_t validationErrors = 0;
-  uint64_t truncated = 0;  // queries cut short by lavapipe's loop cap
+  uint64_t truncated = 0;      // queries cut short by lavapipe's loop cap
+  double deviceSeconds = 0.0;  // the dispatch alone, from timestamp queries
 };
 
 std::vector<RayResult> traceRaysVulkan(const Bvh& bvh, const std::vector<RayQuery>& queries,

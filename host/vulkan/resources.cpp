@@ -1,6 +1,7 @@
 // Vulkan helpers; see resources.h.
 #include "vulkan/resources.h"
 
+#include <cstring>
 #include <string>
 
 #include "common/check.h"
@@ -57,6 +58,56 @@ void checkRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size)
                      std::to_string(size >> 20) + " MiB, the device's maxStorageBufferRange is " +
                      std::to_string(ctx.limits.maxStorageBufferRange >> 20) + " MiB");
   }
+}
+
+void checkUploads(const VulkanContext& ctx, std::span<const Upload> uploads) {
+  for (const Upload& u : uploads) {
+    checkRange(ctx, u.what, u.size);
+    if (u.texels) checkTexelRange(ctx, u.what, u.size);
+  }
+}
+
+std::vector<Buffer> recordUploads(const VulkanContext& ctx, const vk::raii::CommandBuffer& cmd,
+                                  std::span<const Upload> uploads, vk::BufferUsageFlags extraUsage,
+                                  Buffer& staging) {
+  using U = vk::BufferUsageFlagBits;
+  std::vector<Buffer> buffers;
+  vk::DeviceSize stagingSize = 0;
+  for (const Upload& u : uploads) {
+    const vk::BufferUsageFlags usage = u.texels ? U::eUniformTexelBuffer : U::eStorageBuffer;
+    buffers.push_back(makeBuffer(ctx, u.size, usage | extraUsage | U::eTransferDst, false));
+    if (u.texels) makeTexelView(ctx, buffers.back());
+    stagingSize += u.size;
+  }
+  staging = makeBuffer(ctx, stagingSize, U::eTransferSrc, true);
+  vk::DeviceSize offset = 0;
+  for (size_t i = 0; i < uploads.size(); ++i) {
+    std::memcpy(static_cast<char*>(staging.mapped) + offset, uploads[i].data, uploads[i].size);
+    cmd.copyBuffer(*staging.buffer, *buffers[i].buffer, vk::BufferCopy(offset, 0, uploads[i].size));
+    offset += uploads[i].size;
+  }
+  return buffers;
+}
+
+DeviceTimer::DeviceTimer(const VulkanContext& ctx)
+    : queries_(ctx.device, vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, 2)),
+      tickSeconds_(double(ctx.limits.timestampPeriod) * 1e-9) {}
+
+void DeviceTimer::start(const vk::raii::CommandBuffer& cmd) const {
+  cmd.resetQueryPool(*queries_, 0, 2);
+  cmd.writeTimestamp(vk::PipelineStageFlagBits::eTopOfPipe, *queries_, 0);
+}
+
+void DeviceTimer::stop(const vk::raii::CommandBuffer& cmd) const {
+  cmd.writeTimestamp(vk::PipelineStageFlagBits::eBottomOfPipe, *queries_, 1);
+}
+
+double DeviceTimer::seconds() const {
+  const auto [result, ticks] =
+      queries_.getResults<uint64_t>(0, 2, 2 * sizeof(uint64_t), sizeof(uint64_t),
+                                    vk::QueryResultFlagBits::e64 | vk::QueryResultFlagBits::eWait);
+  PT_CHECK(result == vk::Result::eSuccess);
+  return double(ticks[1] - ticks[0]) * tickSeconds_;
 }
 
 void barrier(const vk::raii::CommandBuffer& cmd, vk::PipelineStageFlags src,

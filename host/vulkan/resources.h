@@ -34,6 +34,40 @@ void checkTexelRange(const VulkanContext& ctx, const char* what, vk::DeviceSize 
 // maxStorageBufferRange is 128 MiB): refuse them with the numbers instead (InputError).
 void checkRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size);
 
+// One array for a device-local buffer, copied there through a staging buffer.
+struct Upload {
+  const char* what;  // for the size checks' messages: "triangle" (buffer)
+  const void* data;
+  vk::DeviceSize size;
+  bool texels;  // read as texels (a uniform texel buffer, makeTexelView), else a storage buffer
+};
+
+// Checks every upload against the device's limits (checkRange, and checkTexelRange for texels)
+// before anything is allocated.
+void checkUploads(const VulkanContext& ctx, std::span<const Upload> uploads);
+
+// A device-local buffer for each upload (with its texel view where asked; `extraUsage` added
+// to every one), and the copies into them recorded into `cmd` from `staging`, filled here and
+// to be kept alive by the caller until the commands have run.
+std::vector<Buffer> recordUploads(const VulkanContext& ctx, const vk::raii::CommandBuffer& cmd,
+                                  std::span<const Upload> uploads, vk::BufferUsageFlags extraUsage,
+                                  Buffer& staging);
+
+// The device time between two points of a command buffer, from timestamp queries: start and
+// stop record them (start resets the pool first), seconds reads them once the commands have
+// run.
+class DeviceTimer {
+ public:
+  explicit DeviceTimer(const VulkanContext& ctx);
+  void start(const vk::raii::CommandBuffer& cmd) const;
+  void stop(const vk::raii::CommandBuffer& cmd) const;
+  double seconds() const;
+
+ private:
+  vk::raii::QueryPool queries_;
+  double tickSeconds_;
+};
+
 // Makes writes of one stage visible to the reads/writes of the next.
 void barrier(const vk::raii::CommandBuffer& cmd, vk::PipelineStageFlags src,
              vk::AccessFlags srcAccess, vk::PipelineStageFlags dst, vk::AccessFlags dstAccess);
