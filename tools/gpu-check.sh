@@ -8,17 +8,21 @@
 #    with one sample per dispatch (--samples-per-pass 1: no path regeneration), to tell what
 #    regeneration is worth there;
 #  - `pt diff` of the GPU's image against the CPU's at CPU_SPP: the same samples, so what
-#    differs is floating-point divergence.
+#    differs is floating-point divergence;
+#  - the ray benchmark (build/bench/ray_bench, where it was built) on the Cornell box, the
+#    1M-triangle sphere and the seed's scene: the GPU's ray queries against our CPU traversal
+#    and Embree on every core, with its agreement check.
 #
 # That machine may have neither this machine's libraries nor the meshes. On the build machine,
 #   tools/gpu-check.sh --bundle
-# copies the shared libraries that build/pt and build/pt_tests load, the Vulkan loader and the
-# dynamic loader into out/gpu-bundle/lib, and the seed scene's meshes, gzipped, into
-# out/gpu-bundle (about 25 MB in all). Send build/ and out/gpu-bundle with the checkout; there,
+# copies the shared libraries that build/pt, build/pt_tests and build/bench/ray_bench load
+# (the largest, Embree's, gzipped), the Vulkan loader and the dynamic loader into
+# out/gpu-bundle/lib, and the seed scene's meshes, gzipped, into out/gpu-bundle (about 30 MB in
+# all; with build/, about 55 of the 64 MiB a run may carry). Send build/ and out/gpu-bundle with the checkout; there,
 #   tools/gpu-check.sh [GPU_SPP] [CPU_SPP]          (SIZE=512: another resolution)
 # runs the binaries through the bundled dynamic loader when out/gpu-bundle exists, so they need
 # nothing from the machine but its Vulkan driver. Results go to $OUT (default: a temporary
-# directory); a table comes last. The whole run takes a minute or two on an H100-class GPU
+# directory); a table comes last. The whole run takes a few minutes on an H100-class GPU
 # with 16 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,7 +34,9 @@ if [ "${1:-}" = "--bundle" ]; then
   mkdir -p "$bundle/lib"
   # Every library the binaries load, by the name they ask for, and libvulkan, which the
   # Vulkan-Hpp dispatcher opens at run time.
-  libs=$(ldd build/pt build/pt_tests | awk '$2 == "=>" && $3 ~ /^\// {print $1 " " $3}' | sort -u)
+  binaries=(build/pt build/pt_tests)
+  [ -x build/bench/ray_bench ] && binaries+=(build/bench/ray_bench)
+  libs=$(ldd "${binaries[@]}" | awk '$2 == "=>" && $3 ~ /^\// {print $1 " " $3}' | sort -u)
   vulkan=$(ldconfig -p | awk '$1 == "libvulkan.so.1" {print $NF; exit}')
   [ -n "$vulkan" ] || { echo "gpu-check: libvulkan.so.1 not found (Debian: libvulkan1)" >&2; exit 1; }
   while read -r name path; do cp -L "$path" "$bundle/lib/$name"; done <<<"$libs
@@ -42,6 +48,8 @@ libvulkan.so.1 $vulkan"
   for name in libdl.so.2 libpthread.so.0 librt.so.1; do
     [ -f "$libc_dir/$name" ] && cp -L "$libc_dir/$name" "$bundle/lib/"
   done
+  # Libraries above 8 MB (Embree's is 44 MB) travel gzipped; the run unpacks them.
+  find "$bundle/lib" -type f -size +8M -exec gzip {} \;
   if [ -f assets/dragon_vrip.ply ] && [ -f /usr/share/glmark2/models/bunny.obj ]; then
     gzip -c assets/dragon_vrip.ply >"$bundle/dragon_vrip.ply.gz"
     gzip -c /usr/share/glmark2/models/bunny.obj >"$bundle/bunny.obj.gz"
@@ -59,13 +67,14 @@ out=${OUT:-$(mktemp -d)}
 mkdir -p "$out"
 
 # The binaries, through the bundled loader when there is a bundle.
-run() {
-  if [ -d "$bundle/lib" ]; then
-    "$bundle/lib/ld-linux-x86-64.so.2" --library-path "$PWD/$bundle/lib" "$@"
-  else
-    "$@"
-  fi
-}
+runner=()
+if [ -d "$bundle/lib" ]; then
+  for gz in "$bundle"/lib/*.gz; do
+    [ -e "$gz" ] && [ ! -e "${gz%.gz}" ] && gunzip -c "$gz" >"${gz%.gz}"
+  done
+  runner=("$bundle/lib/ld-linux-x86-64.so.2" --library-path "$PWD/$bundle/lib")
+fi
+run() { "${runner[@]}" "$@"; }
 
 # Some NVIDIA container images keep the driver's ICD file where the Vulkan loader does not look.
 nvidia_icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
@@ -123,6 +132,16 @@ for scene in "${scenes[@]}"; do
   rows+=("$scene $(field 'Mrays/s' "$out/$scene-gpu.txt") $(field 'Mrays/s' "$out/$scene-cpu.txt") \
 ${device:-?} ${relmse:-?} $(field 'Mrays/s' "$out/$scene-gpu-k1.txt")")
 done
+
+# The ray benchmark, bounded in time: the table above comes first in importance.
+if [ -x build/bench/ray_bench ]; then
+  bench_scenes=cornell-box,sphere
+  [ -f "$out/bunny-dragon.json" ] && bench_scenes+=,bunny-dragon
+  timeout 420 "${runner[@]}" build/bench/ray_bench --configs "$out" --scenes "$bench_scenes" \
+    --csv "$out/ray_bench.csv" >"$out/ray_bench.txt" 2>&1 ||
+    echo "gpu-check: ray_bench failed or timed out (see $out/ray_bench.txt)"
+  sed -n '/^ray_bench:/p; /^Mrays\/s/,$p' "$out/ray_bench.txt"
+fi
 
 printf '\n%-14s %12s %12s %9s %12s %16s  %s\n' scene 'GPU Grays/s' 'CPU Grays/s' 'GPU/CPU' \
   'relMSE' 'GPU 1/dispatch' device
