@@ -18,7 +18,8 @@
 # copies the shared libraries that build/pt, build/pt_tests and build/bench/ray_bench load
 # (the largest, Embree's, gzipped), the Vulkan loader and the dynamic loader into
 # out/gpu-bundle/lib, and the seed scene's meshes, gzipped, into out/gpu-bundle (about 30 MB in
-# all; with build/, about 55 of the 64 MiB a run may carry). Send build/ and out/gpu-bundle with the checkout; there,
+# all; with build/, about 55 of the 64 MiB a run may carry). Send build/ and out/gpu-bundle
+# with the checkout; there,
 #   tools/gpu-check.sh [GPU_SPP] [CPU_SPP]          (SIZE=512: another resolution)
 # runs the binaries through the bundled dynamic loader when out/gpu-bundle exists, so they need
 # nothing from the machine but its Vulkan driver. Results go to $OUT (default: a temporary
