@@ -25,8 +25,13 @@ layout(constant_id = PT_SPEC_INTERSECTION) const uint kIntersection = kSpecAtRun
 layout(constant_id = PT_SPEC_SAMPLER) const uint kSampler = kSpecAtRunTime;
 
 layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer {
-  RenderParams params;
+  RenderParams paramsBuffer;
 };
+// The parameters, copied from their buffer once at the start of main and read from here. On
+// lavapipe a buffer load inside a loop or branch runs lane by lane, in a loop of its own (only
+// at the top of main does it read once for all lanes): the path loop had 28 such loops, 5 % of
+// the render.
+RenderParams params;
 // The scene's arrays, as texels (see PT_BINDING_NODES); loadNode, loadTriangle, loadMaterial
 // and loadEmitter read their structs.
 layout(set = 0, binding = PT_BINDING_NODES) uniform usamplerBuffer nodeTexels;
@@ -300,6 +305,7 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
 }
 
 void main() {
+  params = paramsBuffer;
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= params.camera.width || pixel.y >= params.camera.height) return;
   uint index = pixel.y * params.camera.width + pixel.x;
