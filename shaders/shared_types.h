@@ -146,8 +146,11 @@ struct RenderParams {
 // Descriptor bindings of set 0. The scene's arrays are uniform texel buffers, read as 16-byte
 // texels (R32G32B32A32_UINT) a row of a struct at a time: lavapipe gathers a texel fetch for
 // its eight lanes at once, where a storage-buffer load with a different index per lane
-// takes a loop over the lanes with a branch per lane and component. The rest are storage
-// buffers.
+// takes a loop over the lanes with a branch per lane and component (as does any buffer load
+// inside a loop or branch: see `params` in pathtrace.comp). The rest are storage buffers.
+// (Mesa 22.3 fetches these texels in a function of its own, called four times per traversal
+// step; as storage texel buffers read by imageLoad, which it inlines, they were no faster:
+// Cornell box the same, bunny box 2-4 % slower.)
 #define PT_BINDING_PARAMS 0     // RenderParams
 #define PT_BINDING_NODES 1      // GpuBvhNode[], then Triangle[] (gpuTraversalTexels), texels
 #define PT_BINDING_TRIANGLES 2  // Triangle[], texels
