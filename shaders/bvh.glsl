@@ -158,8 +158,12 @@ bool intersectTriangleFast(RayData r, Triangle tri, float tMax, out TriangleHit 
 bool intersectBox(RayData r, vec3 lo, vec3 hi, float tMax, out float tNear) {
   vec3 t0 = (lo - r.origin) * r.invDirection;
   vec3 t1 = (hi - r.origin) * r.invDirection;
-  vec3 tMinV = min(t0, t1);
-  vec3 tMaxV = max(t0, t1);
+  // min(t0, t1) and max(t0, t1), chosen by the direction's sign: rounding keeps the order of
+  // lo - o <= hi - o, so t0 <= t1 exactly when 1/d > 0 (never 0, never NaN: safeInverse).
+  // A select is one instruction on lavapipe, where min and max take three (NaN handling).
+  bvec3 negative = lessThan(r.invDirection, vec3(0.0));
+  vec3 tMinV = mix(t0, t1, negative);
+  vec3 tMaxV = mix(t1, t0, negative);
   float enter = max(max(tMinV.x, tMinV.y), max(tMinV.z, 0.0));
   float exit = min(min(tMaxV.x, tMaxV.y), min(tMaxV.z, tMax)) * kFarScale;
   tNear = enter;
