@@ -159,7 +159,7 @@ bool intersectBox(RayData r, vec3 lo, vec3 hi, float tMax, out float tNear) {
   vec3 t0 = (lo - r.origin) * r.invDirection;
   vec3 t1 = (hi - r.origin) * r.invDirection;
   // min(t0, t1) and max(t0, t1), chosen by the direction's sign: rounding keeps the order of
-  // lo - o <= hi - o, so t0 <= t1 exactly when 1/d > 0 (never 0, never NaN: safeInverse).
+  // lo - o <= hi - o, so t0 <= t1 exactly when 1/d > 0 (never 0: safeInverse).
   // A select is one instruction on lavapipe, where min and max take three (NaN handling).
   bvec3 negative = lessThan(r.invDirection, vec3(0.0));
   vec3 tMinV = mix(t0, t1, negative);

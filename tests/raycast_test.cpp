@@ -26,12 +26,15 @@ namespace {
 const ContextOptions kValidated{.validation = validationWanted()};
 
 // The rays traced on the device with validation (where wanted), which must report no
-// validation error and no query cut short by the loop cap.
+// validation error and no query cut short by the loop cap, and the dispatch's device time
+// (what the ray benchmark divides by) as a positive, finite number of seconds.
 std::vector<RayResult> traceChecked(const Bvh& bvh, const std::vector<RayQuery>& queries) {
   RaycastStats stats;
   std::vector<RayResult> results = traceRaysVulkan(bvh, queries, kValidated, &stats);
   EXPECT_EQ(stats.validationErrors, 0u);
   EXPECT_EQ(stats.truncated, 0u);
+  EXPECT_GT(stats.deviceSeconds, 0.0);
+  EXPECT_LT(stats.deviceSeconds, 3600.0);
   return results;
 }
 

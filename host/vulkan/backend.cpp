@@ -78,7 +78,7 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   buffers.accumSize = vk::DeviceSize(cam.width) * cam.height * sizeof(AccumPixel);
   checkRange(ctx, "accumulation", buffers.accumSize);
   checkUploads(ctx, uploads);
-  buffers.bound = recordUploads(ctx, cmd, uploads, {}, staging);
+  buffers.bound = recordUploads(ctx, cmd, uploads, staging);
   for (const Upload& u : uploads) buffers.texels.push_back(u.texels);
   const auto readWrite = U::eStorageBuffer | U::eTransferSrc | U::eTransferDst;
   buffers.bound.push_back(makeBuffer(ctx, buffers.accumSize, readWrite, false));

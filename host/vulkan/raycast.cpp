@@ -34,7 +34,7 @@ std::vector<RayResult> traceRaysVulkan(const Bvh& bvh, const std::vector<RayQuer
   const Commands commands(ctx);
   commands.begin();
   Buffer staging;
-  std::vector<Buffer> buffers = recordUploads(ctx, commands.cmd, uploads, {}, staging);
+  std::vector<Buffer> buffers = recordUploads(ctx, commands.cmd, uploads, staging);
   buffers.push_back(makeBuffer(ctx, resultSize, U::eStorageBuffer | U::eTransferSrc, false));
   const Buffer readback = makeBuffer(ctx, resultSize, U::eTransferDst, true);
   std::vector<Binding> bound;

@@ -68,14 +68,13 @@ void checkUploads(const VulkanContext& ctx, std::span<const Upload> uploads) {
 }
 
 std::vector<Buffer> recordUploads(const VulkanContext& ctx, const vk::raii::CommandBuffer& cmd,
-                                  std::span<const Upload> uploads, vk::BufferUsageFlags extraUsage,
-                                  Buffer& staging) {
+                                  std::span<const Upload> uploads, Buffer& staging) {
   using U = vk::BufferUsageFlagBits;
   std::vector<Buffer> buffers;
   vk::DeviceSize stagingSize = 0;
   for (const Upload& u : uploads) {
     const vk::BufferUsageFlags usage = u.texels ? U::eUniformTexelBuffer : U::eStorageBuffer;
-    buffers.push_back(makeBuffer(ctx, u.size, usage | extraUsage | U::eTransferDst, false));
+    buffers.push_back(makeBuffer(ctx, u.size, usage | U::eTransferDst, false));
     if (u.texels) makeTexelView(ctx, buffers.back());
     stagingSize += u.size;
   }

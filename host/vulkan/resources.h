@@ -46,12 +46,11 @@ struct Upload {
 // before anything is allocated.
 void checkUploads(const VulkanContext& ctx, std::span<const Upload> uploads);
 
-// A device-local buffer for each upload (with its texel view where asked; `extraUsage` added
-// to every one), and the copies into them recorded into `cmd` from `staging`, filled here and
-// to be kept alive by the caller until the commands have run.
+// A device-local buffer for each upload (with its texel view where asked), and the copies into
+// them recorded into `cmd` from `staging`, filled here and to be kept alive by the caller until
+// the commands have run.
 std::vector<Buffer> recordUploads(const VulkanContext& ctx, const vk::raii::CommandBuffer& cmd,
-                                  std::span<const Upload> uploads, vk::BufferUsageFlags extraUsage,
-                                  Buffer& staging);
+                                  std::span<const Upload> uploads, Buffer& staging);
 
 // The device time between two points of a command buffer, from timestamp queries: start and
 // stop record them (start resets the pool first), seconds reads them once the commands have
