@@ -1,8 +1,9 @@
 // The GPU path tracer: one invocation traces a pass's samples of one pixel (as many as the
 // host chose for the dispatch) and adds them to the accumulation buffer's sums. The same
 // integrator as host/cpu/integrator.cpp (NEE + BSDF sampling with MIS, Russian roulette,
-// Lambertian and mirror), written separately in GLSL; the layouts (shared_types.h) and random
-// numbers (sampling.h) are shared.
+// Lambertian and mirror, and bsdf.h's materials), written separately in GLSL; the layouts
+// (shared_types.h), random numbers (sampling.h) and the BSDFs beyond the two (bsdf.h) are
+// shared.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #ifdef PT_DEBUG_PRINTF
@@ -23,6 +24,20 @@ layout(constant_id = PT_SPEC_MIS) const bool kMis = true;
 layout(constant_id = PT_SPEC_RR) const bool kRussianRoulette = true;
 layout(constant_id = PT_SPEC_INTERSECTION) const uint kIntersection = kSpecAtRunTime;
 layout(constant_id = PT_SPEC_SAMPLER) const uint kSampler = kSpecAtRunTime;
+layout(constant_id = PT_SPEC_CONDUCTOR) const bool kConductor = true;
+layout(constant_id = PT_SPEC_DIELECTRIC) const bool kDielectric = true;
+layout(constant_id = PT_SPEC_THIN_DIELECTRIC) const bool kThinDielectric = true;
+layout(constant_id = PT_SPEC_DIFFUSE_TRANSMISSION) const bool kDiffuseTransmission = true;
+layout(constant_id = PT_SPEC_COATED_DIFFUSE) const bool kCoatedDiffuse = true;
+// Some surface has one of bsdf.h's materials; bsdf.h's switch sees only the types in use.
+const bool kBsdfMaterials =
+    kConductor || kDielectric || kThinDielectric || kDiffuseTransmission || kCoatedDiffuse;
+#define PT_HAS_CONDUCTOR kConductor
+#define PT_HAS_DIELECTRIC kDielectric
+#define PT_HAS_THIN_DIELECTRIC kThinDielectric
+#define PT_HAS_DIFFUSE_TRANSMISSION kDiffuseTransmission
+#define PT_HAS_COATED_DIFFUSE kCoatedDiffuse
+#include "bsdf.h"
 
 layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer {
   RenderParams paramsBuffer;
@@ -66,11 +81,22 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
   (kSampler == kSpecAtRunTime ? params.samplerType == kSamplerSobol : kSampler == kSamplerSobol)
 #include "bvh.glsl"
 
+// The rows beyond the first two only where a scene has bsdf.h's materials.
 Material loadMaterial(uint i) {
-  int at = int(2u * i);
+  int at = int(kMaterialTexels * i);
   uvec4 a = texelFetch(materialTexels, at);
   uvec4 b = texelFetch(materialTexels, at + 1);
-  return Material(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w);
+  uvec4 c = uvec4(0u), d = uvec4(0u), e = uvec4(0u), f = uvec4(0u);
+  if (kBsdfMaterials) {
+    c = texelFetch(materialTexels, at + 2);
+    d = texelFetch(materialTexels, at + 3);
+    e = texelFetch(materialTexels, at + 4);
+    f = texelFetch(materialTexels, at + 5);
+  }
+  return Material(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
+                  uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.xyz),
+                  uintBitsToFloat(d.w), uintBitsToFloat(e.xyz), uintBitsToFloat(e.w),
+                  uintBitsToFloat(f.x), f.y, f.z, f.w);
 }
 
 Emitter loadEmitter(uint i) {
@@ -94,6 +120,56 @@ struct Retrace {
   vec3 contribution;
 };
 
+// A uniform point on an emitter chosen from the alias table with uChoose (uLight: the point).
+struct LightPoint {
+  vec3 point;
+  vec3 normal;      // the emitter's unit geometric normal (it emits on this side)
+  float area;
+  float magnitude;  // for the ray offset at the light
+  float pmf;        // probability of choosing this emitter
+  vec3 Le;
+  uint triangle;
+  uint primitive;
+};
+
+LightPoint pickLightPoint(vec2 uChoose, vec2 uLight) {
+  uint slot = aliasTableSlot(uChoose.x, params.emitterCount);
+  Emitter emitter = loadEmitter(aliasTablePick(slot, loadEmitter(slot), uChoose.y));
+  Triangle light = loadTriangle(emitter.triangle);
+  vec2 b = sampleTriangleBarycentrics(uLight);
+  vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
+  return LightPoint((1.0 - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2,
+                    normalize(lightCross), 0.5 * length(lightCross),
+                    triangleMagnitude(light.v0, light.v1, light.v2), emitter.pmf,
+                    loadMaterial(light.material).emission, emitter.triangle, light.primitive);
+}
+
+// Traces the shadow ray of a light sample, from `from` (offset) to the light point (offset);
+// returns false when it is occluded. When the traversal gave up (see Retrace), `retrace`
+// takes the ray and the contribution, and this returns false: the contribution comes later.
+bool unoccluded(vec3 from, LightPoint light, vec3 contribution, inout Retrace retrace) {
+  vec3 to = offsetRayOrigin(light.point, light.normal, light.magnitude);
+  gRays++;
+  HitData blocker;
+  bool inexact;
+  bool occluded =
+      traceRayWith(/*exact=*/false, from, to - from, 1.0, /*anyHit=*/true, blocker, inexact);
+  if (inexact) {
+    retrace = Retrace(true, true, from, to - from, contribution);
+    return false;
+  }
+  return !occluded;
+}
+
+void debugLightSample(uint depth, LightPoint light, float lightPdf, float weight) {
+#ifdef PT_DEBUG_PRINTF
+  if (gDebug) {
+    debugPrintfEXT("gpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g",
+                   depth, light.triangle, light.primitive, lightPdf, weight);
+  }
+#endif
+}
+
 // Samples direct illumination at diffuse vertex p with shading normal n (next-event
 // estimation, pbrt's SampleLd): picks an emitter from the alias table with uChoose, a uniform
 // point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
@@ -103,48 +179,50 @@ struct Retrace {
 vec3 sampleDirectLight(vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f, vec2 uChoose,
                        vec2 uLight, bool misOn, uint depth, inout Retrace retrace) {
   // Pick an emitter from the alias table, then a uniform point on its triangle.
-  uint slot = aliasTableSlot(uChoose.x, params.emitterCount);
-  Emitter emitter = loadEmitter(aliasTablePick(slot, loadEmitter(slot), uChoose.y));
-  Triangle light = loadTriangle(emitter.triangle);
-  vec2 b = sampleTriangleBarycentrics(uLight);
-  vec3 lightPoint = (1.0 - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
-  vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
-  float lightArea = 0.5 * length(lightCross);
-  vec3 lightNormal = normalize(lightCross);
+  LightPoint light = pickLightPoint(uChoose, uLight);
 
-  vec3 toLight = lightPoint - p;
+  vec3 toLight = light.point - p;
   float dist2 = dot(toLight, toLight);
   vec3 wl = toLight / sqrt(dist2);
-  float cosLight = -dot(lightNormal, wl);  // > 0: we see the emitting side
+  float cosLight = -dot(light.normal, wl);  // > 0: we see the emitting side
   float cosSurface = dot(n, wl);
   if (!(cosLight > 0.0 && cosSurface > 0.0)) return vec3(0.0);
 
   // Shadow ray between the two offset points; t in [0, 1) spans the segment.
-  vec3 from = offsetRayOrigin(p, n, magnitude);
-  vec3 to =
-      offsetRayOrigin(lightPoint, lightNormal, triangleMagnitude(light.v0, light.v1, light.v2));
-  gRays++;
-  HitData blocker;
-  bool inexact;
-  bool occluded =
-      traceRayWith(/*exact=*/false, from, to - from, 1.0, /*anyHit=*/true, blocker, inexact);
-  if (occluded && !inexact) return vec3(0.0);
-
-  float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
+  float lightPdf = light.pmf * dist2 / (cosLight * light.area);
   float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0;
-  vec3 Le = loadMaterial(light.material).emission;
-#ifdef PT_DEBUG_PRINTF
-  if (gDebug) {
-    debugPrintfEXT("gpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g",
-                   depth, emitter.triangle, light.primitive, lightPdf, weight);
-  }
-#endif
-  vec3 contribution = beta * f * Le * (cosSurface * weight / lightPdf);
-  if (inexact) {
-    retrace = Retrace(true, true, from, to - from, contribution);
-    return vec3(0.0);
-  }
-  return contribution;
+  debugLightSample(depth, light, lightPdf, weight);
+  vec3 contribution = beta * f * light.Le * (cosSurface * weight / lightPdf);
+  return unoccluded(offsetRayOrigin(p, n, magnitude), light, contribution, retrace)
+             ? contribution
+             : vec3(0.0);
+}
+
+// sampleDirectLight at a vertex with one of bsdf.h's BSDFs (integrator.cpp's
+// sampleDirectLightBsdf): the BSDF's value and density in the local shading frame, whose z is
+// the geometric normal ng; the shadow ray leaves from the side the light is on.
+vec3 sampleDirectLightBsdf(vec3 p, vec3 ng, ShadingFrame frame, Material material, vec3 wo,
+                           float magnitude, vec3 beta, vec2 uChoose, vec2 uLight,
+                           RandomStream evalStream, RandomStream pdfStream, bool misOn,
+                           uint depth, inout Retrace retrace) {
+  LightPoint light = pickLightPoint(uChoose, uLight);
+  vec3 toLight = light.point - p;
+  float dist2 = dot(toLight, toLight);
+  vec3 wl = toLight / sqrt(dist2);
+  float cosLight = -dot(light.normal, wl);  // > 0: we see the emitting side
+  if (!(cosLight > 0.0)) return vec3(0.0);
+  vec3 wi = toLocal(frame, wl);
+  vec3 f = bsdfF(material, wo, wi, evalStream) * absCosTheta(wi);
+  if (!(maxComponent(f) > 0.0)) return vec3(0.0);
+
+  float lightPdf = light.pmf * dist2 / (cosLight * light.area);
+  float weight = misOn ? powerHeuristic(lightPdf, bsdfPdf(material, wo, wi, pdfStream)) : 1.0;
+  debugLightSample(depth, light, lightPdf, weight);
+  vec3 contribution = beta * f * light.Le * (weight / lightPdf);
+  return unoccluded(offsetRayOrigin(p, wi.z > 0.0 ? ng : -ng, magnitude), light, contribution,
+                    retrace)
+             ? contribution
+             : vec3(0.0);
 }
 
 // What sampleRadiance (host/cpu/integrator.cpp) keeps across its loop: one sample's path,
@@ -158,6 +236,7 @@ struct Path {
   vec3 beta;            // path throughput
   bool specularBounce;  // the ray leaves a specular bounce (or the camera)
   float bsdfPdf;        // solid-angle pdf of the BSDF sample that produced the ray
+  float etaScale;       // product of the squared relative indices refracted through
   bool hitReady;        // the ray's closest hit is hitFound and hit already (see Retrace)
   bool hitFound;
   HitData hit;
@@ -193,6 +272,7 @@ Path startPath(uvec2 pixel, uint sampleIndex) {
   // The camera ray counts as specular: emission it finds is taken at full weight.
   path.specularBounce = true;
   path.bsdfPdf = 0.0;
+  path.etaScale = 1.0;
   path.hitReady = false;
   path.hitFound = false;
   path.hit = HitData(0.0, 0u);
@@ -263,14 +343,45 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   uint dim = kDimFirstBounce + kDimsPerBounce * path.depth;
   ++path.depth;
 
-  // Both materials are two-sided: shade with the normal facing the incoming ray.
+  // Diffuse and mirror surfaces are two-sided: shaded with the normal facing the ray.
   vec3 n = cosOut >= 0.0 ? ng : -ng;
   vec3 wi;
-  if (kMirror && (!kDiffuse || material.type == kMaterialMirror)) {
+  if (kMirror && ((!kDiffuse && !kBsdfMaterials) || material.type == kMaterialMirror)) {
     // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
     wi = path.direction - 2.0 * dot(path.direction, n) * n;
     path.beta *= material.reflectance;
     path.specularBounce = true;
+  } else if (kBsdfMaterials && (!kDiffuse || material.type != kMaterialDiffuse)) {
+    // One of bsdf.h's BSDFs, in the shading frame about the geometric normal (not turned
+    // towards the ray: a dielectric tells inside from outside by it).
+    ShadingFrame frame = makeShadingFrame(ng, tri.v1 - tri.v0);
+    vec3 woLocal = toLocal(frame, wo);
+    // Sample direct illumination from an emitter, unless the BSDF has only delta lobes.
+    if (neeOn() && bsdfHasNonSpecular(material)) {
+      path.L += sampleDirectLightBsdf(
+          p, ng, frame, material, woLocal, magnitude, path.beta,
+          random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
+          random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
+          makeRandomStream(pixel, sampleIndex, dim, seed, kStreamEval),
+          makeRandomStream(pixel, sampleIndex, dim, seed, kStreamLightPdf), misOn(), path.depth,
+          retrace);
+    }
+    // Sample the BSDF; the lobe choice takes the roulette dimension's second number.
+    BsdfSample bs = bsdfSample(material, woLocal,
+                               random2(sobol, pixel, sampleIndex, dim + kDimRoulette, seed).y,
+                               random2(sobol, pixel, sampleIndex, dim + kDimBsdf, seed),
+                               makeRandomStream(pixel, sampleIndex, dim, seed, kStreamSample));
+    if (bs.flags == 0u) return true;
+    wi = fromLocal(frame, bs.wi);
+    path.beta *= bs.f * (absCosTheta(bs.wi) / bs.pdf);
+    path.specularBounce = (bs.flags & kBsdfSpecular) != 0u;
+    path.bsdfPdf = bs.pdfIsProportional
+                       ? bsdfPdf(material, woLocal, bs.wi,
+                                 makeRandomStream(pixel, sampleIndex, dim, seed, kStreamSamplePdf))
+                       : bs.pdf;
+    if ((bs.flags & kBsdfTransmission) != 0u) path.etaScale *= bs.eta * bs.eta;
+    // The new ray leaves from the side it goes to.
+    n = bs.wi.z > 0.0 ? ng : -ng;
   } else {
     vec3 f = material.reflectance * kInvPi;
     // Sample direct illumination from an emitter (next-event estimation).
@@ -293,7 +404,7 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
 
   // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
   if (rouletteOn() && path.depth >= params.rrStartDepth) {
-    float q = max(0.0, 1.0 - maxComponent(path.beta));
+    float q = max(0.0, 1.0 - maxComponent(kBsdfMaterials ? path.beta * path.etaScale : path.beta));
     if (random1(sobol, pixel, sampleIndex, dim + kDimRoulette, seed) < q) return true;
     path.beta /= 1.0 - q;
   }

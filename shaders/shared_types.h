@@ -84,15 +84,41 @@ struct Triangle {
   uint primitive;  //  4 bytes: index of the triangle in scene (load) order
 };                 // 48 bytes
 
+// Material types. Diffuse and mirror are the seed's; the rest follow pbrt-v4's materials of
+// the same names (its parameters, its definitions: shaders/bsdf.h).
 PT_CONST uint kMaterialDiffuse = 0u;  // ideal Lambertian, BRDF = reflectance / pi, two-sided
 PT_CONST uint kMaterialMirror = 1u;   // ideal specular reflection, no Fresnel, two-sided
+PT_CONST uint kMaterialConductor = 2u;    // metal: complex Fresnel, smooth or Trowbridge-Reitz
+PT_CONST uint kMaterialDielectric = 3u;   // glass: reflection and refraction, smooth or rough
+PT_CONST uint kMaterialThinDielectric = 4u;        // a pane: reflection, straight transmission
+PT_CONST uint kMaterialDiffuseTransmission = 5u;   // Lambertian reflection and transmission
+PT_CONST uint kMaterialCoatedDiffuse = 6u;  // dielectric coat over a Lambertian base (layered)
+PT_CONST uint kMaterialTypeCount = 7u;
 
+// One material. The first two rows are all that diffuse and mirror surfaces read; the others
+// hold the parameters of the other types (zero where a type has no use for them). Roughness is
+// stored as the Trowbridge-Reitz alpha, pbrt-v4's remapping already applied by the host.
 struct Material {
-  vec3 reflectance;  // 12 bytes: diffuse albedo or mirror reflectance, linear RGB
-  uint type;         //  4 bytes: kMaterialDiffuse or kMaterialMirror
-  vec3 emission;     // 12 bytes: radiance emitted on the front side (geometric normal side)
-  uint reserved;     //  4 bytes: zero (keeps the 16-byte row)
-};                   // 32 bytes
+  vec3 reflectance;    // 12 bytes: diffuse albedo, mirror reflectance, diffusetransmission's
+                       //           reflectance, coateddiffuse's base albedo; linear RGB
+  uint type;           //  4 bytes: kMaterial*
+  vec3 emission;       // 12 bytes: radiance emitted on the front side (geometric normal side)
+  uint reserved;       //  4 bytes: zero (keeps the 16-byte row)
+  vec3 eta;            // 12 bytes: conductor: real part of the index of refraction per channel;
+                       //           dielectric, thindielectric, coateddiffuse: the index in .x
+  float alphaX;        //  4 bytes: Trowbridge-Reitz alpha along the tangent (conductor,
+                       //           dielectric, coateddiffuse's coat)
+  vec3 k;              // 12 bytes: conductor: imaginary part of the index (absorption)
+  float alphaY;        //  4 bytes: alpha along the bitangent
+  vec3 transmittance;  // 12 bytes: diffusetransmission: transmittance; coateddiffuse: the
+                       //           albedo of the medium between coat and base
+  float thickness;     //  4 bytes: coateddiffuse: the medium's optical thickness
+  float g;             //  4 bytes: coateddiffuse: Henyey-Greenstein asymmetry of the medium
+  uint maxDepth;       //  4 bytes: coateddiffuse: random-walk length
+  uint nSamples;       //  4 bytes: coateddiffuse: random walks per evaluation
+  uint reserved1;      //  4 bytes: zero
+};                     // 96 bytes
+PT_CONST uint kMaterialTexels = 6u;  // 16-byte texels per Material (the GPU reads them so)
 
 // One entry of the emitter alias table (Walker 1977, Vose 1991): emitter i is picked with
 // probability pmf; sampling draws a slot uniformly and keeps it with probability
@@ -173,7 +199,13 @@ struct RenderParams {
 #define PT_SPEC_SAMPLER 7       // uint: RenderParams::samplerType (independent or Sobol)
 // Not an effect: the traversal stack's size, rows of four entries (bvh.glsl), from the tree.
 #define PT_SPEC_STACK_ROWS 8  // uint: 1 to kBvhStackSize / 4
-#define PT_SPEC_COUNT 9
+// The material types beyond the seed's (bool each: some surface has that type).
+#define PT_SPEC_CONDUCTOR 9
+#define PT_SPEC_DIELECTRIC 10
+#define PT_SPEC_THIN_DIELECTRIC 11
+#define PT_SPEC_DIFFUSE_TRANSMISSION 12
+#define PT_SPEC_COATED_DIFFUSE 13
+#define PT_SPEC_COUNT 14
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever

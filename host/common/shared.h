@@ -26,9 +26,14 @@ static_assert(offsetof(Triangle, v0) == 0 && offsetof(Triangle, material) == 12)
 static_assert(offsetof(Triangle, v1) == 16 && offsetof(Triangle, emitter) == 28);
 static_assert(offsetof(Triangle, v2) == 32 && offsetof(Triangle, primitive) == 44);
 
-static_assert(sizeof(Material) == 32);
+static_assert(sizeof(Material) == 96 && sizeof(Material) == 16 * kMaterialTexels);
 static_assert(offsetof(Material, reflectance) == 0 && offsetof(Material, type) == 12);
 static_assert(offsetof(Material, emission) == 16 && offsetof(Material, reserved) == 28);
+static_assert(offsetof(Material, eta) == 32 && offsetof(Material, alphaX) == 44);
+static_assert(offsetof(Material, k) == 48 && offsetof(Material, alphaY) == 60);
+static_assert(offsetof(Material, transmittance) == 64 && offsetof(Material, thickness) == 76);
+static_assert(offsetof(Material, g) == 80 && offsetof(Material, maxDepth) == 84);
+static_assert(offsetof(Material, nSamples) == 88 && offsetof(Material, reserved1) == 92);
 
 static_assert(sizeof(Emitter) == 16);
 static_assert(offsetof(Emitter, pmf) == 4 && offsetof(Emitter, aliasThreshold) == 8);

@@ -15,6 +15,7 @@
 
 #include <sched.h>
 
+#include "bsdf.h"
 #include "bvh/traverse.h"
 #include "common/check.h"
 #include "cpu/bounce_random.h"
@@ -32,6 +33,59 @@ int availableCpus() {
   return int(std::max(1u, std::thread::hardware_concurrency()));
 }
 
+// A uniform point on an emitter chosen from the alias table with uChoose (uLight: the point).
+struct LightPoint {
+  vec3 point;
+  vec3 normal;      // the emitter's unit geometric normal (it emits on this side)
+  float area;
+  float magnitude;  // for the ray offset at the light
+  float pmf;        // probability of choosing this emitter
+  vec3 Le;
+  uint triangle;
+};
+
+LightPoint pickLightPoint(const SceneData& scene, const CpuSceneCopies& copies, vec2 uChoose,
+                          vec2 uLight) {
+  const uint slot = aliasTableSlot(uChoose.x, scene.params.emitterCount);
+  const Emitter& emitter = scene.emitters[aliasTablePick(slot, scene.emitters[slot], uChoose.y)];
+  const Triangle& light = scene.bvh.triangles[emitter.triangle];
+  const TriangleShading& lightShading = copies.shading[emitter.triangle];
+  const vec2 b = sampleTriangleBarycentrics(uLight);
+  return LightPoint{(1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2,
+                    lightShading.normal,
+                    lightShading.area,
+                    lightShading.magnitude,
+                    emitter.pmf,
+                    scene.materials[light.material].emission,
+                    emitter.triangle};
+}
+
+// The unit direction from p towards a light point, the squared distance, and the cosine at the
+// light (> 0: p sees the emitting side).
+struct ToLight {
+  vec3 wl;
+  float dist2;
+  float cosLight;
+};
+
+ToLight towardsLight(const LightPoint& light, vec3 p) {
+  const vec3 toLight = light.point - p;
+  const float dist2 = dot(toLight, toLight);
+  const vec3 wl = toLight / std::sqrt(dist2);
+  return ToLight{wl, dist2, -dot(light.normal, wl)};
+}
+
+// --debug-pixel's line about a light sample.
+void printLightSample(const SceneData& scene, const LightPoint& light, float lightPdf,
+                      float weight, bool debugPrint, uint depth) {
+  if (debugPrint) {
+    std::fprintf(stderr,
+                 "cpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g\n",
+                 depth, light.triangle, scene.bvh.triangles[light.triangle].primitive, lightPdf,
+                 weight);
+  }
+}
+
 // Samples direct illumination at diffuse vertex p with shading normal n (next-event
 // estimation, pbrt's SampleLd): picks an emitter from the alias table with uChoose, a uniform
 // point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
@@ -41,37 +95,50 @@ vec3 sampleDirectLight(const SceneData& scene, const CpuSceneCopies& copies, vec
                        float magnitude, vec3 beta, vec3 f, vec2 uChoose, vec2 uLight, bool misOn,
                        Intersection test, uint64_t& rays, bool debugPrint, uint depth) {
   // Pick an emitter from the alias table, then a uniform point on its triangle.
-  const uint slot = aliasTableSlot(uChoose.x, scene.params.emitterCount);
-  const Emitter& emitter = scene.emitters[aliasTablePick(slot, scene.emitters[slot], uChoose.y)];
-  const Triangle& light = scene.bvh.triangles[emitter.triangle];
-  const TriangleShading& lightShading = copies.shading[emitter.triangle];
-  const vec2 b = sampleTriangleBarycentrics(uLight);
-  const vec3 lightPoint = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
-  const float lightArea = lightShading.area;
-  const vec3 lightNormal = lightShading.normal;
+  const LightPoint light = pickLightPoint(scene, copies, uChoose, uLight);
 
-  const vec3 toLight = lightPoint - p;
-  const float dist2 = dot(toLight, toLight);
-  const vec3 wl = toLight / std::sqrt(dist2);
-  const float cosLight = -dot(lightNormal, wl);  // > 0: we see the emitting side
-  const float cosSurface = dot(n, wl);
-  if (!(cosLight > 0.0f && cosSurface > 0.0f)) return vec3(0.0f);
+  const ToLight toward = towardsLight(light, p);
+  const float cosSurface = dot(n, toward.wl);
+  if (!(toward.cosLight > 0.0f && cosSurface > 0.0f)) return vec3(0.0f);
 
   // Shadow ray between the two offset points; t in [0, 1) spans the segment.
   const vec3 from = offsetRayOrigin(p, n, magnitude);
-  const vec3 to = offsetRayOrigin(lightPoint, lightNormal, lightShading.magnitude);
+  const vec3 to = offsetRayOrigin(light.point, light.normal, light.magnitude);
   ++rays;
   if (anyHit(copies.wide, Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
 
-  const float lightPdf = emitter.pmf * dist2 / (cosLight * lightArea);
+  const float lightPdf = light.pmf * toward.dist2 / (toward.cosLight * light.area);
   const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
-  const vec3 Le = scene.materials[light.material].emission;
-  if (debugPrint) {
-    std::fprintf(stderr,
-                 "cpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g\n",
-                 depth, emitter.triangle, light.primitive, lightPdf, weight);
-  }
-  return beta * f * Le * (cosSurface * weight / lightPdf);
+  printLightSample(scene, light, lightPdf, weight, debugPrint, depth);
+  return beta * f * light.Le * (cosSurface * weight / lightPdf);
+}
+
+// sampleDirectLight at a vertex with one of bsdf.h's BSDFs: the same light sample, with the
+// BSDF's value and density in place of the Lambertian's, in the local shading frame (z is
+// the geometric normal ng, which the frame's z equals). The shadow ray leaves from the side
+// the light is on; f * |cos| is zero where the BSDF does not scatter that way.
+vec3 sampleDirectLightBsdf(const SceneData& scene, const CpuSceneCopies& copies, vec3 p, vec3 ng,
+                           const ShadingFrame& frame, const Material& material, vec3 wo,
+                           float magnitude, vec3 beta, vec2 uChoose, vec2 uLight,
+                           RandomStream evalStream, RandomStream pdfStream, bool misOn,
+                           Intersection test, uint64_t& rays, bool debugPrint, uint depth) {
+  const LightPoint light = pickLightPoint(scene, copies, uChoose, uLight);
+  const ToLight toward = towardsLight(light, p);
+  if (!(toward.cosLight > 0.0f)) return vec3(0.0f);
+  const vec3 wi = toLocal(frame, toward.wl);
+  const vec3 f = bsdfF(material, wo, wi, evalStream) * absCosTheta(wi);
+  if (!(maxComponent(f) > 0.0f)) return vec3(0.0f);
+
+  const vec3 from = offsetRayOrigin(p, wi.z > 0.0f ? ng : -ng, magnitude);
+  const vec3 to = offsetRayOrigin(light.point, light.normal, light.magnitude);
+  ++rays;
+  if (anyHit(copies.wide, Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
+
+  const float lightPdf = light.pmf * toward.dist2 / (toward.cosLight * light.area);
+  const float weight =
+      misOn ? powerHeuristic(lightPdf, bsdfPdf(material, wo, wi, pdfStream)) : 1.0f;
+  printLightSample(scene, light, lightPdf, weight, debugPrint, depth);
+  return beta * f * light.Le * (weight / lightPdf);
 }
 
 }  // namespace
@@ -101,6 +168,9 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
   // The camera ray counts as specular: emission it finds is taken at full weight.
   bool specularBounce = true;
   float bsdfPdf = 0.0f;  // solid-angle pdf of the BSDF sample that produced `ray`
+  // Product of the squared relative indices of the refractions so far: radiance is scaled by
+  // 1 / eta^2 on each, which Russian roulette leaves out (pbrt-v4's etaScale).
+  float etaScale = 1.0f;
 
   for (uint depth = 0;;) {
     // Find the closest surface along the ray; the background is black.
@@ -149,8 +219,8 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     const uint dim = kDimFirstBounce + kDimsPerBounce * depth;
     ++depth;
 
-    // Both materials are two-sided: shade with the normal facing the incoming ray.
-    const vec3 n = cosOut >= 0.0f ? ng : -ng;
+    // Diffuse and mirror surfaces are two-sided: shaded with the normal facing the ray.
+    vec3 n = cosOut >= 0.0f ? ng : -ng;
     // This event's random numbers, all four dimensions at once (the shader draws each where
     // it is used: the same numbers).
     const BounceRandom u = bounceRandomSimd(sobol, pixel, sampleIndex, dim, seed);
@@ -160,6 +230,34 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
       wi = ray.direction - 2.0f * dot(ray.direction, n) * n;
       beta *= material.reflectance;
       specularBounce = true;
+    } else if (material.type != kMaterialDiffuse) {
+      // One of bsdf.h's BSDFs, in the shading frame about the geometric normal (not turned
+      // towards the ray: a dielectric tells inside from outside by it).
+      const ShadingFrame frame = makeShadingFrame(ng, tri.v1 - tri.v0);
+      const vec3 woLocal = toLocal(frame, wo);
+      // Sample direct illumination from an emitter, unless the BSDF has only delta lobes.
+      if (neeOn && bsdfHasNonSpecular(material)) {
+        L += sampleDirectLightBsdf(
+            scene, copies, p, ng, frame, material, woLocal, magnitude, beta, u.lightChoose,
+            u.lightPoint, makeRandomStream(pixel, sampleIndex, dim, seed, kStreamEval),
+            makeRandomStream(pixel, sampleIndex, dim, seed, kStreamLightPdf), misOn, test, rays,
+            debugPrint, depth);
+      }
+      // Sample the BSDF; the lobe choice takes the roulette dimension's second number.
+      const BsdfSample bs =
+          bsdfSample(material, woLocal, u.roulette.y, u.bsdf,
+                     makeRandomStream(pixel, sampleIndex, dim, seed, kStreamSample));
+      if (bs.flags == 0u) break;
+      wi = fromLocal(frame, bs.wi);
+      beta *= bs.f * (absCosTheta(bs.wi) / bs.pdf);
+      specularBounce = (bs.flags & kBsdfSpecular) != 0u;
+      bsdfPdf = bs.pdfIsProportional
+                    ? pt::bsdfPdf(material, woLocal, bs.wi,
+                                  makeRandomStream(pixel, sampleIndex, dim, seed, kStreamSamplePdf))
+                    : bs.pdf;
+      if ((bs.flags & kBsdfTransmission) != 0u) etaScale *= bs.eta * bs.eta;
+      // The new ray leaves from the side it goes to.
+      n = bs.wi.z > 0.0f ? ng : -ng;
     } else {
       const vec3 f = material.reflectance * kInvPi;
       // Sample direct illumination from an emitter (next-event estimation).
@@ -178,7 +276,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
 
     // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
     if (params.russianRoulette != 0u && depth >= params.rrStartDepth) {
-      const float q = std::max(0.0f, 1.0f - maxComponent(beta));
+      const float q = std::max(0.0f, 1.0f - maxComponent(beta * etaScale));
       if (u.roulette.x < q) break;
       beta /= 1.0f - q;
     }

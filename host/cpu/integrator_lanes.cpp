@@ -29,6 +29,7 @@
 
 #include "bvh/wide_bvh.h"
 #include "bvh/wide_traverse-inl.h"
+#include "cpu/integrator.h"
 #include "cpu/integrator_lanes.h"
 #include "cpu/random_lanes-inl.h"
 
@@ -612,6 +613,12 @@ HWY_EXPORT(sampleRadianceLanesImpl);
 
 void sampleRadianceLanes(const SceneData& scene, const uvec2* pixels, size_t count,
                          uint32_t sampleIndex, vec3* out, uint64_t& rays) {
+  // The lanes transcribe diffuse and mirror surfaces only; a scene with bsdf.h's materials
+  // takes the reference path by path (the same results by definition).
+  if (scene.effects.hasBsdfMaterials()) {
+    for (size_t i = 0; i < count; ++i) out[i] = sampleRadiance(scene, pixels[i], sampleIndex, rays);
+    return;
+  }
   HWY_DYNAMIC_DISPATCH(sampleRadianceLanesImpl)(scene, pixels, count, sampleIndex, out, rays);
 }
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "bsdf.h"
 #include "common/check.h"
 
 namespace pt {
@@ -35,6 +36,11 @@ std::string EffectSet::toString() const {
   };
   add(diffuse, "diffuse");
   add(mirror, "mirror");
+  add(conductor, "conductor");
+  add(dielectric, "dielectric");
+  add(thinDielectric, "thindielectric");
+  add(diffuseTransmission, "diffusetransmission");
+  add(coatedDiffuse, "coateddiffuse");
   add(lightSampling, "nee");
   add(mis, "mis");
   add(russianRoulette, "rr");
@@ -152,20 +158,31 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
 
   // Effects: which material kinds occur on triangles, and whether light sampling can matter.
   EffectSet& fx = data.effects;
-  for (const Triangle& tri : data.bvh.triangles) {
-    const Material& m = data.materials[tri.material];
+  std::vector<char> used(data.materials.size(), 0);
+  for (const Triangle& tri : data.bvh.triangles) used[tri.material] = 1;
+  bool lightSampled = false;  // some surface has a BSDF with a non-delta lobe
+  for (size_t i = 0; i < used.size(); ++i) {
+    if (!used[i]) continue;
+    const Material& m = data.materials[i];
     const bool reflects = m.reflectance != vec3(0.0f);
     if (m.type == kMaterialMirror && reflects) fx.mirror = true;
     if (m.type == kMaterialDiffuse && reflects) fx.diffuse = true;
+    if (m.type == kMaterialConductor) fx.conductor = true;
+    if (m.type == kMaterialDielectric) fx.dielectric = true;
+    if (m.type == kMaterialThinDielectric) fx.thinDielectric = true;
+    if (m.type == kMaterialDiffuseTransmission) fx.diffuseTransmission = true;
+    if (m.type == kMaterialCoatedDiffuse) fx.coatedDiffuse = true;
+    if (m.type > kMaterialMirror && bsdfHasNonSpecular(m)) lightSampled = true;
   }
   const bool scatters = p.maxDepth > 0;
-  fx.lightSampling =
-      fx.diffuse && scatters && !data.emitters.empty() && p.strategy != kStrategyBsdf;
+  fx.lightSampling = (fx.diffuse || lightSampled) && scatters && !data.emitters.empty() &&
+                     p.strategy != kStrategyBsdf;
   fx.bsdfEmission = !data.emitters.empty() && p.strategy != kStrategyNee;
   fx.watertight = !settings.fastIntersection;
   fx.sobol = p.samplerType == kSamplerSobol;
   fx.mis = fx.lightSampling && fx.bsdfEmission && p.strategy == kStrategyMis;
-  fx.russianRoulette = p.russianRoulette != 0 && scatters && (fx.diffuse || fx.mirror);
+  fx.russianRoulette =
+      p.russianRoulette != 0 && scatters && (fx.diffuse || fx.mirror || fx.hasBsdfMaterials());
   return data;
 }
 

@@ -100,11 +100,15 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   const SpecData spec{{all || fx.diffuse, all || fx.mirror, all || fx.lightSampling,
                        all || fx.bsdfEmission, all || fx.mis, all || fx.russianRoulette,
                        all ? kSpecAtRunTime : params.fastIntersection,
-                       all ? kSpecAtRunTime : params.samplerType, buffers.stackRows}};
+                       all ? kSpecAtRunTime : params.samplerType, buffers.stackRows,
+                       all || fx.conductor, all || fx.dielectric, all || fx.thinDielectric,
+                       all || fx.diffuseTransmission, all || fx.coatedDiffuse}};
   static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
                 PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
                 PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
-                PT_SPEC_COUNT == 9);
+                PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 &&
+                PT_SPEC_THIN_DIELECTRIC == 11 && PT_SPEC_DIFFUSE_TRANSMISSION == 12 &&
+                PT_SPEC_COATED_DIFFUSE == 13 && PT_SPEC_COUNT == 14);
   std::vector<vk::SpecializationMapEntry> entries;
   for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));

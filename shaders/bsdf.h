@@ -1,0 +1,933 @@
+// The BSDFs of the material types beyond diffuse and mirror, written once for the CPU
+// reference and the shader (C++ through GLM, GLSL through #include). Each follows pbrt-v4's
+// definition of the BxDF of the same name (Pharr, Jakob and Humphreys, "Physically Based
+// Rendering", 4th edition, chapters 9 and 14; its bxdfs.h), in RGB instead of sampled
+// wavelengths. Everything works in the local shading frame, z along the shading normal, with
+// the book's names: wo (towards the viewer), wi (towards the light), wm (microfacet normal).
+// f and the pdf are per unit solid angle; f excludes the cosine.
+//
+// A delta lobe (a smooth interface) is returned only by sampling, flagged kBsdfSpecular,
+// with f and pdf carrying the same delta (their ratio is what counts); bsdfF and bsdfPdf leave
+// delta lobes out, as pbrt-v4's do.
+#ifndef PT_BSDF_H
+#define PT_BSDF_H
+
+#include "sampling.h"
+#include "shared_types.h"
+
+#ifdef __cplusplus
+namespace pt {
+#define PT_INOUT(T) T&
+#define PT_OUT(T) T&
+#else
+#define PT_INOUT(T) inout T
+#define PT_OUT(T) out T
+#endif
+
+// Which material types the code is compiled for. The shader defines these as its
+// specialization constants, so that types a scene does not use fold away; C++ has them all.
+#ifndef PT_HAS_CONDUCTOR
+#define PT_HAS_CONDUCTOR true
+#define PT_HAS_DIELECTRIC true
+#define PT_HAS_THIN_DIELECTRIC true
+#define PT_HAS_DIFFUSE_TRANSMISSION true
+#define PT_HAS_COATED_DIFFUSE true
+#endif
+
+PT_CONST float kInv4Pi = 0.07957747154594766788f;
+
+// ---- Sample records and flags ------------------------------------------------------------
+
+PT_CONST uint kBsdfReflection = 1u;    // wi on wo's side of the surface
+PT_CONST uint kBsdfTransmission = 2u;  // wi on the other side
+PT_CONST uint kBsdfSpecular = 4u;      // a delta lobe: no light sampling can find wi
+// Restricting a sampler to one kind of scattering (pbrt-v4's BxDFReflTransFlags), as the
+// layered BSDF's random walk asks of its interfaces.
+PT_CONST uint kSampleReflection = 1u;
+PT_CONST uint kSampleTransmission = 2u;
+PT_CONST uint kSampleAll = 3u;
+
+// One sampled direction. flags == 0: no sample (the path ends). pdfIsProportional: pdf is
+// only proportional to the density of wi (the layered BSDF's random walk), so that f / pdf is
+// right but MIS must ask bsdfPdf for the density (an estimate of it).
+struct BsdfSample {
+  vec3 f;                  // BSDF value (a delta's weight for a specular sample)
+  float pdf;               // solid-angle density (or a discrete probability, if specular)
+  vec3 wi;                 // sampled direction, local frame
+  uint flags;              // kBsdf* bits, 0 when sampling failed
+  float eta;               // relative index of refraction crossed by a transmission, else 1
+  bool pdfIsProportional;  // see above
+};
+
+PT_INLINE BsdfSample noBsdfSample() {
+  return BsdfSample(vec3(0.0f), 0.0f, vec3(0.0f, 0.0f, 1.0f), 0u, 1.0f, false);
+}
+
+// ---- Local-frame trigonometry -------------------------------------------------------------
+
+PT_INLINE float absCosTheta(vec3 w) {
+  return abs(w.z);
+}
+PT_INLINE bool sameHemisphere(vec3 a, vec3 b) {
+  return a.z * b.z > 0.0f;
+}
+PT_INLINE float sqr(float x) {
+  return x * x;
+}
+PT_INLINE float safeSqrt(float x) {
+  return sqrt(max(0.0f, x));
+}
+// (cos phi, sin phi) of w about z; (1, 0) along the pole.
+PT_INLINE vec2 cosSinPhi(vec3 w) {
+  float sinTheta = safeSqrt(1.0f - w.z * w.z);
+  if (sinTheta == 0.0f) return vec2(1.0f, 0.0f);
+  return vec2(clamp(w.x / sinTheta, -1.0f, 1.0f), clamp(w.y / sinTheta, -1.0f, 1.0f));
+}
+PT_INLINE vec3 reflectAbout(vec3 wo, vec3 n) {
+  return -wo + (2.0f * dot(wo, n)) * n;
+}
+// Refraction of wi through a surface of normal n (either side) and relative index eta
+// (inside over outside, n pointing outside). False on total internal reflection. etap: the
+// relative index the ray actually crossed (eta, or 1 / eta coming from inside).
+PT_INLINE bool refractAbout(vec3 wi, vec3 n, float eta, PT_OUT(float) etap, PT_OUT(vec3) wt) {
+  float cosThetaI = dot(n, wi);
+  etap = eta;
+  if (cosThetaI < 0.0f) {
+    etap = 1.0f / eta;
+    cosThetaI = -cosThetaI;
+    n = -n;
+  }
+  float sin2ThetaI = max(0.0f, 1.0f - cosThetaI * cosThetaI);
+  float sin2ThetaT = sin2ThetaI / (etap * etap);
+  wt = vec3(0.0f);
+  if (sin2ThetaT >= 1.0f) return false;
+  float cosThetaT = safeSqrt(1.0f - sin2ThetaT);
+  wt = -wi / etap + (cosThetaI / etap - cosThetaT) * n;
+  return true;
+}
+
+// ---- Fresnel equations -------------------------------------------------------------------
+
+// Unpolarized Fresnel reflectance of a dielectric interface (pbrt-v4's FrDielectric): eta is
+// the index inside over outside; a negative cosine means the ray arrives from inside.
+PT_INLINE float frDielectric(float cosThetaI, float eta) {
+  cosThetaI = clamp(cosThetaI, -1.0f, 1.0f);
+  if (cosThetaI < 0.0f) {
+    eta = 1.0f / eta;
+    cosThetaI = -cosThetaI;
+  }
+  float sin2ThetaI = 1.0f - cosThetaI * cosThetaI;
+  float sin2ThetaT = sin2ThetaI / (eta * eta);
+  if (sin2ThetaT >= 1.0f) return 1.0f;  // total internal reflection
+  float cosThetaT = safeSqrt(1.0f - sin2ThetaT);
+  float rParallel = (eta * cosThetaI - cosThetaT) / (eta * cosThetaI + cosThetaT);
+  float rPerpendicular = (cosThetaI - eta * cosThetaT) / (cosThetaI + eta * cosThetaT);
+  return (rParallel * rParallel + rPerpendicular * rPerpendicular) * 0.5f;
+}
+
+// Complex numbers as vec2 (real, imaginary), for the conductor's Fresnel term.
+PT_INLINE vec2 complexMul(vec2 a, vec2 b) {
+  return vec2(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
+}
+PT_INLINE vec2 complexDiv(vec2 a, vec2 b) {
+  float scale = 1.0f / (b.x * b.x + b.y * b.y);
+  return vec2(scale * (a.x * b.x + a.y * b.y), scale * (a.y * b.x - a.x * b.y));
+}
+PT_INLINE float complexNorm(vec2 a) {
+  return a.x * a.x + a.y * a.y;
+}
+// The principal square root, as pbrt-v4's pstd::sqrt for complex numbers.
+PT_INLINE vec2 complexSqrt(vec2 z) {
+  float n = sqrt(z.x * z.x + z.y * z.y);
+  if (n == 0.0f) return vec2(0.0f);
+  float t1 = sqrt(0.5f * (n + abs(z.x)));
+  float t2 = 0.5f * z.y / t1;
+  if (z.x >= 0.0f) return vec2(t1, t2);
+  return vec2(abs(t2), z.y >= 0.0f ? t1 : -t1);
+}
+
+// Fresnel reflectance of a conductor of complex index eta + i k, one channel (pbrt-v4's
+// FrComplex).
+PT_INLINE float frComplex1(float cosThetaI, float etaRe, float etaIm) {
+  cosThetaI = clamp(cosThetaI, 0.0f, 1.0f);
+  vec2 eta = vec2(etaRe, etaIm);
+  float sin2ThetaI = 1.0f - cosThetaI * cosThetaI;
+  vec2 sin2ThetaT = complexDiv(vec2(sin2ThetaI, 0.0f), complexMul(eta, eta));
+  vec2 cosThetaT = complexSqrt(vec2(1.0f, 0.0f) - sin2ThetaT);
+  vec2 etaCosI = eta * cosThetaI;
+  vec2 rParallel = complexDiv(etaCosI - cosThetaT, etaCosI + cosThetaT);
+  vec2 etaCosT = complexMul(eta, cosThetaT);
+  vec2 rPerpendicular =
+      complexDiv(vec2(cosThetaI, 0.0f) - etaCosT, vec2(cosThetaI, 0.0f) + etaCosT);
+  return (complexNorm(rParallel) + complexNorm(rPerpendicular)) * 0.5f;
+}
+PT_INLINE vec3 frComplex(float cosThetaI, vec3 eta, vec3 k) {
+  return vec3(frComplex1(cosThetaI, eta.x, k.x), frComplex1(cosThetaI, eta.y, k.y),
+              frComplex1(cosThetaI, eta.z, k.z));
+}
+
+// ---- Trowbridge-Reitz (GGX) microfacet distribution -----------------------------------------
+// Anisotropic, alpha per tangent axis; visible normals sampled as in Heitz 2018 ("Sampling the
+// GGX Distribution of Visible Normals", JCGT), pbrt-v4's Sample_wm.
+
+struct TrowbridgeReitz {
+  float alphaX;
+  float alphaY;
+};
+
+// Below this alpha the surface is treated as perfectly smooth (pbrt-v4's EffectivelySmooth).
+PT_CONST float kSmoothAlpha = 1e-3f;
+PT_INLINE bool effectivelySmooth(TrowbridgeReitz d) {
+  return max(d.alphaX, d.alphaY) < kSmoothAlpha;
+}
+
+// pbrt-v4's RoughnessToAlpha, applied by the host when "remaproughness" is true.
+PT_INLINE float roughnessToAlpha(float roughness) {
+  return sqrt(roughness);
+}
+
+PT_INLINE float trD(TrowbridgeReitz d, vec3 wm) {
+  float cos2Theta = wm.z * wm.z;
+  float cos4Theta = cos2Theta * cos2Theta;
+  if (cos4Theta < 1e-16f) return 0.0f;
+  float tan2Theta = max(0.0f, 1.0f - cos2Theta) / cos2Theta;
+  vec2 cs = cosSinPhi(wm);
+  float e = tan2Theta * (sqr(cs.x / d.alphaX) + sqr(cs.y / d.alphaY));
+  return 1.0f / (kPi * d.alphaX * d.alphaY * cos4Theta * sqr(1.0f + e));
+}
+
+PT_INLINE float trLambda(TrowbridgeReitz d, vec3 w) {
+  float cos2Theta = w.z * w.z;
+  if (cos2Theta == 0.0f) return 0.0f;  // pbrt-v4: an infinite tan^2 gives 0
+  float tan2Theta = max(0.0f, 1.0f - cos2Theta) / cos2Theta;
+  vec2 cs = cosSinPhi(w);
+  float alpha2 = sqr(cs.x * d.alphaX) + sqr(cs.y * d.alphaY);
+  return (sqrt(1.0f + alpha2 * tan2Theta) - 1.0f) * 0.5f;
+}
+
+PT_INLINE float trG1(TrowbridgeReitz d, vec3 w) {
+  return 1.0f / (1.0f + trLambda(d, w));
+}
+
+// Height-correlated masking-shadowing.
+PT_INLINE float trG(TrowbridgeReitz d, vec3 wo, vec3 wi) {
+  return 1.0f / (1.0f + trLambda(d, wo) + trLambda(d, wi));
+}
+
+// Density of the normals visible from w: G1(w) / |cos w| * D(wm) * |w . wm|.
+PT_INLINE float trPdf(TrowbridgeReitz d, vec3 w, vec3 wm) {
+  return trG1(d, w) / absCosTheta(w) * trD(d, wm) * abs(dot(w, wm));
+}
+
+PT_INLINE vec3 trSampleWm(TrowbridgeReitz d, vec3 w, vec2 u) {
+  // Transform w to the hemispherical configuration (alpha = 1).
+  vec3 wh = normalize(vec3(d.alphaX * w.x, d.alphaY * w.y, w.z));
+  if (wh.z < 0.0f) wh = -wh;
+  // An orthonormal basis about wh.
+  vec3 t1 = wh.z < 0.99999f ? normalize(cross(vec3(0.0f, 0.0f, 1.0f), wh)) : vec3(1.0f, 0.0f, 0.0f);
+  vec3 t2 = cross(wh, t1);
+  // A uniform point on the unit disk, warped to the projection of the visible hemisphere.
+  float r = sqrt(u.x);
+  vec2 cs = cosSinTwoPi(u.y);
+  vec2 p = r * cs;
+  float h = sqrt(1.0f - p.x * p.x);
+  float s = (1.0f + wh.z) * 0.5f;
+  p.y = (1.0f - s) * h + s * p.y;
+  // Reproject onto the hemisphere and back to the ellipsoid configuration.
+  float pz = sqrt(max(0.0f, 1.0f - dot(p, p)));
+  vec3 nh = p.x * t1 + p.y * t2 + pz * wh;
+  return normalize(vec3(d.alphaX * nh.x, d.alphaY * nh.y, max(1e-6f, nh.z)));
+}
+
+// ---- Diffuse reflection (the coated material's base) ------------------------------------
+
+PT_INLINE vec3 diffuseF(vec3 r, vec3 wo, vec3 wi) {
+  return sameHemisphere(wo, wi) ? r * kInvPi : vec3(0.0f);
+}
+PT_INLINE float diffusePdf(vec3 wo, vec3 wi, uint sampleFlags) {
+  if ((sampleFlags & kSampleReflection) == 0u || !sameHemisphere(wo, wi)) return 0.0f;
+  return absCosTheta(wi) * kInvPi;
+}
+PT_INLINE BsdfSample diffuseSample(vec3 r, vec3 wo, vec2 u, uint sampleFlags) {
+  if ((sampleFlags & kSampleReflection) == 0u) return noBsdfSample();
+  vec3 wi = sampleCosineHemisphere(u);
+  if (wo.z < 0.0f) wi.z = -wi.z;
+  float pdf = absCosTheta(wi) * kInvPi;
+  if (!(pdf > 0.0f)) return noBsdfSample();
+  return BsdfSample(r * kInvPi, pdf, wi, kBsdfReflection, 1.0f, false);
+}
+
+// ---- Conductor -----------------------------------------------------------------------------
+// pbrt-v4's ConductorBxDF: specular reflection scaled by the complex Fresnel term when
+// effectively smooth, else the Torrance-Sparrow model over Trowbridge-Reitz. Two-sided.
+
+PT_INLINE vec3 conductorF(TrowbridgeReitz d, vec3 eta, vec3 k, vec3 wo, vec3 wi) {
+  if (!sameHemisphere(wo, wi) || effectivelySmooth(d)) return vec3(0.0f);
+  float cosThetaO = absCosTheta(wo);
+  float cosThetaI = absCosTheta(wi);
+  if (cosThetaI == 0.0f || cosThetaO == 0.0f) return vec3(0.0f);
+  vec3 wm = wi + wo;
+  if (dot(wm, wm) == 0.0f) return vec3(0.0f);
+  wm = normalize(wm);
+  vec3 F = frComplex(abs(dot(wo, wm)), eta, k);
+  return trD(d, wm) * F * trG(d, wo, wi) / (4.0f * cosThetaI * cosThetaO);
+}
+
+PT_INLINE float conductorPdf(TrowbridgeReitz d, vec3 wo, vec3 wi) {
+  if (!sameHemisphere(wo, wi) || effectivelySmooth(d)) return 0.0f;
+  vec3 wm = wo + wi;
+  if (dot(wm, wm) == 0.0f) return 0.0f;
+  wm = normalize(wm);
+  if (wm.z < 0.0f) wm = -wm;
+  return trPdf(d, wo, wm) / (4.0f * abs(dot(wo, wm)));
+}
+
+PT_INLINE BsdfSample conductorSample(TrowbridgeReitz d, vec3 eta, vec3 k, vec3 wo, vec2 u) {
+  if (effectivelySmooth(d)) {
+    // Specular reflection.
+    vec3 wi = vec3(-wo.x, -wo.y, wo.z);
+    float cosThetaI = absCosTheta(wi);
+    if (cosThetaI == 0.0f) return noBsdfSample();
+    return BsdfSample(frComplex(cosThetaI, eta, k) / cosThetaI, 1.0f, wi,
+                      kBsdfReflection | kBsdfSpecular, 1.0f, false);
+  }
+  // Sample a visible microfacet normal and reflect about it.
+  if (wo.z == 0.0f) return noBsdfSample();
+  vec3 wm = trSampleWm(d, wo, u);
+  vec3 wi = reflectAbout(wo, wm);
+  if (!sameHemisphere(wo, wi)) return noBsdfSample();
+  float pdf = trPdf(d, wo, wm) / (4.0f * abs(dot(wo, wm)));
+  float cosThetaO = absCosTheta(wo);
+  float cosThetaI = absCosTheta(wi);
+  if (cosThetaI == 0.0f || cosThetaO == 0.0f || !(pdf > 0.0f)) return noBsdfSample();
+  vec3 F = frComplex(abs(dot(wo, wm)), eta, k);
+  vec3 f = trD(d, wm) * F * trG(d, wo, wi) / (4.0f * cosThetaI * cosThetaO);
+  return BsdfSample(f, pdf, wi, kBsdfReflection, 1.0f, false);
+}
+
+// ---- Dielectric ------------------------------------------------------------------------------
+// pbrt-v4's DielectricBxDF: eta is the index of the side the normal points away from (inside)
+// over the other. Smooth (specular reflection or refraction, chosen in proportion to the
+// Fresnel reflectance) when eta is 1 or the distribution effectively smooth, else rough
+// (Walter et al. 2007 over Trowbridge-Reitz). `radiance`: the path carries radiance from a
+// camera, and refraction scales it by 1 / eta^2 (pbrt-v4's TransportMode::Radiance); false for
+// importance, as the layered BSDF's paths from the light side need.
+
+PT_INLINE bool dielectricIsSmooth(TrowbridgeReitz d, float eta) {
+  return eta == 1.0f || effectivelySmooth(d);
+}
+
+// The generalized half vector of wo and wi facing +z, or false where there is none or the
+// microfacet faces away from either direction.
+PT_INLINE bool dielectricHalfVector(float eta, vec3 wo, vec3 wi, PT_OUT(vec3) wm,
+                                    PT_OUT(float) etap) {
+  float cosThetaO = wo.z;
+  float cosThetaI = wi.z;
+  bool reflect = cosThetaI * cosThetaO > 0.0f;
+  etap = 1.0f;
+  if (!reflect) etap = cosThetaO > 0.0f ? eta : 1.0f / eta;
+  wm = wi * etap + wo;
+  if (cosThetaI == 0.0f || cosThetaO == 0.0f || dot(wm, wm) == 0.0f) return false;
+  wm = normalize(wm);
+  if (wm.z < 0.0f) wm = -wm;
+  // Discard back-facing microfacets.
+  return !(dot(wm, wi) * cosThetaI < 0.0f || dot(wm, wo) * cosThetaO < 0.0f);
+}
+
+PT_INLINE vec3 dielectricF(TrowbridgeReitz d, float eta, vec3 wo, vec3 wi, bool radiance) {
+  if (dielectricIsSmooth(d, eta)) return vec3(0.0f);
+  vec3 wm;
+  float etap;
+  if (!dielectricHalfVector(eta, wo, wi, wm, etap)) return vec3(0.0f);
+  float F = frDielectric(dot(wo, wm), eta);
+  if (wi.z * wo.z > 0.0f) {
+    return vec3(trD(d, wm) * trG(d, wo, wi) * F / abs(4.0f * wi.z * wo.z));
+  }
+  float denom = sqr(dot(wi, wm) + dot(wo, wm) / etap) * wi.z * wo.z;
+  float ft = trD(d, wm) * (1.0f - F) * trG(d, wo, wi) * abs(dot(wi, wm) * dot(wo, wm) / denom);
+  if (radiance) ft /= sqr(etap);
+  return vec3(ft);
+}
+
+PT_INLINE float dielectricPdf(TrowbridgeReitz d, float eta, vec3 wo, vec3 wi, uint sampleFlags) {
+  if (dielectricIsSmooth(d, eta)) return 0.0f;
+  vec3 wm;
+  float etap;
+  if (!dielectricHalfVector(eta, wo, wi, wm, etap)) return 0.0f;
+  // The probabilities of reflection and transmission.
+  float R = frDielectric(dot(wo, wm), eta);
+  float T = 1.0f - R;
+  float pr = (sampleFlags & kSampleReflection) != 0u ? R : 0.0f;
+  float pt = (sampleFlags & kSampleTransmission) != 0u ? T : 0.0f;
+  if (pr == 0.0f && pt == 0.0f) return 0.0f;
+  if (wi.z * wo.z > 0.0f) return trPdf(d, wo, wm) / (4.0f * abs(dot(wo, wm))) * pr / (pr + pt);
+  float denom = sqr(dot(wi, wm) + dot(wo, wm) / etap);
+  float dwmDwi = abs(dot(wi, wm)) / denom;
+  return trPdf(d, wo, wm) * dwmDwi * pt / (pr + pt);
+}
+
+PT_INLINE BsdfSample dielectricSample(TrowbridgeReitz d, float eta, vec3 wo, float uc, vec2 u,
+                                      bool radiance, uint sampleFlags) {
+  if (dielectricIsSmooth(d, eta)) {
+    // Specular reflection or transmission, in proportion to the Fresnel terms.
+    float R = frDielectric(wo.z, eta);
+    float T = 1.0f - R;
+    float pr = (sampleFlags & kSampleReflection) != 0u ? R : 0.0f;
+    float pt = (sampleFlags & kSampleTransmission) != 0u ? T : 0.0f;
+    if (pr == 0.0f && pt == 0.0f) return noBsdfSample();
+    if (uc < pr / (pr + pt)) {
+      vec3 wi = vec3(-wo.x, -wo.y, wo.z);
+      if (wi.z == 0.0f) return noBsdfSample();
+      return BsdfSample(vec3(R / absCosTheta(wi)), pr / (pr + pt), wi,
+                        kBsdfReflection | kBsdfSpecular, 1.0f, false);
+    }
+    vec3 wi;
+    float etap;
+    if (!refractAbout(wo, vec3(0.0f, 0.0f, 1.0f), eta, etap, wi) || wi.z == 0.0f) {
+      return noBsdfSample();
+    }
+    float ft = T / absCosTheta(wi);
+    if (radiance) ft /= sqr(etap);
+    return BsdfSample(vec3(ft), pt / (pr + pt), wi, kBsdfTransmission | kBsdfSpecular, etap,
+                      false);
+  }
+  // Rough: sample a visible microfacet normal, then reflect or refract about it.
+  if (wo.z == 0.0f) return noBsdfSample();
+  vec3 wm = trSampleWm(d, wo, u);
+  float R = frDielectric(dot(wo, wm), eta);
+  float T = 1.0f - R;
+  float pr = (sampleFlags & kSampleReflection) != 0u ? R : 0.0f;
+  float pt = (sampleFlags & kSampleTransmission) != 0u ? T : 0.0f;
+  if (pr == 0.0f && pt == 0.0f) return noBsdfSample();
+  if (uc < pr / (pr + pt)) {
+    vec3 wi = reflectAbout(wo, wm);
+    if (!sameHemisphere(wo, wi)) return noBsdfSample();
+    float pdf = trPdf(d, wo, wm) / (4.0f * abs(dot(wo, wm))) * pr / (pr + pt);
+    vec3 f = vec3(trD(d, wm) * trG(d, wo, wi) * R / (4.0f * wi.z * wo.z));
+    if (!(pdf > 0.0f)) return noBsdfSample();
+    return BsdfSample(f, pdf, wi, kBsdfReflection, 1.0f, false);
+  }
+  vec3 wi;
+  float etap;
+  bool tir = !refractAbout(wo, wm, eta, etap, wi);
+  if (sameHemisphere(wo, wi) || wi.z == 0.0f || tir) return noBsdfSample();
+  float denom = sqr(dot(wi, wm) + dot(wo, wm) / etap);
+  float dwmDwi = abs(dot(wi, wm)) / denom;
+  float pdf = trPdf(d, wo, wm) * dwmDwi * pt / (pr + pt);
+  float ft =
+      T * trD(d, wm) * trG(d, wo, wi) * abs(dot(wi, wm) * dot(wo, wm) / (wi.z * wo.z * denom));
+  if (radiance) ft /= sqr(etap);
+  if (!(pdf > 0.0f)) return noBsdfSample();
+  return BsdfSample(vec3(ft), pdf, wi, kBsdfTransmission, etap, false);
+}
+
+// ---- Thin dielectric ---------------------------------------------------------------------
+// pbrt-v4's ThinDielectricBxDF: a pane whose two parallel interfaces reflect back and forth;
+// the reflectance sums the geometric series R + T^2 R / (1 - R^2). Transmission passes
+// straight through. Only delta lobes.
+
+PT_INLINE BsdfSample thinDielectricSample(float eta, vec3 wo, float uc) {
+  float R = frDielectric(absCosTheta(wo), eta);
+  float T = 1.0f - R;
+  if (R < 1.0f) {
+    R += sqr(T) * R / (1.0f - sqr(R));
+    T = 1.0f - R;
+  }
+  if (R == 0.0f && T == 0.0f) return noBsdfSample();
+  if (wo.z == 0.0f) return noBsdfSample();
+  if (uc < R / (R + T)) {
+    vec3 wi = vec3(-wo.x, -wo.y, wo.z);
+    return BsdfSample(vec3(R / absCosTheta(wi)), R / (R + T), wi,
+                      kBsdfReflection | kBsdfSpecular, 1.0f, false);
+  }
+  vec3 wi = -wo;
+  return BsdfSample(vec3(T / absCosTheta(wi)), T / (R + T), wi, kBsdfTransmission | kBsdfSpecular,
+                    1.0f, false);
+}
+
+// ---- Diffuse transmission ------------------------------------------------------------------
+// pbrt-v4's DiffuseTransmissionBxDF: Lambertian reflection r / pi on wo's side, Lambertian
+// transmission t / pi on the other; each side sampled cosine-weighted, chosen in proportion
+// to the largest channel of r and t.
+
+PT_INLINE vec3 diffuseTransmissionF(vec3 r, vec3 t, vec3 wo, vec3 wi) {
+  return sameHemisphere(wo, wi) ? r * kInvPi : t * kInvPi;
+}
+PT_INLINE float diffuseTransmissionPdf(vec3 r, vec3 t, vec3 wo, vec3 wi) {
+  float pr = maxComponent(r);
+  float pt = maxComponent(t);
+  if (pr == 0.0f && pt == 0.0f) return 0.0f;
+  float p = absCosTheta(wi) * kInvPi;
+  return sameHemisphere(wo, wi) ? p * pr / (pr + pt) : p * pt / (pr + pt);
+}
+PT_INLINE BsdfSample diffuseTransmissionSample(vec3 r, vec3 t, vec3 wo, float uc, vec2 u) {
+  float pr = maxComponent(r);
+  float pt = maxComponent(t);
+  if (pr == 0.0f && pt == 0.0f) return noBsdfSample();
+  vec3 wi = sampleCosineHemisphere(u);
+  float p = absCosTheta(wi) * kInvPi;
+  if (!(p > 0.0f)) return noBsdfSample();
+  if (uc < pr / (pr + pt)) {
+    if (wo.z < 0.0f) wi.z = -wi.z;
+    return BsdfSample(r * kInvPi, p * pr / (pr + pt), wi, kBsdfReflection, 1.0f, false);
+  }
+  if (wo.z > 0.0f) wi.z = -wi.z;
+  return BsdfSample(t * kInvPi, p * pt / (pr + pt), wi, kBsdfTransmission, 1.0f, false);
+}
+
+// ---- Random numbers of the layered BSDF's random walks -----------------------------------
+// pbrt-v4 seeds a generator from a hash of the directions. Here the stream is a function of the
+// path's own random-number coordinates (pixel, sample, dimension, seed) and of what it is for
+// (kStream*), so that the CPU reference and the shader take the same walks even where their
+// directions differ in the last bits.
+
+struct RandomStream {
+  uvec4 key;  // .w advances by one per number drawn
+};
+PT_CONST uint kStreamSample = 1u;      // sampling a direction
+PT_CONST uint kStreamEval = 2u;        // bsdfF at a light sample
+PT_CONST uint kStreamLightPdf = 3u;    // bsdfPdf at a light sample
+PT_CONST uint kStreamSamplePdf = 4u;   // bsdfPdf of a sampled direction (pdfIsProportional)
+
+PT_INLINE RandomStream makeRandomStream(uvec2 pixel, uint sampleIndex, uint dimension, uint seed,
+                                        uint purpose) {
+  uvec4 h = pcg4d(uvec4(pixel.x, pixel.y, sampleIndex, dimension + seed * 0x9E3779B9u));
+  return RandomStream(uvec4(h.x, h.y, h.z ^ purpose * 0x85EBCA6Bu, h.w));
+}
+
+// A uniform number in [0, 1), 24 bits (exact in float on both sides).
+PT_INLINE float nextRandom(PT_INOUT(RandomStream) s) {
+  uvec4 h = pcg4d(s.key);
+  s.key.w += 1u;
+  return float(h.x >> 8u) * (1.0f / 16777216.0f);
+}
+// Two numbers, drawn in order. (Never vec2(nextRandom(s), nextRandom(s)): C++ leaves the
+// order of a call's arguments open, and GCC draws the second first, GLSL the first.)
+PT_INLINE vec2 nextRandom2(PT_INOUT(RandomStream) s) {
+  float a = nextRandom(s);
+  float b = nextRandom(s);
+  return vec2(a, b);
+}
+
+// ---- Henyey-Greenstein phase function (the coat's medium) ----------------------------------
+// pbrt-v4's conventions: wo and wi both point away from the scattering point, so forward
+// scattering (g > 0) sends wi near -wo.
+
+PT_INLINE float henyeyGreenstein(float cosTheta, float g) {
+  g = clamp(g, -0.99f, 0.99f);
+  float denom = 1.0f + g * g + 2.0f * g * cosTheta;
+  return kInv4Pi * (1.0f - g * g) / (denom * safeSqrt(denom));
+}
+
+// Samples wi for wo; pdf = p = henyeyGreenstein(dot(wo, wi), g).
+PT_INLINE vec3 sampleHenyeyGreenstein(vec3 wo, float g, vec2 u, PT_OUT(float) pdf) {
+  g = clamp(g, -0.99f, 0.99f);
+  float cosTheta;
+  if (abs(g) < 1e-3f) {
+    cosTheta = 1.0f - 2.0f * u.x;
+  } else {
+    cosTheta = -1.0f / (2.0f * g) * (1.0f + g * g - sqr((1.0f - g * g) / (1.0f + g - 2.0f * g * u.x)));
+  }
+  float sinTheta = safeSqrt(1.0f - cosTheta * cosTheta);
+  vec2 cs = cosSinTwoPi(u.y);
+  pdf = henyeyGreenstein(cosTheta, g);
+  return localToWorld(vec3(sinTheta * cs.x, sinTheta * cs.y, cosTheta), wo);
+}
+
+// ---- Coated diffuse: pbrt-v4's LayeredBxDF<DielectricBxDF, DiffuseBxDF, twoSided = true> ----
+// A dielectric coat (eta, roughness) over a Lambertian base (reflectance), with a medium of
+// the given thickness, albedo and g between them. f and sampling are stochastic estimates
+// by random walks between the two interfaces (unbiased; maxDepth bounds a walk, with Russian
+// roulette after four steps); the pdf is an estimate mixed with the uniform density, good
+// for MIS only (pbrt-v4's choice). Interfaces are named by z: the coat at z = thickness, the
+// base at z = 0. Two-sided: a wo below the surface is mirrored above it.
+
+struct CoatedDiffuse {
+  TrowbridgeReitz coat;
+  float eta;
+  vec3 reflectance;
+  vec3 albedo;
+  float thickness;
+  float g;
+  uint maxDepth;
+  uint nSamples;
+};
+
+PT_INLINE CoatedDiffuse coatedDiffuseOf(Material m) {
+  return CoatedDiffuse(TrowbridgeReitz(m.alphaX, m.alphaY), m.eta.x, m.reflectance,
+                       m.transmittance, max(m.thickness, 1.17549435e-38f), m.g, m.maxDepth,
+                       m.nSamples);
+}
+
+// The medium's transmittance over depth dz along w (unit extinction).
+PT_INLINE float layerTransmittance(float dz, vec3 w) {
+  if (abs(dz) <= 1.17549435e-38f) return 1.0f;
+  return exp(-abs(dz / w.z));
+}
+
+// The two interfaces seen from the walk: the coat (top) or the base (bottom).
+PT_INLINE vec3 coatedInterfaceF(CoatedDiffuse c, bool top, vec3 wo, vec3 wi, bool radiance) {
+  return top ? dielectricF(c.coat, c.eta, wo, wi, radiance) : diffuseF(c.reflectance, wo, wi);
+}
+PT_INLINE float coatedInterfacePdf(CoatedDiffuse c, bool top, vec3 wo, vec3 wi, uint flags) {
+  return top ? dielectricPdf(c.coat, c.eta, wo, wi, flags) : diffusePdf(wo, wi, flags);
+}
+PT_INLINE BsdfSample coatedInterfaceSample(CoatedDiffuse c, bool top, vec3 wo, float uc, vec2 u,
+                                           bool radiance, uint flags) {
+  return top ? dielectricSample(c.coat, c.eta, wo, uc, u, radiance, flags)
+             : diffuseSample(c.reflectance, wo, u, flags);
+}
+PT_INLINE bool sampleUsable(BsdfSample s) {
+  return s.flags != 0u && maxComponent(s.f) > 0.0f && s.pdf > 0.0f && s.wi.z != 0.0f;
+}
+
+PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance,
+                              RandomStream rng) {
+  if (wo.z < 0.0f) {
+    wo = -wo;
+    wi = -wi;
+  }
+  // Entered through the coat (two-sided); reflection leaves through it too, transmission
+  // (none here: the base is opaque) would leave through the base.
+  bool exitTop = sameHemisphere(wo, wi);
+  float exitZ = exitTop ? c.thickness : 0.0f;
+  bool coatSmooth = dielectricIsSmooth(c.coat, c.eta);
+  bool exitSpecular = exitTop ? coatSmooth : false;
+  bool nonExitSpecular = exitTop ? false : coatSmooth;
+  float n = float(c.nSamples);
+  // Reflection at the entrance interface.
+  vec3 f = vec3(0.0f);
+  if (exitTop) f = n * dielectricF(c.coat, c.eta, wo, wi, radiance);
+
+  for (uint s = 0u; s < c.nSamples; ++s) {
+    // Sample the transmission through the entrance interface, and a virtual light path from
+    // wi through the exit interface (pbrt-v4's wos and wis).
+    float uc = nextRandom(rng);
+    vec2 u = nextRandom2(rng);
+    BsdfSample wos = dielectricSample(c.coat, c.eta, wo, uc, u, radiance, kSampleTransmission);
+    if (!sampleUsable(wos)) continue;
+    uc = nextRandom(rng);
+    u = nextRandom2(rng);
+    BsdfSample wis = coatedInterfaceSample(c, exitTop, wi, uc, u, !radiance, kSampleTransmission);
+    if (!sampleUsable(wis)) continue;
+
+    vec3 beta = wos.f * absCosTheta(wos.wi) / wos.pdf;
+    float z = c.thickness;
+    vec3 w = wos.wi;
+    for (uint depth = 0u; depth < c.maxDepth; ++depth) {
+      // Possibly end the walk with Russian roulette.
+      if (depth > 3u && maxComponent(beta) < 0.25f) {
+        float q = max(0.0f, 1.0f - maxComponent(beta));
+        if (nextRandom(rng) < q) break;
+        beta /= 1.0f - q;
+      }
+      if (maxComponent(c.albedo) == 0.0f) {
+        // No scattering medium: advance to the other interface.
+        z = z == c.thickness ? 0.0f : c.thickness;
+        beta *= layerTransmittance(c.thickness, w);
+      } else {
+        // Sample a scattering event in the medium.
+        float dz = -log(1.0f - nextRandom(rng)) * abs(w.z);
+        float zp = w.z > 0.0f ? z + dz : z - dz;
+        if (zp == z) continue;
+        if (0.0f < zp && zp < c.thickness) {
+          // Scattering in the medium: towards wis's direction (NEE), then a new direction.
+          float wt = 1.0f;
+          if (!exitSpecular) {
+            wt = powerHeuristic(wis.pdf, henyeyGreenstein(dot(-w, -wis.wi), c.g));
+          }
+          f += beta * c.albedo * henyeyGreenstein(dot(-w, -wis.wi), c.g) * wt *
+               layerTransmittance(zp - exitZ, wis.wi) * wis.f / wis.pdf;
+          float phasePdf;
+          vec3 wNew =
+              sampleHenyeyGreenstein(-w, c.g, nextRandom2(rng), phasePdf);
+          if (!(phasePdf > 0.0f) || wNew.z == 0.0f) continue;
+          // The phase function's value equals its pdf: beta *= albedo.
+          beta *= c.albedo;
+          w = wNew;
+          z = zp;
+          // Possibly leave through the exit interface towards wi.
+          if (((z < exitZ && w.z > 0.0f) || (z > exitZ && w.z < 0.0f)) && !exitSpecular) {
+            vec3 fExit = coatedInterfaceF(c, exitTop, -w, wi, radiance);
+            if (maxComponent(fExit) > 0.0f) {
+              float exitPdf = coatedInterfacePdf(c, exitTop, -w, wi, kSampleTransmission);
+              float wt2 = powerHeuristic(phasePdf, exitPdf);
+              f += beta * layerTransmittance(zp - exitZ, wNew) * fExit * wt2;
+            }
+          }
+          continue;
+        }
+        z = clamp(zp, 0.0f, c.thickness);
+      }
+      if (z == exitZ) {
+        // Reflection at the exit interface back into the layer.
+        float uc2 = nextRandom(rng);
+        vec2 u2 = nextRandom2(rng);
+        BsdfSample bs =
+            coatedInterfaceSample(c, exitTop, -w, uc2, u2, radiance, kSampleReflection);
+        if (!sampleUsable(bs)) break;
+        beta *= bs.f * absCosTheta(bs.wi) / bs.pdf;
+        w = bs.wi;
+      } else {
+        // Scattering at the other interface: first towards wis (NEE).
+        if (!nonExitSpecular) {
+          float wt = 1.0f;
+          if (!exitSpecular) {
+            wt = powerHeuristic(wis.pdf,
+                                coatedInterfacePdf(c, !exitTop, -w, -wis.wi, kSampleAll));
+          }
+          f += beta * coatedInterfaceF(c, !exitTop, -w, -wis.wi, radiance) *
+               absCosTheta(wis.wi) * wt * layerTransmittance(c.thickness, wis.wi) * wis.f /
+               wis.pdf;
+        }
+        // Then a new direction from that interface's BSDF.
+        float uc2 = nextRandom(rng);
+        vec2 u2 = nextRandom2(rng);
+        BsdfSample bs =
+            coatedInterfaceSample(c, !exitTop, -w, uc2, u2, radiance, kSampleReflection);
+        if (!sampleUsable(bs)) break;
+        beta *= bs.f * absCosTheta(bs.wi) / bs.pdf;
+        w = bs.wi;
+        if (!exitSpecular) {
+          // Towards wi through the exit interface along the new direction (NEE by BSDF).
+          vec3 fExit = coatedInterfaceF(c, exitTop, -w, wi, radiance);
+          if (maxComponent(fExit) > 0.0f) {
+            float wt = 1.0f;
+            if (!nonExitSpecular) {
+              float exitPdf = coatedInterfacePdf(c, exitTop, -w, wi, kSampleTransmission);
+              wt = powerHeuristic(bs.pdf, exitPdf);
+            }
+            f += beta * layerTransmittance(c.thickness, bs.wi) * fExit * wt;
+          }
+        }
+      }
+    }
+  }
+  return f / n;
+}
+
+PT_INLINE BsdfSample coatedDiffuseSample(CoatedDiffuse c, vec3 wo, float uc, vec2 u,
+                                         bool radiance, RandomStream rng) {
+  bool flipWi = false;
+  if (wo.z < 0.0f) {
+    wo = -wo;
+    flipWi = true;
+  }
+  // Sample the coat to get the first direction.
+  BsdfSample bs = dielectricSample(c.coat, c.eta, wo, uc, u, radiance, kSampleAll);
+  if (!sampleUsable(bs)) return noBsdfSample();
+  if ((bs.flags & kBsdfReflection) != 0u) {
+    if (flipWi) bs.wi = -bs.wi;
+    bs.pdfIsProportional = true;
+    return bs;
+  }
+  vec3 w = bs.wi;
+  bool specularPath = (bs.flags & kBsdfSpecular) != 0u;
+  vec3 f = bs.f * absCosTheta(bs.wi);
+  float pdf = bs.pdf;
+  float z = c.thickness;
+  for (uint depth = 0u; depth < c.maxDepth; ++depth) {
+    // Possibly end the walk with Russian roulette.
+    float rrBeta = maxComponent(f) / pdf;
+    if (depth > 3u && rrBeta < 0.25f) {
+      float q = max(0.0f, 1.0f - rrBeta);
+      if (nextRandom(rng) < q) return noBsdfSample();
+      pdf *= 1.0f - q;
+    }
+    if (w.z == 0.0f) return noBsdfSample();
+    if (maxComponent(c.albedo) > 0.0f) {
+      // Possibly scatter in the medium.
+      float dz = -log(1.0f - nextRandom(rng)) * absCosTheta(w);
+      float zp = w.z > 0.0f ? z + dz : z - dz;
+      if (zp == z) return noBsdfSample();
+      if (0.0f < zp && zp < c.thickness) {
+        float phasePdf;
+        vec3 wNew =
+            sampleHenyeyGreenstein(-w, c.g, nextRandom2(rng), phasePdf);
+        if (!(phasePdf > 0.0f) || wNew.z == 0.0f) return noBsdfSample();
+        f *= c.albedo * phasePdf;
+        pdf *= phasePdf;
+        specularPath = false;
+        w = wNew;
+        z = zp;
+        continue;
+      }
+      z = clamp(zp, 0.0f, c.thickness);
+    } else {
+      // Advance to the other interface.
+      z = z == c.thickness ? 0.0f : c.thickness;
+      f *= layerTransmittance(c.thickness, w);
+    }
+    // Scatter at the interface reached.
+    bool top = z != 0.0f;
+    float uc2 = nextRandom(rng);
+    vec2 u2 = nextRandom2(rng);
+    BsdfSample is = coatedInterfaceSample(c, top, -w, uc2, u2, radiance, kSampleAll);
+    if (!sampleUsable(is)) return noBsdfSample();
+    f *= is.f;
+    pdf *= is.pdf;
+    specularPath = specularPath && (is.flags & kBsdfSpecular) != 0u;
+    w = is.wi;
+    if ((is.flags & kBsdfTransmission) != 0u) {
+      // The walk has left the layers.
+      uint flags = sameHemisphere(wo, w) ? kBsdfReflection : kBsdfTransmission;
+      if (specularPath) flags |= kBsdfSpecular;
+      if (flipWi) w = -w;
+      return BsdfSample(f, pdf, w, flags, 1.0f, true);
+    }
+    f *= absCosTheta(is.wi);
+  }
+  return noBsdfSample();
+}
+
+PT_INLINE float coatedDiffusePdf(CoatedDiffuse c, vec3 wo, vec3 wi, RandomStream rng) {
+  if (wo.z < 0.0f) {
+    wo = -wo;
+    wi = -wi;
+  }
+  // Nothing leaves through the opaque base: only reflection has a density.
+  if (!sameHemisphere(wo, wi)) return 0.0f;
+  float n = float(c.nSamples);
+  // Reflection at the coat.
+  float pdfSum = n * dielectricPdf(c.coat, c.eta, wo, wi, kSampleReflection);
+  bool coatSmooth = dielectricIsSmooth(c.coat, c.eta);
+  for (uint s = 0u; s < c.nSamples; ++s) {
+    // Transmission, reflection at the base, transmission (TRT).
+    float uc = nextRandom(rng);
+    vec2 u = nextRandom2(rng);
+    BsdfSample wos = dielectricSample(c.coat, c.eta, wo, uc, u, true, kSampleTransmission);
+    uc = nextRandom(rng);
+    u = nextRandom2(rng);
+    BsdfSample wis = dielectricSample(c.coat, c.eta, wi, uc, u, false, kSampleTransmission);
+    if (wos.flags == 0u || !(maxComponent(wos.f) > 0.0f) || !(wos.pdf > 0.0f) ||
+        wis.flags == 0u || !(maxComponent(wis.f) > 0.0f) || !(wis.pdf > 0.0f)) {
+      continue;
+    }
+    if (coatSmooth) {
+      pdfSum += diffusePdf(-wos.wi, -wis.wi, kSampleAll);
+    } else {
+      // The base is diffuse (non-specular): estimate the product by MIS.
+      nextRandom(rng);  // the lobe choice, which a diffuse base does not need
+      vec2 u2 = nextRandom2(rng);
+      BsdfSample rs = diffuseSample(c.reflectance, -wos.wi, u2, kSampleAll);
+      if (rs.flags != 0u && maxComponent(rs.f) > 0.0f && rs.pdf > 0.0f) {
+        float rPdf = diffusePdf(-wos.wi, -wis.wi, kSampleAll);
+        pdfSum += powerHeuristic(wis.pdf, rPdf) * rPdf;
+        float tPdf = dielectricPdf(c.coat, c.eta, -rs.wi, wi, kSampleAll);
+        pdfSum += powerHeuristic(rs.pdf, tPdf) * tPdf;
+      }
+    }
+  }
+  // Mix with the uniform density, as pbrt-v4 does, so the estimate is never 0 where f is not.
+  return 0.1f * kInv4Pi + 0.9f * (pdfSum / n);
+}
+
+// ---- The material switch: what the integrators call ---------------------------------------
+// For types other than diffuse and mirror (those two stay in the integrators' own code).
+
+PT_INLINE TrowbridgeReitz distributionOf(Material m) {
+  return TrowbridgeReitz(m.alphaX, m.alphaY);
+}
+
+// Whether the BSDF has a lobe that light sampling can find (not only delta lobes).
+PT_INLINE bool bsdfHasNonSpecular(Material m) {
+  if (PT_HAS_CONDUCTOR && m.type == kMaterialConductor) {
+    return !effectivelySmooth(distributionOf(m));
+  }
+  if (PT_HAS_DIELECTRIC && m.type == kMaterialDielectric) {
+    return !dielectricIsSmooth(distributionOf(m), m.eta.x);
+  }
+  if (PT_HAS_THIN_DIELECTRIC && m.type == kMaterialThinDielectric) return false;
+  return true;  // diffuse transmission, coated diffuse
+}
+
+// f(wo, wi) without delta lobes; `rng` feeds the coated material's estimate.
+PT_INLINE vec3 bsdfF(Material m, vec3 wo, vec3 wi, RandomStream rng) {
+  if (wo.z == 0.0f) return vec3(0.0f);
+  if (PT_HAS_CONDUCTOR && m.type == kMaterialConductor) {
+    return conductorF(distributionOf(m), m.eta, m.k, wo, wi);
+  }
+  if (PT_HAS_DIELECTRIC && m.type == kMaterialDielectric) {
+    return dielectricF(distributionOf(m), m.eta.x, wo, wi, true);
+  }
+  if (PT_HAS_DIFFUSE_TRANSMISSION && m.type == kMaterialDiffuseTransmission) {
+    return diffuseTransmissionF(m.reflectance, m.transmittance, wo, wi);
+  }
+  if (PT_HAS_COATED_DIFFUSE && m.type == kMaterialCoatedDiffuse) {
+    return coatedDiffuseF(coatedDiffuseOf(m), wo, wi, true, rng);
+  }
+  return vec3(0.0f);  // thin dielectric: delta lobes only
+}
+
+// The density of sampling wi (non-delta lobes); an estimate for the coated material.
+PT_INLINE float bsdfPdf(Material m, vec3 wo, vec3 wi, RandomStream rng) {
+  if (wo.z == 0.0f) return 0.0f;
+  if (PT_HAS_CONDUCTOR && m.type == kMaterialConductor) {
+    return conductorPdf(distributionOf(m), wo, wi);
+  }
+  if (PT_HAS_DIELECTRIC && m.type == kMaterialDielectric) {
+    return dielectricPdf(distributionOf(m), m.eta.x, wo, wi, kSampleAll);
+  }
+  if (PT_HAS_DIFFUSE_TRANSMISSION && m.type == kMaterialDiffuseTransmission) {
+    return diffuseTransmissionPdf(m.reflectance, m.transmittance, wo, wi);
+  }
+  if (PT_HAS_COATED_DIFFUSE && m.type == kMaterialCoatedDiffuse) {
+    return coatedDiffusePdf(coatedDiffuseOf(m), wo, wi, rng);
+  }
+  return 0.0f;
+}
+
+// Samples wi for wo with uc (choice of lobe) and u (direction); radiance transport.
+PT_INLINE BsdfSample bsdfSample(Material m, vec3 wo, float uc, vec2 u, RandomStream rng) {
+  if (wo.z == 0.0f) return noBsdfSample();
+  if (PT_HAS_CONDUCTOR && m.type == kMaterialConductor) {
+    return conductorSample(distributionOf(m), m.eta, m.k, wo, u);
+  }
+  if (PT_HAS_DIELECTRIC && m.type == kMaterialDielectric) {
+    return dielectricSample(distributionOf(m), m.eta.x, wo, uc, u, true, kSampleAll);
+  }
+  if (PT_HAS_THIN_DIELECTRIC && m.type == kMaterialThinDielectric) {
+    return thinDielectricSample(m.eta.x, wo, uc);
+  }
+  if (PT_HAS_DIFFUSE_TRANSMISSION && m.type == kMaterialDiffuseTransmission) {
+    return diffuseTransmissionSample(m.reflectance, m.transmittance, wo, uc, u);
+  }
+  if (PT_HAS_COATED_DIFFUSE && m.type == kMaterialCoatedDiffuse) {
+    return coatedDiffuseSample(coatedDiffuseOf(m), wo, uc, u, true, rng);
+  }
+  return noBsdfSample();
+}
+
+// ---- Shading frame ------------------------------------------------------------------------
+// z along the normal n (unit); x along `tangent` made orthogonal to n, as pbrt-v4's frame from
+// dpdu (a triangle without UVs takes pbrt-v4's default UVs, whose dpdu is v1 - v0); any
+// orthonormal pair where the tangent is parallel to n.
+
+struct ShadingFrame {
+  vec3 x;
+  vec3 y;
+  vec3 z;
+};
+
+PT_INLINE ShadingFrame makeShadingFrame(vec3 n, vec3 tangent) {
+  vec3 t = tangent - dot(n, tangent) * n;
+  float len2 = dot(t, t);
+  if (!(len2 > 1e-20f)) {
+    t = localToWorld(vec3(1.0f, 0.0f, 0.0f), n);
+  } else {
+    t = t / sqrt(len2);
+  }
+  return ShadingFrame(t, cross(n, t), n);
+}
+PT_INLINE vec3 toLocal(ShadingFrame f, vec3 w) {
+  return vec3(dot(w, f.x), dot(w, f.y), dot(w, f.z));
+}
+PT_INLINE vec3 fromLocal(ShadingFrame f, vec3 w) {
+  return w.x * f.x + w.y * f.y + w.z * f.z;
+}
+
+#ifdef __cplusplus
+}  // namespace pt
+#endif
+
+#endif  // PT_BSDF_H
