@@ -919,6 +919,14 @@ PT_INLINE ShadingFrame makeShadingFrame(vec3 n, vec3 tangent) {
   }
   return ShadingFrame(t, cross(n, t), n);
 }
+// The shading normal at barycentrics b (weights of v0, v1, v2): the vertex normals
+// interpolated and normalized; ng where they cancel.
+PT_INLINE vec3 interpolatedNormal(TriangleNormals t, vec3 b, vec3 ng) {
+  vec3 n = b.x * t.n0 + b.y * t.n1 + b.z * t.n2;
+  float len2 = dot(n, n);
+  return len2 > 0.0f ? n / sqrt(len2) : ng;
+}
+
 PT_INLINE vec3 toLocal(ShadingFrame f, vec3 w) {
   return vec3(dot(w, f.x), dot(w, f.y), dot(w, f.z));
 }

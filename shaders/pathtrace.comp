@@ -29,6 +29,7 @@ layout(constant_id = PT_SPEC_DIELECTRIC) const bool kDielectric = true;
 layout(constant_id = PT_SPEC_THIN_DIELECTRIC) const bool kThinDielectric = true;
 layout(constant_id = PT_SPEC_DIFFUSE_TRANSMISSION) const bool kDiffuseTransmission = true;
 layout(constant_id = PT_SPEC_COATED_DIFFUSE) const bool kCoatedDiffuse = true;
+layout(constant_id = PT_SPEC_SHADING_NORMALS) const bool kShadingNormals = true;
 // Some surface has one of bsdf.h's materials; bsdf.h's switch sees only the types in use.
 const bool kBsdfMaterials =
     kConductor || kDielectric || kThinDielectric || kDiffuseTransmission || kCoatedDiffuse;
@@ -53,6 +54,7 @@ layout(set = 0, binding = PT_BINDING_NODES) uniform usamplerBuffer nodeTexels;
 layout(set = 0, binding = PT_BINDING_TRIANGLES) uniform usamplerBuffer triangleTexels;
 layout(set = 0, binding = PT_BINDING_MATERIALS) uniform usamplerBuffer materialTexels;
 layout(set = 0, binding = PT_BINDING_EMITTERS) uniform usamplerBuffer emitterTexels;
+layout(set = 0, binding = PT_BINDING_NORMALS) uniform usamplerBuffer normalTexels;
 layout(std430, set = 0, binding = PT_BINDING_ACCUM) buffer AccumBuffer {
   AccumPixel accum[];
 };
@@ -97,6 +99,14 @@ Material loadMaterial(uint i) {
                   uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.xyz),
                   uintBitsToFloat(d.w), uintBitsToFloat(e.xyz), uintBitsToFloat(e.w),
                   uintBitsToFloat(f.x), f.y, f.z, f.w);
+}
+
+TriangleNormals loadNormals(uint primitive) {
+  int at = int(3u * primitive);
+  vec4 a = uintBitsToFloat(texelFetch(normalTexels, at));
+  vec4 b = uintBitsToFloat(texelFetch(normalTexels, at + 1));
+  vec4 c = uintBitsToFloat(texelFetch(normalTexels, at + 2));
+  return TriangleNormals(a.xyz, a.w, b.xyz, b.w, c.xyz, c.w);
 }
 
 Emitter loadEmitter(uint i) {
@@ -175,8 +185,9 @@ void debugLightSample(uint depth, LightPoint light, float lightPdf, float weight
 // point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
 // contribution to L, beta * f * Le * cos / pdf, weighted by the power heuristic against BSDF
 // sampling when misOn; zero when the point faces away or is occluded, and zero with `retrace`
-// set when the shadow ray is to be traced again.
-vec3 sampleDirectLight(vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f, vec2 uChoose,
+// set when the shadow ray is to be traced again. The shadow ray leaves along n, or with
+// shading normals (n then interpolated) on the side of the geometric normal ng the light is on.
+vec3 sampleDirectLight(vec3 p, vec3 n, vec3 ng, bool shadingNormals, float magnitude, vec3 beta, vec3 f, vec2 uChoose,
                        vec2 uLight, bool misOn, uint depth, inout Retrace retrace) {
   // Pick an emitter from the alias table, then a uniform point on its triangle.
   LightPoint light = pickLightPoint(uChoose, uLight);
@@ -193,14 +204,15 @@ vec3 sampleDirectLight(vec3 p, vec3 n, float magnitude, vec3 beta, vec3 f, vec2 
   float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0;
   debugLightSample(depth, light, lightPdf, weight);
   vec3 contribution = beta * f * light.Le * (cosSurface * weight / lightPdf);
-  return unoccluded(offsetRayOrigin(p, n, magnitude), light, contribution, retrace)
+  vec3 side = shadingNormals ? (dot(ng, wl) > 0.0 ? ng : -ng) : n;
+  return unoccluded(offsetRayOrigin(p, side, magnitude), light, contribution, retrace)
              ? contribution
              : vec3(0.0);
 }
 
 // sampleDirectLight at a vertex with one of bsdf.h's BSDFs (integrator.cpp's
-// sampleDirectLightBsdf): the BSDF's value and density in the local shading frame, whose z is
-// the geometric normal ng; the shadow ray leaves from the side the light is on.
+// sampleDirectLightBsdf): the BSDF's value and density in the local shading frame; the shadow
+// ray leaves from the side of the geometric normal ng the light is on.
 vec3 sampleDirectLightBsdf(vec3 p, vec3 ng, ShadingFrame frame, Material material, vec3 wo,
                            float magnitude, vec3 beta, vec2 uChoose, vec2 uLight,
                            RandomStream evalStream, RandomStream pdfStream, bool misOn,
@@ -219,7 +231,7 @@ vec3 sampleDirectLightBsdf(vec3 p, vec3 ng, ShadingFrame frame, Material materia
   float weight = misOn ? powerHeuristic(lightPdf, bsdfPdf(material, wo, wi, pdfStream)) : 1.0;
   debugLightSample(depth, light, lightPdf, weight);
   vec3 contribution = beta * f * light.Le * (weight / lightPdf);
-  return unoccluded(offsetRayOrigin(p, wi.z > 0.0 ? ng : -ng, magnitude), light, contribution,
+  return unoccluded(offsetRayOrigin(p, dot(ng, wl) > 0.0 ? ng : -ng, magnitude), light, contribution,
                     retrace)
              ? contribution
              : vec3(0.0);
@@ -345,6 +357,12 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
 
   // Diffuse and mirror surfaces are two-sided: shaded with the normal facing the ray.
   vec3 n = cosOut >= 0.0 ? ng : -ng;
+  // With vertex normals, shaded about the interpolated normal (integrator.cpp says more).
+  vec3 ns = ng;
+  if (kShadingNormals && params.normalsPresent != 0u) {
+    ns = interpolatedNormal(loadNormals(tri.primitive), b, ng);
+    n = dot(ns, wo) >= 0.0 ? ns : -ns;
+  }
   vec3 wi;
   if (kMirror && ((!kDiffuse && !kBsdfMaterials) || material.type == kMaterialMirror)) {
     // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
@@ -352,9 +370,9 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
     path.beta *= material.reflectance;
     path.specularBounce = true;
   } else if (kBsdfMaterials && (!kDiffuse || material.type != kMaterialDiffuse)) {
-    // One of bsdf.h's BSDFs, in the shading frame about the geometric normal (not turned
+    // One of bsdf.h's BSDFs, in the shading frame about the shading normal (not turned
     // towards the ray: a dielectric tells inside from outside by it).
-    ShadingFrame frame = makeShadingFrame(ng, tri.v1 - tri.v0);
+    ShadingFrame frame = makeShadingFrame(ns, tri.v1 - tri.v0);
     vec3 woLocal = toLocal(frame, wo);
     // Sample direct illumination from an emitter, unless the BSDF has only delta lobes.
     if (neeOn() && bsdfHasNonSpecular(material)) {
@@ -381,12 +399,13 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
                        : bs.pdf;
     if ((bs.flags & kBsdfTransmission) != 0u) path.etaScale *= bs.eta * bs.eta;
     // The new ray leaves from the side it goes to.
-    n = bs.wi.z > 0.0 ? ng : -ng;
+    n = dot(ng, wi) > 0.0 ? ng : -ng;
   } else {
     vec3 f = material.reflectance * kInvPi;
     // Sample direct illumination from an emitter (next-event estimation).
     if (neeOn() && material.reflectance != vec3(0.0)) {
-      path.L += sampleDirectLight(p, n, magnitude, path.beta, f,
+      path.L += sampleDirectLight(p, n, ng, kShadingNormals && params.normalsPresent != 0u,
+                                  magnitude, path.beta, f,
                                   random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
                                   random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
                                   misOn(), path.depth, retrace);
@@ -410,6 +429,7 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   }
 
   // Leave the surface on the side of the new direction.
+  if (kShadingNormals && params.normalsPresent != 0u) n = dot(ng, wi) > 0.0 ? ng : -ng;
   path.origin = offsetRayOrigin(p, n, magnitude);
   path.direction = wi;
   return false;

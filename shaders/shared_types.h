@@ -120,6 +120,17 @@ struct Material {
 };                     // 96 bytes
 PT_CONST uint kMaterialTexels = 6u;  // 16-byte texels per Material (the GPU reads them so)
 
+// The vertex normals of one triangle, for shading normals, in the scene's load order (indexed by
+// Triangle::primitive). Unit length, in world space. Uploaded only where some mesh has normals.
+struct TriangleNormals {
+  vec3 n0;          // 12 bytes: at v0
+  float reserved0;  //  4 bytes: zero
+  vec3 n1;          // 12 bytes: at v1
+  float reserved1;  //  4 bytes
+  vec3 n2;          // 12 bytes: at v2
+  float reserved2;  //  4 bytes
+};                  // 48 bytes
+
 // One entry of the emitter alias table (Walker 1977, Vose 1991): emitter i is picked with
 // probability pmf; sampling draws a slot uniformly and keeps it with probability
 // aliasThreshold, else takes slot alias.
@@ -165,7 +176,11 @@ struct RenderParams {
   uint russianRoulette;   // 4 bytes: 0 or 1
   uint fastIntersection;  // 4 bytes: 1: Moller-Trumbore (not watertight), 0: watertight
   uint samplerType;       //  4 bytes: kSamplerIndependent or kSamplerSobol
-};                        // 96 bytes
+  uint normalsPresent;    //  4 bytes: 1 when the vertex-normal buffer holds the scene's normals
+  uint reserved0;         //  4 bytes: zero
+  uint reserved1;         //  4 bytes: zero
+  uint reserved2;         //  4 bytes: zero
+};                        // 112 bytes
 
 // ---- Compute pipeline interface (Vulkan backend) ----------------------------------------
 
@@ -182,9 +197,10 @@ struct RenderParams {
 #define PT_BINDING_TRIANGLES 2  // Triangle[], texels
 #define PT_BINDING_MATERIALS 3  // Material[], texels
 #define PT_BINDING_EMITTERS 4   // Emitter[], texels (one dummy entry when the scene has none)
-#define PT_BINDING_ACCUM 5      // AccumPixel[width * height]
-#define PT_BINDING_COUNTERS 6   // DeviceCounters
-#define PT_BINDING_COUNT 7
+#define PT_BINDING_NORMALS 5    // TriangleNormals[], texels (one dummy entry when none)
+#define PT_BINDING_ACCUM 6      // AccumPixel[width * height]
+#define PT_BINDING_COUNTERS 7   // DeviceCounters
+#define PT_BINDING_COUNT 8
 
 // Specialization constant ids: the effect set. An effect switched off is compiled out.
 #define PT_SPEC_DIFFUSE 0        // bool: Lambertian surfaces occur
@@ -205,7 +221,8 @@ struct RenderParams {
 #define PT_SPEC_THIN_DIELECTRIC 11
 #define PT_SPEC_DIFFUSE_TRANSMISSION 12
 #define PT_SPEC_COATED_DIFFUSE 13
-#define PT_SPEC_COUNT 14
+#define PT_SPEC_SHADING_NORMALS 14  // bool: some mesh has vertex normals
+#define PT_SPEC_COUNT 15
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever

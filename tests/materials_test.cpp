@@ -3,6 +3,8 @@
 // effect set naming exactly the types used. The BSDFs themselves are tested in bsdf_test.cpp.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "bsdf.h"
@@ -107,8 +109,179 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"thinAndTranslucent", thinDielectric(1.5f), diffuseTransmission(),
              "thindielectric+diffusetransmission"},
         Case{"coated", coatedDiffuse(0.0f, vec3(0.0f)), coatedDiffuse(0.3f, vec3(0.5f)),
+             "coateddiffuse"},
+        // The hard cases: nearly smooth and fully rough, indices next to 1 and far from it
+        // (glass blocks: total internal reflection inside), extreme anisotropy.
+        Case{"conductorRoughnessExtremes", conductor(1e-4f), conductor(1.0f), "conductor"},
+        Case{"glassIndexExtremes", dielectric(1.0001f, 0.0f), dielectric(4.0f, 0.0f),
+             "dielectric"},
+        Case{"roughGlassExtremes", dielectric(1.0001f, 0.05f), dielectric(4.0f, 1.0f),
+             "dielectric"},
+        Case{"anisotropyExtremes",
+             [] {
+               Material m = conductor(0.001f);
+               m.alphaY = 1.0f;
+               return m;
+             }(),
+             [] {
+               Material m = dielectric(1.5f, 1.0f);
+               m.alphaY = 0.001f;
+               return m;
+             }(),
+             "conductor+dielectric"},
+        Case{"coatedExtremes", coatedDiffuse(1.0f, vec3(1.0f)), coatedDiffuse(1e-4f, vec3(0.0f)),
              "coateddiffuse"}),
     [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
+
+// A sphere of 2 * 24 * 48 triangles at the origin, radius 1, with vertex normals: the
+// sphere's own (smooth shading), or twisted by `twist` radians about the vertical axis's
+// cross product with the normal (so that many shading normals point below their triangles).
+void addSphere(Scene& scene, uint material, float twist) {
+  const std::vector<Triangle> sphere = test::makeSphere(vec3(0.0f), 1.0f, 24, 48);
+  if (scene.normals.empty()) {
+    for (const Triangle& t : scene.triangles) {
+      const vec3 ng = normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
+      scene.normals.push_back(TriangleNormals{ng, 0.0f, ng, 0.0f, ng, 0.0f});
+    }
+  }
+  auto normalAt = [&](vec3 v) {
+    const vec3 n = normalize(v);
+    const vec3 axis = cross(vec3(0.0f, 1.0f, 0.0f), n);
+    if (dot(axis, axis) < 1e-12f) return n;
+    const vec3 a = normalize(axis);
+    // Rodrigues' rotation of n about a by `twist`.
+    return n * std::cos(twist) + cross(a, n) * std::sin(twist) +
+           a * dot(a, n) * (1.0f - std::cos(twist));
+  };
+  for (Triangle t : sphere) {
+    t.material = material;
+    t.primitive = uint(scene.triangles.size());
+    scene.triangles.push_back(t);
+    scene.normals.push_back(
+        TriangleNormals{normalAt(t.v0), 0.0f, normalAt(t.v1), 0.0f, normalAt(t.v2), 0.0f});
+  }
+}
+
+// A closed cube around the sphere whose faces emit Le = 1 and reflect nothing, looked into
+// from inside: a white furnace.
+Scene furnaceWith(const Material& m, float twist) {
+  Scene scene;
+  scene.materials = {Material{vec3(0.0f), kMaterialDiffuse, vec3(1.0f), 0}, m};
+  for (Triangle& t : scene.triangles) t.material = 0;
+  const uint faces[6] = {0, 0, 0, 0, 0, 0};
+  test::addInwardCube(scene, faces);
+  for (Triangle& t : scene.triangles) {
+    t.v0 *= 3.0f;
+    t.v1 *= 3.0f;
+    t.v2 *= 3.0f;
+  }
+  for (uint i = 0; i < scene.triangles.size(); ++i) scene.triangles[i].primitive = i;
+  addSphere(scene, 1, twist);
+  scene.camera = CameraDesc{vec3(0.0f, 0.0f, -2.9f), vec3(0.0f), vec3(0, 1, 0), 40.0f, 16, 16};
+  scene.integrator.maxDepth = 1000;
+  return scene;
+}
+
+// Mean and standard error of an image's pixels.
+struct ImageMean {
+  glm::dvec3 mean{0.0}, se{0.0};
+};
+ImageMean imageMean(const Image& image) {
+  ImageMean r;
+  const double n = double(image.pixels.size());
+  for (const vec3& p : image.pixels) r.mean += glm::dvec3(p) / n;
+  glm::dvec3 sq(0.0);
+  for (const vec3& p : image.pixels) sq += (glm::dvec3(p) - r.mean) * (glm::dvec3(p) - r.mean);
+  r.se = sqrt(sq / (n - 1.0) / n);
+  return r;
+}
+
+// In the furnace every material that loses no energy shows radiance 1, whatever it is; one
+// that absorbs shows less, never more. The camera sees the smooth-shaded sphere, which fills
+// the view; both backends, nothing invalid.
+TEST(MaterialsFurnace, NeverAboveOneAndOneWhenLossless) {
+  Material transmissive = diffuseTransmission();
+  transmissive.reflectance = vec3(0.5f);
+  transmissive.transmittance = vec3(0.5f);
+  Material coated = coatedDiffuse(0.2f, vec3(0.0f));
+  coated.reflectance = vec3(1.0f);
+  Material metal = conductor(0.3f);
+  metal.eta = vec3(1.0f);
+  metal.k = vec3(200.0f);  // reflectance 0.9999
+  struct FurnaceCase {
+    const char* name;
+    Material m;
+    bool lossless;
+  };
+  for (const FurnaceCase& c : {FurnaceCase{"smooth glass", dielectric(1.5f, 0.0f), true},
+                               FurnaceCase{"thin glass", thinDielectric(1.5f), true},
+                               FurnaceCase{"diffuse transmission", transmissive, true},
+                               FurnaceCase{"rough glass", dielectric(1.5f, 0.3f), false},
+                               FurnaceCase{"rough metal", metal, false},
+                               FurnaceCase{"coated", coated, false}}) {
+    SCOPED_TRACE(c.name);
+    const SceneData data = prepareScene(furnaceWith(c.m, 0.0f), RenderSettings{});
+    EXPECT_TRUE(data.effects.shadingNormals);
+    const Comparison cmp = renderBoth(data, 32);
+    EXPECT_EQ(cmp.cpu.invalidSamples + cmp.gpu.invalidSamples, 0u);
+    EXPECT_EQ(cmp.gpu.validationErrors, 0u);
+    for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+      const ImageMean m = imageMean(*image);
+      for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_LE(m.mean[ch], 1.0 + 3.0 * m.se[ch] + 1e-6) << "channel " << ch;
+        if (c.lossless) EXPECT_NEAR(m.mean[ch], 1.0, 3.0 * m.se[ch] + 1e-5) << "channel " << ch;
+      }
+      std::printf("furnace, %s, %s: mean %.5f (standard error %.5f)\n", c.name,
+                  image == &cmp.cpuImage ? "cpu" : "vulkan", m.mean.x, m.se.x);
+    }
+  }
+}
+
+// Shading normals twisted by 100 degrees, so that many point below their triangles: every
+// material still gives finite samples, and the backends still agree.
+TEST(MaterialsShadingNormals, TwistedNormalsStayFiniteOnBothBackends) {
+  for (const Material& m : {dielectric(1.5f, 0.0f), conductor(0.2f), coatedDiffuse(0.1f, vec3(0.0f)),
+                            Material{vec3(0.7f), kMaterialDiffuse, vec3(0.0f), 0}}) {
+    SCOPED_TRACE("type " + std::to_string(m.type));
+    Scene scene = furnaceWith(m, 100.0f * kPi / 180.0f);
+    scene.materials[0].reflectance = vec3(0.3f);  // the walls scatter too
+    const SceneData data = prepareScene(std::move(scene), RenderSettings{});
+    const Comparison cmp = renderBoth(data, 8);
+    EXPECT_EQ(cmp.cpu.invalidSamples + cmp.gpu.invalidSamples, 0u);
+    expectAgreement(cmp);
+  }
+}
+
+// Smooth shading changes the image (the sphere's facets disappear) and the backends agree on
+// it, for the seed's materials too.
+TEST(MaterialsShadingNormals, SmoothSphereAgreesAndDiffersFromFlat) {
+  Scene scene = loadScene(test::kConfigs / "cornell-box.json");
+  Material glass = dielectric(1.5f, 0.0f);
+  scene.materials.push_back(glass);
+  scene.materialNames.push_back("glass");
+  scene.triangles.resize(10);  // walls only; the blocks go
+  scene.triangles.push_back(loadScene(test::kConfigs / "cornell-box.json").triangles[30]);
+  scene.triangles.push_back(loadScene(test::kConfigs / "cornell-box.json").triangles[31]);
+  for (uint i = 0; i < scene.triangles.size(); ++i) scene.triangles[i].primitive = i;
+  const size_t before = scene.triangles.size();
+  addSphere(scene, uint(scene.materials.size() - 1), 0.0f);
+  for (size_t i = before; i < scene.triangles.size(); ++i) {
+    Triangle& t = scene.triangles[i];
+    for (vec3* v : {&t.v0, &t.v1, &t.v2}) *v = *v * 120.0f + vec3(278.0f, 150.0f, 280.0f);
+  }
+  Scene flat = scene;
+  flat.normals.clear();
+  const RenderSettings settings{.width = 32, .height = 32};
+  const SceneData smooth = prepareScene(std::move(scene), settings);
+  const SceneData faceted = prepareScene(std::move(flat), settings);
+  EXPECT_TRUE(smooth.effects.shadingNormals);
+  EXPECT_FALSE(faceted.effects.shadingNormals);
+  const Comparison a = renderBoth(smooth, 8);
+  expectAgreement(a);
+  const Comparison b = renderBoth(faceted, 8);
+  expectAgreement(b);
+  EXPECT_GT(diffImages(a.cpuImage, b.cpuImage, 1e-3).pixelsOverThreshold, 10u);
+}
 
 TEST(Materials, DiffuseOnlySceneUsesNone) {
   const SceneData data = prepareScene(loadScene(test::kConfigs / "cornell-box.json"),

@@ -85,7 +85,9 @@ KeyValues imageSettings(const SceneData& data, const RenderSettings& settings,
       {"camera", hashOf(camera)},
       {"scene", hexHash(hashBytes(
                     corners.data(), corners.size() * sizeof(Corners),
-                    hashBytes(data.materials.data(), data.materials.size() * sizeof(Material))))},
+                    hashBytes(data.materials.data(), data.materials.size() * sizeof(Material),
+                              hashBytes(data.normals.data(),
+                                        data.normals.size() * sizeof(TriangleNormals)))))},
       {"bvh",
        hexHash(hashBytes(
            leafOrder.data(), leafOrder.size() * sizeof(uint32_t),

@@ -35,6 +35,9 @@ static_assert(offsetof(Material, transmittance) == 64 && offsetof(Material, thic
 static_assert(offsetof(Material, g) == 80 && offsetof(Material, maxDepth) == 84);
 static_assert(offsetof(Material, nSamples) == 88 && offsetof(Material, reserved1) == 92);
 
+static_assert(sizeof(TriangleNormals) == 48);
+static_assert(offsetof(TriangleNormals, n1) == 16 && offsetof(TriangleNormals, n2) == 32);
+
 static_assert(sizeof(Emitter) == 16);
 static_assert(offsetof(Emitter, pmf) == 4 && offsetof(Emitter, aliasThreshold) == 8);
 static_assert(offsetof(Emitter, alias) == 12);
@@ -43,7 +46,8 @@ static_assert(sizeof(Camera) == 64);
 static_assert(offsetof(Camera, forward) == 16 && offsetof(Camera, right) == 32);
 static_assert(offsetof(Camera, up) == 48 && offsetof(Camera, height) == 60);
 
-static_assert(sizeof(RenderParams) == 96);
+static_assert(sizeof(RenderParams) == 112);
+static_assert(offsetof(RenderParams, normalsPresent) == 96);
 static_assert(offsetof(RenderParams, maxDepth) == 64 && offsetof(RenderParams, seed) == 76);
 static_assert(offsetof(RenderParams, russianRoulette) == 84);
 

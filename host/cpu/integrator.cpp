@@ -90,9 +90,11 @@ void printLightSample(const SceneData& scene, const LightPoint& light, float lig
 // estimation, pbrt's SampleLd): picks an emitter from the alias table with uChoose, a uniform
 // point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
 // contribution to L, beta * f * Le * cos / pdf, weighted by the power heuristic against BSDF
-// sampling when misOn; zero when the point faces away or is occluded.
+// sampling when misOn; zero when the point faces away or is occluded. The shadow ray leaves
+// along n, or with shading normals (n then interpolated) on the side of the geometric normal
+// ng that the light is on.
 vec3 sampleDirectLight(const SceneData& scene, const CpuSceneCopies& copies, vec3 p, vec3 n,
-                       float magnitude, vec3 beta, vec3 f, vec2 uChoose, vec2 uLight, bool misOn,
+                       vec3 ng, bool shadingNormals, float magnitude, vec3 beta, vec3 f, vec2 uChoose, vec2 uLight, bool misOn,
                        Intersection test, uint64_t& rays, bool debugPrint, uint depth) {
   // Pick an emitter from the alias table, then a uniform point on its triangle.
   const LightPoint light = pickLightPoint(scene, copies, uChoose, uLight);
@@ -102,7 +104,8 @@ vec3 sampleDirectLight(const SceneData& scene, const CpuSceneCopies& copies, vec
   if (!(toward.cosLight > 0.0f && cosSurface > 0.0f)) return vec3(0.0f);
 
   // Shadow ray between the two offset points; t in [0, 1) spans the segment.
-  const vec3 from = offsetRayOrigin(p, n, magnitude);
+  const vec3 side = shadingNormals ? (dot(ng, toward.wl) > 0.0f ? ng : -ng) : n;
+  const vec3 from = offsetRayOrigin(p, side, magnitude);
   const vec3 to = offsetRayOrigin(light.point, light.normal, light.magnitude);
   ++rays;
   if (anyHit(copies.wide, Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
@@ -114,9 +117,9 @@ vec3 sampleDirectLight(const SceneData& scene, const CpuSceneCopies& copies, vec
 }
 
 // sampleDirectLight at a vertex with one of bsdf.h's BSDFs: the same light sample, with the
-// BSDF's value and density in place of the Lambertian's, in the local shading frame (z is
-// the geometric normal ng, which the frame's z equals). The shadow ray leaves from the side
-// the light is on; f * |cos| is zero where the BSDF does not scatter that way.
+// BSDF's value and density in place of the Lambertian's, in the local shading frame. The
+// shadow ray leaves from the side of the geometric normal ng the light is on; f * |cos| is
+// zero where the BSDF does not scatter that way.
 vec3 sampleDirectLightBsdf(const SceneData& scene, const CpuSceneCopies& copies, vec3 p, vec3 ng,
                            const ShadingFrame& frame, const Material& material, vec3 wo,
                            float magnitude, vec3 beta, vec2 uChoose, vec2 uLight,
@@ -129,7 +132,7 @@ vec3 sampleDirectLightBsdf(const SceneData& scene, const CpuSceneCopies& copies,
   const vec3 f = bsdfF(material, wo, wi, evalStream) * absCosTheta(wi);
   if (!(maxComponent(f) > 0.0f)) return vec3(0.0f);
 
-  const vec3 from = offsetRayOrigin(p, wi.z > 0.0f ? ng : -ng, magnitude);
+  const vec3 from = offsetRayOrigin(p, dot(ng, toward.wl) > 0.0f ? ng : -ng, magnitude);
   const vec3 to = offsetRayOrigin(light.point, light.normal, light.magnitude);
   ++rays;
   if (anyHit(copies.wide, Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
@@ -219,8 +222,17 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     const uint dim = kDimFirstBounce + kDimsPerBounce * depth;
     ++depth;
 
+    // The shading normal: the mesh's vertex normals interpolated where it has them, else ng.
+    // (pbrt-v4 does not guard against the light leaks a shading normal can cause, and nor do
+    // we: BSDFs are evaluated about ns whichever side of the geometric surface wi is on; rays
+    // leave on the side of ng they go to.)
+    const bool shadingNormals = !scene.normals.empty();
+    const vec3 ns = shadingNormals
+                        ? interpolatedNormal(scene.normals[tri.primitive], hit->barycentrics, ng)
+                        : ng;
     // Diffuse and mirror surfaces are two-sided: shaded with the normal facing the ray.
     vec3 n = cosOut >= 0.0f ? ng : -ng;
+    if (shadingNormals) n = dot(ns, wo) >= 0.0f ? ns : -ns;
     // This event's random numbers, all four dimensions at once (the shader draws each where
     // it is used: the same numbers).
     const BounceRandom u = bounceRandomSimd(sobol, pixel, sampleIndex, dim, seed);
@@ -231,9 +243,9 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
       beta *= material.reflectance;
       specularBounce = true;
     } else if (material.type != kMaterialDiffuse) {
-      // One of bsdf.h's BSDFs, in the shading frame about the geometric normal (not turned
+      // One of bsdf.h's BSDFs, in the shading frame about the shading normal (not turned
       // towards the ray: a dielectric tells inside from outside by it).
-      const ShadingFrame frame = makeShadingFrame(ng, tri.v1 - tri.v0);
+      const ShadingFrame frame = makeShadingFrame(ns, tri.v1 - tri.v0);
       const vec3 woLocal = toLocal(frame, wo);
       // Sample direct illumination from an emitter, unless the BSDF has only delta lobes.
       if (neeOn && bsdfHasNonSpecular(material)) {
@@ -257,13 +269,13 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
                     : bs.pdf;
       if ((bs.flags & kBsdfTransmission) != 0u) etaScale *= bs.eta * bs.eta;
       // The new ray leaves from the side it goes to.
-      n = bs.wi.z > 0.0f ? ng : -ng;
+      n = dot(ng, wi) > 0.0f ? ng : -ng;
     } else {
       const vec3 f = material.reflectance * kInvPi;
       // Sample direct illumination from an emitter (next-event estimation).
       if (neeOn && material.reflectance != vec3(0.0f)) {
-        L += sampleDirectLight(scene, copies, p, n, magnitude, beta, f, u.lightChoose, u.lightPoint,
-                               misOn, test, rays, debugPrint, depth);
+        L += sampleDirectLight(scene, copies, p, n, ng, shadingNormals, magnitude, beta, f,
+                               u.lightChoose, u.lightPoint, misOn, test, rays, debugPrint, depth);
       }
       // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
       wi = localToWorld(sampleCosineHemisphere(u.bsdf), n);
@@ -282,6 +294,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     }
 
     // Leave the surface on the side of the new direction.
+    if (shadingNormals) n = dot(ng, wi) > 0.0f ? ng : -ng;
     ray = Ray{offsetRayOrigin(p, n, magnitude), wi};
   }
   if (debugPrint) {

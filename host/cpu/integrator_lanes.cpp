@@ -613,9 +613,10 @@ HWY_EXPORT(sampleRadianceLanesImpl);
 
 void sampleRadianceLanes(const SceneData& scene, const uvec2* pixels, size_t count,
                          uint32_t sampleIndex, vec3* out, uint64_t& rays) {
-  // The lanes transcribe diffuse and mirror surfaces only; a scene with bsdf.h's materials
-  // takes the reference path by path (the same results by definition).
-  if (scene.effects.hasBsdfMaterials()) {
+  // The lanes transcribe diffuse and mirror surfaces about the geometric normal only; a scene
+  // with bsdf.h's materials or shading normals takes the reference path by path (the same
+  // results by definition).
+  if (scene.effects.hasBsdfMaterials() || scene.effects.shadingNormals) {
     for (size_t i = 0; i < count; ++i) out[i] = sampleRadiance(scene, pixels[i], sampleIndex, rays);
     return;
   }

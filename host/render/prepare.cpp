@@ -41,6 +41,7 @@ std::string EffectSet::toString() const {
   add(thinDielectric, "thindielectric");
   add(diffuseTransmission, "diffusetransmission");
   add(coatedDiffuse, "coateddiffuse");
+  add(shadingNormals, "shading-normals");
   add(lightSampling, "nee");
   add(mis, "mis");
   add(russianRoulette, "rr");
@@ -136,6 +137,8 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   const IntegratorSettings& integ = scene.integrator;
   data.spp = settings.spp.value_or(integ.spp);
   data.materials = scene.materials;
+  data.normals = std::move(scene.normals);
+  PT_CHECK(data.normals.empty() || data.normals.size() == scene.triangles.size());
 
   std::vector<Triangle> triangles = std::move(scene.triangles);
   CameraDesc camera = scene.camera;
@@ -178,6 +181,8 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   fx.lightSampling = (fx.diffuse || lightSampled) && scatters && !data.emitters.empty() &&
                      p.strategy != kStrategyBsdf;
   fx.bsdfEmission = !data.emitters.empty() && p.strategy != kStrategyNee;
+  fx.shadingNormals = !data.normals.empty();
+  p.normalsPresent = fx.shadingNormals ? 1u : 0u;
   fx.watertight = !settings.fastIntersection;
   fx.sobol = p.samplerType == kSamplerSobol;
   fx.mis = fx.lightSampling && fx.bsdfEmission && p.strategy == kStrategyMis;

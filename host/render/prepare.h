@@ -59,6 +59,7 @@ struct EffectSet {
   bool thinDielectric = false;
   bool diffuseTransmission = false;
   bool coatedDiffuse = false;
+  bool shadingNormals = false;  // some mesh has vertex normals: shading normals interpolated
   bool lightSampling = false;  // next-event estimation (needs emitters, a diffuse surface)
   bool bsdfEmission = false;   // emission found by BSDF-sampled rays is counted (MIS/BSDF)
   bool mis = false;            // both of the above, weighed by the power heuristic
@@ -125,6 +126,8 @@ struct SceneData {
   Bvh bvh;
   std::vector<Material> materials;
   std::vector<Emitter> emitters;  // alias table; empty when nothing emits
+  // Vertex normals by Triangle::primitive (load order), or empty when no mesh has any.
+  std::vector<TriangleNormals> normals;
   RenderParams params{};
   int spp = 0;
   EffectSet effects;

@@ -39,12 +39,25 @@ struct Scene {
   // Triangles in load order; Triangle::primitive is the index in this vector and
   // Triangle::emitter is kNoEmitter until buildEmitters assigns it.
   std::vector<Triangle> triangles;
+  // Vertex normals per triangle, parallel to `triangles`, or empty when no mesh has normals
+  // (triangles of meshes without them then repeat their geometric normal).
+  std::vector<TriangleNormals> normals;
   std::vector<std::string> warnings;  // e.g. dropped zero-area triangles, one line each
 };
 
 // Reads a scene file. Throws InputError with "<file>: <field or line>: <message>" for
 // anything malformed (see docs/scene-format.md). Mesh paths are relative to the JSON file.
 Scene loadScene(const std::filesystem::path& path);
+
+// A material of type `type` (kMaterial*) with the defaults of docs/scene-format.md (pbrt-v4's,
+// for the types taken from pbrt-v4) and no emission. The JSON reader and the MTL mapping both
+// start from it, so that a default is written in one place.
+Material defaultMaterial(uint type);
+
+// Makes `material` pbrt-v4's conductor of the given reflectance colour (its
+// ConductorMaterial::GetBxDF): eta = 1 and k = 2 sqrt(r) / sqrt(1 - r) per channel, with r
+// clamped to [0, 0.9999] so that white stays finite.
+void setConductorReflectance(Material& material, vec3 reflectance);
 
 // Builds the GPU camera for a film of width x height pixels.
 Camera makeCamera(const CameraDesc& desc, int width, int height);

@@ -54,6 +54,8 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   // An empty emitter table still needs a valid binding: one zeroed entry the shader never reads.
   const std::vector<Emitter> emitters =
       scene.emitters.empty() ? std::vector<Emitter>{Emitter{}} : scene.emitters;
+  const std::vector<TriangleNormals> normals =
+      scene.normals.empty() ? std::vector<TriangleNormals>{TriangleNormals{}} : scene.normals;
   const GpuBvh bvh = buildGpuBvh(scene.bvh);
   const std::vector<uint32_t> traversal = gpuTraversalTexels(bvh, scene.bvh.triangles);
   // In PT_BINDING_* order, followed by the accumulation and the counters.
@@ -63,10 +65,11 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       {"triangle", scene.bvh.triangles.data(), scene.bvh.triangles.size() * sizeof(Triangle), true},
       {"material", scene.materials.data(), scene.materials.size() * sizeof(Material), true},
       {"emitter", emitters.data(), emitters.size() * sizeof(Emitter), true},
+      {"vertex normal", normals.data(), normals.size() * sizeof(TriangleNormals), true},
   };
   static_assert(PT_BINDING_PARAMS == 0 && PT_BINDING_NODES == 1 && PT_BINDING_TRIANGLES == 2 &&
-                PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 && PT_BINDING_ACCUM == 5 &&
-                PT_BINDING_COUNTERS == 6);
+                PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 &&
+                PT_BINDING_NORMALS == 5 && PT_BINDING_ACCUM == 6 && PT_BINDING_COUNTERS == 7);
   static_assert(std::size(uploads) + 2 == PT_BINDING_COUNT, "every binding is a buffer");
 
   // Every size is checked before anything is allocated: a scene too large for the device is
@@ -102,13 +105,15 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
                        all ? kSpecAtRunTime : params.fastIntersection,
                        all ? kSpecAtRunTime : params.samplerType, buffers.stackRows,
                        all || fx.conductor, all || fx.dielectric, all || fx.thinDielectric,
-                       all || fx.diffuseTransmission, all || fx.coatedDiffuse}};
+                       all || fx.diffuseTransmission, all || fx.coatedDiffuse,
+                       all || fx.shadingNormals}};
   static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
                 PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
                 PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
                 PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 &&
                 PT_SPEC_THIN_DIELECTRIC == 11 && PT_SPEC_DIFFUSE_TRANSMISSION == 12 &&
-                PT_SPEC_COATED_DIFFUSE == 13 && PT_SPEC_COUNT == 14);
+                PT_SPEC_COATED_DIFFUSE == 13 && PT_SPEC_SHADING_NORMALS == 14 &&
+                PT_SPEC_COUNT == 15);
   std::vector<vk::SpecializationMapEntry> entries;
   for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));
