@@ -34,6 +34,12 @@ namespace pt {
 #define PT_HAS_COATED_DIFFUSE true
 #endif
 
+// Counts an iteration of the layered BSDF's loops where the shader keeps count of its loops
+// (lavapipe caps them; see pathtrace.comp); nothing in C++.
+#ifndef PT_LOOP_TICK
+#define PT_LOOP_TICK()
+#endif
+
 PT_CONST float kInv4Pi = 0.07957747154594766788f;
 
 // ---- Sample records and flags ------------------------------------------------------------
@@ -600,6 +606,7 @@ PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance,
   if (exitTop) f = n * dielectricF(c.coat, c.eta, wo, wi, radiance);
 
   for (uint s = 0u; s < c.nSamples; ++s) {
+    PT_LOOP_TICK();
     // Sample the transmission through the entrance interface, and a virtual light path from
     // wi through the exit interface (pbrt-v4's wos and wis).
     float uc = nextRandom(rng);
@@ -615,6 +622,7 @@ PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance,
     float z = c.thickness;
     vec3 w = wos.wi;
     for (uint depth = 0u; depth < c.maxDepth; ++depth) {
+      PT_LOOP_TICK();
       // Possibly end the walk with Russian roulette.
       if (depth > 3u && maxComponent(beta) < 0.25f) {
         float q = max(0.0f, 1.0f - maxComponent(beta));
@@ -727,6 +735,7 @@ PT_INLINE BsdfSample coatedDiffuseSample(CoatedDiffuse c, vec3 wo, float uc, vec
   float pdf = bs.pdf;
   float z = c.thickness;
   for (uint depth = 0u; depth < c.maxDepth; ++depth) {
+    PT_LOOP_TICK();
     // Possibly end the walk with Russian roulette.
     float rrBeta = maxComponent(f) / pdf;
     if (depth > 3u && rrBeta < 0.25f) {
@@ -792,6 +801,7 @@ PT_INLINE float coatedDiffusePdf(CoatedDiffuse c, vec3 wo, vec3 wi, RandomStream
   float pdfSum = n * dielectricPdf(c.coat, c.eta, wo, wi, kSampleReflection);
   bool coatSmooth = dielectricIsSmooth(c.coat, c.eta);
   for (uint s = 0u; s < c.nSamples; ++s) {
+    PT_LOOP_TICK();
     // Transmission, reflection at the base, transmission (TRT).
     float uc = nextRandom(rng);
     vec2 u = nextRandom2(rng);

@@ -33,12 +33,6 @@ layout(constant_id = PT_SPEC_SHADING_NORMALS) const bool kShadingNormals = true;
 // Some surface has one of bsdf.h's materials; bsdf.h's switch sees only the types in use.
 const bool kBsdfMaterials =
     kConductor || kDielectric || kThinDielectric || kDiffuseTransmission || kCoatedDiffuse;
-#define PT_HAS_CONDUCTOR kConductor
-#define PT_HAS_DIELECTRIC kDielectric
-#define PT_HAS_THIN_DIELECTRIC kThinDielectric
-#define PT_HAS_DIFFUSE_TRANSMISSION kDiffuseTransmission
-#define PT_HAS_COATED_DIFFUSE kCoatedDiffuse
-#include "bsdf.h"
 
 layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer {
   RenderParams paramsBuffer;
@@ -74,6 +68,15 @@ bool gTruncated = false;
 uint gLoopIterations = 0u;  // this invocation's count, for the statistics
 uint gRays = 0u;
 bool gDebug = false;  // this invocation prints its path (--debug-pixel)
+
+// bsdf.h, for the material types in use, its loops counted.
+#define PT_HAS_CONDUCTOR kConductor
+#define PT_HAS_DIELECTRIC kDielectric
+#define PT_HAS_THIN_DIELECTRIC kThinDielectric
+#define PT_HAS_DIFFUSE_TRANSMISSION kDiffuseTransmission
+#define PT_HAS_COATED_DIFFUSE kCoatedDiffuse
+#define PT_LOOP_TICK() gLoopIterations++
+#include "bsdf.h"
 
 // Watertight unless switched off by specialization or, unspecialized, by the parameters.
 #define PT_WATERTIGHT \
