@@ -24,12 +24,24 @@ layout(constant_id = PT_SPEC_MIS) const bool kMis = true;
 layout(constant_id = PT_SPEC_RR) const bool kRussianRoulette = true;
 layout(constant_id = PT_SPEC_INTERSECTION) const uint kIntersection = kSpecAtRunTime;
 layout(constant_id = PT_SPEC_SAMPLER) const uint kSampler = kSpecAtRunTime;
+#ifdef PT_NO_BSDF_MATERIALS
+// The variant for scenes of diffuse and mirror surfaces without vertex normals (the host picks
+// it): nothing of bsdf.h is compiled in, which lavapipe's compiler takes a second over even
+// where specialization constants switch it off.
+const bool kConductor = false;
+const bool kDielectric = false;
+const bool kThinDielectric = false;
+const bool kDiffuseTransmission = false;
+const bool kCoatedDiffuse = false;
+const bool kShadingNormals = false;
+#else
 layout(constant_id = PT_SPEC_CONDUCTOR) const bool kConductor = true;
 layout(constant_id = PT_SPEC_DIELECTRIC) const bool kDielectric = true;
 layout(constant_id = PT_SPEC_THIN_DIELECTRIC) const bool kThinDielectric = true;
 layout(constant_id = PT_SPEC_DIFFUSE_TRANSMISSION) const bool kDiffuseTransmission = true;
 layout(constant_id = PT_SPEC_COATED_DIFFUSE) const bool kCoatedDiffuse = true;
 layout(constant_id = PT_SPEC_SHADING_NORMALS) const bool kShadingNormals = true;
+#endif
 // Some surface has one of bsdf.h's materials; bsdf.h's switch sees only the types in use.
 const bool kBsdfMaterials =
     kConductor || kDielectric || kThinDielectric || kDiffuseTransmission || kCoatedDiffuse;
@@ -69,6 +81,7 @@ uint gLoopIterations = 0u;  // this invocation's count, for the statistics
 uint gRays = 0u;
 bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 
+#ifndef PT_NO_BSDF_MATERIALS
 // bsdf.h, for the material types in use, its loops counted.
 #define PT_HAS_CONDUCTOR kConductor
 #define PT_HAS_DIELECTRIC kDielectric
@@ -77,6 +90,7 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 #define PT_HAS_COATED_DIFFUSE kCoatedDiffuse
 #define PT_LOOP_TICK() gLoopIterations++
 #include "bsdf.h"
+#endif
 
 // Watertight unless switched off by specialization or, unspecialized, by the parameters.
 #define PT_WATERTIGHT \
@@ -104,6 +118,7 @@ Material loadMaterial(uint i) {
                   uintBitsToFloat(f.x), f.y, f.z, f.w);
 }
 
+#ifndef PT_NO_BSDF_MATERIALS
 TriangleNormals loadNormals(uint primitive) {
   int at = int(3u * primitive);
   vec4 a = uintBitsToFloat(texelFetch(normalTexels, at));
@@ -111,6 +126,7 @@ TriangleNormals loadNormals(uint primitive) {
   vec4 c = uintBitsToFloat(texelFetch(normalTexels, at + 2));
   return TriangleNormals(a.xyz, a.w, b.xyz, b.w, c.xyz, c.w);
 }
+#endif
 
 Emitter loadEmitter(uint i) {
   uvec4 a = texelFetch(emitterTexels, int(i));
@@ -157,21 +173,31 @@ LightPoint pickLightPoint(vec2 uChoose, vec2 uLight) {
                     loadMaterial(light.material).emission, emitter.triangle, light.primitive);
 }
 
-// Traces the shadow ray of a light sample, from `from` (offset) to the light point (offset);
-// returns false when it is occluded. When the traversal gave up (see Retrace), `retrace`
-// takes the ray and the contribution, and this returns false: the contribution comes later.
-bool unoccluded(vec3 from, LightPoint light, vec3 contribution, inout Retrace retrace) {
+// Traces the shadow ray of a light sample from `from` (offset) to the light point (offset),
+// `direction` spanning it with t in [0, 1): kShadowOccluded, kShadowClear, or kShadowRetrace
+// when the traversal gave up (see Retrace), the ray then to be traced again later.
+const uint kShadowOccluded = 0u;
+const uint kShadowClear = 1u;
+const uint kShadowRetrace = 2u;
+uint traceShadowRay(vec3 from, LightPoint light, out vec3 direction) {
   vec3 to = offsetRayOrigin(light.point, light.normal, light.magnitude);
+  direction = to - from;
   gRays++;
   HitData blocker;
   bool inexact;
   bool occluded =
-      traceRayWith(/*exact=*/false, from, to - from, 1.0, /*anyHit=*/true, blocker, inexact);
-  if (inexact) {
-    retrace = Retrace(true, true, from, to - from, contribution);
-    return false;
-  }
-  return !occluded;
+      traceRayWith(/*exact=*/false, from, direction, 1.0, /*anyHit=*/true, blocker, inexact);
+  if (inexact) return kShadowRetrace;
+  return occluded ? kShadowOccluded : kShadowClear;
+}
+
+// A clear shadow ray's contribution, or zero with `retrace` set to add it once the ray has been
+// traced again.
+vec3 addOrDefer(uint shadow, vec3 from, vec3 direction, vec3 contribution,
+                inout Retrace retrace) {
+  if (shadow != kShadowRetrace) return contribution;
+  retrace = Retrace(true, true, from, direction, contribution);
+  return vec3(0.0);
 }
 
 void debugLightSample(uint depth, LightPoint light, float lightPdf, float weight) {
@@ -203,16 +229,19 @@ vec3 sampleDirectLight(vec3 p, vec3 n, vec3 ng, bool shadingNormals, float magni
   if (!(cosLight > 0.0 && cosSurface > 0.0)) return vec3(0.0);
 
   // Shadow ray between the two offset points; t in [0, 1) spans the segment.
+  vec3 from = offsetRayOrigin(p, shadingNormals ? (dot(ng, wl) > 0.0 ? ng : -ng) : n, magnitude);
+  vec3 direction;
+  uint shadow = traceShadowRay(from, light, direction);
+  if (shadow == kShadowOccluded) return vec3(0.0);
+
   float lightPdf = light.pmf * dist2 / (cosLight * light.area);
   float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0;
   debugLightSample(depth, light, lightPdf, weight);
   vec3 contribution = beta * f * light.Le * (cosSurface * weight / lightPdf);
-  vec3 side = shadingNormals ? (dot(ng, wl) > 0.0 ? ng : -ng) : n;
-  return unoccluded(offsetRayOrigin(p, side, magnitude), light, contribution, retrace)
-             ? contribution
-             : vec3(0.0);
+  return addOrDefer(shadow, from, direction, contribution, retrace);
 }
 
+#ifndef PT_NO_BSDF_MATERIALS
 // sampleDirectLight at a vertex with one of bsdf.h's BSDFs (integrator.cpp's
 // sampleDirectLightBsdf): the BSDF's value and density in the local shading frame; the shadow
 // ray leaves from the side of the geometric normal ng the light is on.
@@ -230,15 +259,18 @@ vec3 sampleDirectLightBsdf(vec3 p, vec3 ng, ShadingFrame frame, Material materia
   vec3 f = bsdfF(material, wo, wi, evalStream) * absCosTheta(wi);
   if (!(maxComponent(f) > 0.0)) return vec3(0.0);
 
+  vec3 from = offsetRayOrigin(p, dot(ng, wl) > 0.0 ? ng : -ng, magnitude);
+  vec3 direction;
+  uint shadow = traceShadowRay(from, light, direction);
+  if (shadow == kShadowOccluded) return vec3(0.0);
+
   float lightPdf = light.pmf * dist2 / (cosLight * light.area);
   float weight = misOn ? powerHeuristic(lightPdf, bsdfPdf(material, wo, wi, pdfStream)) : 1.0;
   debugLightSample(depth, light, lightPdf, weight);
   vec3 contribution = beta * f * light.Le * (weight / lightPdf);
-  return unoccluded(offsetRayOrigin(p, dot(ng, wl) > 0.0 ? ng : -ng, magnitude), light, contribution,
-                    retrace)
-             ? contribution
-             : vec3(0.0);
+  return addOrDefer(shadow, from, direction, contribution, retrace);
 }
+#endif
 
 // What sampleRadiance (host/cpu/integrator.cpp) keeps across its loop: one sample's path,
 // between two bounces.
@@ -362,16 +394,19 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   vec3 n = cosOut >= 0.0 ? ng : -ng;
   // With vertex normals, shaded about the interpolated normal (integrator.cpp says more).
   vec3 ns = ng;
+#ifndef PT_NO_BSDF_MATERIALS
   if (kShadingNormals && params.normalsPresent != 0u) {
     ns = interpolatedNormal(loadNormals(tri.primitive), b, ng);
     n = dot(ns, wo) >= 0.0 ? ns : -ns;
   }
+#endif
   vec3 wi;
   if (kMirror && ((!kDiffuse && !kBsdfMaterials) || material.type == kMaterialMirror)) {
     // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
     wi = path.direction - 2.0 * dot(path.direction, n) * n;
     path.beta *= material.reflectance;
     path.specularBounce = true;
+#ifndef PT_NO_BSDF_MATERIALS
   } else if (kBsdfMaterials && (!kDiffuse || material.type != kMaterialDiffuse)) {
     // One of bsdf.h's BSDFs, in the shading frame about the shading normal (not turned
     // towards the ray: a dielectric tells inside from outside by it).
@@ -403,6 +438,7 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
     if ((bs.flags & kBsdfTransmission) != 0u) path.etaScale *= bs.eta * bs.eta;
     // The new ray leaves from the side it goes to.
     n = dot(ng, wi) > 0.0 ? ng : -ng;
+#endif
   } else {
     vec3 f = material.reflectance * kInvPi;
     // Sample direct illumination from an emitter (next-event estimation).

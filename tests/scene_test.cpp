@@ -2,10 +2,12 @@
 // the camera basis, and the one-line InputError every kind of bad input must produce.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -401,6 +403,352 @@ TEST(SceneMaterials, BadMaterials) {
   EXPECT_CONTAINS(withMaterials(R"([3])"), "materials[0]: expected an object, got a number");
 }
 
+// The materials of a scene with the given "materials" array (and one quad of the first).
+std::vector<Material> loadMaterials(const TempDir& dir, const std::string& materials) {
+  const std::string first = nlohmann::json::parse(materials)[0]["name"];
+  const std::string quad = R"([{"type": "quad", "material": ")" + first +
+                           R"(", "vertices": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]}])";
+  return loadScene(dir.write("materials.json", sceneJson(materials, quad))).materials;
+}
+
+// Every field, so that a parameter landing in the wrong field, or a field a type does not
+// use left non-zero, fails.
+void expectMaterial(const Material& got, const Material& want, const std::string& what) {
+  SCOPED_TRACE(what);
+  EXPECT_EQ(got.type, want.type);
+  EXPECT_EQ(got.reflectance, want.reflectance);
+  EXPECT_EQ(got.emission, want.emission);
+  EXPECT_EQ(got.eta, want.eta);
+  EXPECT_EQ(got.k, want.k);
+  EXPECT_EQ(got.alphaX, want.alphaX);
+  EXPECT_EQ(got.alphaY, want.alphaY);
+  EXPECT_EQ(got.transmittance, want.transmittance);
+  EXPECT_EQ(got.thickness, want.thickness);
+  EXPECT_EQ(got.g, want.g);
+  EXPECT_EQ(got.maxDepth, want.maxDepth);
+  EXPECT_EQ(got.nSamples, want.nSamples);
+  EXPECT_EQ(got.reserved, 0u);
+  EXPECT_EQ(got.reserved1, 0u);
+}
+
+// pbrt-v4's default copper, as RGB (docs/scene-format.md).
+const vec3 kCopperEta(0.200438f, 0.924033f, 1.10221f);
+const vec3 kCopperK(3.91295f, 2.45285f, 2.14219f);
+
+TEST(SceneMaterials, EveryTypeWithItsDefaults) {
+  TempDir dir;
+  const std::vector<Material> m = loadMaterials(dir, R"([
+      {"name": "d"}, {"name": "m", "type": "mirror"}, {"name": "c", "type": "conductor"},
+      {"name": "g", "type": "dielectric"}, {"name": "t", "type": "thindielectric"},
+      {"name": "s", "type": "diffusetransmission"}, {"name": "p", "type": "coateddiffuse"}])");
+  ASSERT_EQ(m.size(), 7u);
+  Material want{};
+  want.type = kMaterialDiffuse;
+  want.reflectance = vec3(0.8f);
+  expectMaterial(m[0], want, "diffuse");
+  want = Material{};
+  want.type = kMaterialMirror;
+  want.reflectance = vec3(1.0f);
+  expectMaterial(m[1], want, "mirror");
+  want = Material{};
+  want.type = kMaterialConductor;  // smooth copper
+  want.eta = kCopperEta;
+  want.k = kCopperK;
+  expectMaterial(m[2], want, "conductor");
+  want = Material{};
+  want.type = kMaterialDielectric;  // smooth, index 1.5 in eta.x
+  want.eta = vec3(1.5f, 0.0f, 0.0f);
+  expectMaterial(m[3], want, "dielectric");
+  want.type = kMaterialThinDielectric;
+  expectMaterial(m[4], want, "thindielectric");
+  want = Material{};
+  want.type = kMaterialDiffuseTransmission;
+  want.reflectance = vec3(0.25f);
+  want.transmittance = vec3(0.25f);
+  expectMaterial(m[5], want, "diffusetransmission");
+  want = Material{};
+  want.type = kMaterialCoatedDiffuse;
+  want.reflectance = vec3(0.5f);
+  want.eta = vec3(1.5f, 0.0f, 0.0f);
+  want.thickness = 0.01f;
+  want.maxDepth = 10;
+  want.nSamples = 1;
+  expectMaterial(m[6], want, "coateddiffuse");
+  // The public defaults are the same.
+  for (const Material& material : m) {
+    expectMaterial(material, defaultMaterial(material.type), "defaultMaterial");
+  }
+}
+
+TEST(SceneMaterials, ConductorParameters) {
+  TempDir dir;
+  const std::vector<Material> m = loadMaterials(dir, R"([
+      {"name": "gold", "type": "conductor", "eta": [0.143119, 0.374957, 1.44248],
+       "k": [3.98316, 2.38572, 1.60322], "roughness": 0.04, "emission": [1, 2, 3]},
+      {"name": "grey", "type": "conductor", "eta": 1.5, "k": 0, "uroughness": 0.25,
+       "vroughness": 0.01},
+      {"name": "raw", "type": "conductor", "roughness": 0.3, "uroughness": 0.2,
+       "remaproughness": false},
+      {"name": "etaOnly", "type": "conductor", "eta": 2},
+      {"name": "refl", "type": "conductor", "reflectance": [0, 0.5, 1], "roughness": 0.09}])");
+  Material want{};
+  want.type = kMaterialConductor;
+  want.eta = vec3(0.143119f, 0.374957f, 1.44248f);
+  want.k = vec3(3.98316f, 2.38572f, 1.60322f);
+  want.alphaX = want.alphaY = 0.2f;  // remapped: sqrt(0.04)
+  want.emission = vec3(1, 2, 3);
+  expectMaterial(m[0], want, "gold");
+  want = Material{};
+  want.type = kMaterialConductor;
+  want.eta = vec3(1.5f);  // one number: all three channels
+  want.k = vec3(0.0f);
+  want.alphaX = 0.5f;  // uroughness 0.25
+  want.alphaY = 0.1f;  // vroughness 0.01
+  expectMaterial(m[1], want, "grey");
+  // Without remapping the values are the alphas; uroughness wins over roughness for u only.
+  want = defaultMaterial(kMaterialConductor);
+  want.alphaX = 0.2f;
+  want.alphaY = 0.3f;
+  expectMaterial(m[2], want, "raw");
+  // eta alone keeps pbrt-v4's default copper k.
+  want = defaultMaterial(kMaterialConductor);
+  want.eta = vec3(2.0f);
+  expectMaterial(m[3], want, "etaOnly");
+  // pbrt-v4's reflectance rule: eta 1, k = 2 sqrt(r) / sqrt(1 - r), r clamped to 0.9999.
+  want = Material{};
+  want.type = kMaterialConductor;
+  want.eta = vec3(1.0f);
+  want.k = vec3(0.0f, float(2.0 * std::sqrt(0.5) / std::sqrt(0.5)),
+                float(2.0 * std::sqrt(0.9999) / std::sqrt(1.0 - 0.9999)));
+  want.alphaX = want.alphaY = std::sqrt(0.09f);
+  expectMaterial(m[4], want, "reflectance");
+  EXPECT_FLOAT_EQ(m[4].k.y, 2.0f);
+  EXPECT_NEAR(m[4].k.z, 199.99f, 0.01f);
+}
+
+TEST(SceneMaterials, DielectricParameters) {
+  TempDir dir;
+  const std::vector<Material> m = loadMaterials(dir, R"([
+      {"name": "glass", "type": "dielectric", "eta": 1.33, "roughness": 0.01},
+      {"name": "frosted", "type": "dielectric", "uroughness": 0.5, "vroughness": 0.3,
+       "remaproughness": false, "eta": 0.8},
+      {"name": "pane", "type": "thindielectric", "eta": 1.2, "emission": [0, 0, 4]}])");
+  Material want{};
+  want.type = kMaterialDielectric;
+  want.eta = vec3(1.33f, 0.0f, 0.0f);
+  want.alphaX = want.alphaY = 0.1f;
+  expectMaterial(m[0], want, "glass");
+  want.eta = vec3(0.8f, 0.0f, 0.0f);
+  want.alphaX = 0.5f;
+  want.alphaY = 0.3f;
+  expectMaterial(m[1], want, "frosted");
+  want = Material{};
+  want.type = kMaterialThinDielectric;
+  want.eta = vec3(1.2f, 0.0f, 0.0f);
+  want.emission = vec3(0, 0, 4);
+  expectMaterial(m[2], want, "pane");
+}
+
+TEST(SceneMaterials, DiffuseTransmissionParameters) {
+  TempDir dir;
+  const std::vector<Material> m = loadMaterials(dir, R"([
+      {"name": "leaf", "type": "diffusetransmission", "reflectance": [0.1, 0.5, 0.2],
+       "transmittance": [0.2, 0.6, 0.1]},
+      {"name": "scaled", "type": "diffusetransmission", "reflectance": [0.1, 0.5, 0.2],
+       "transmittance": [0.2, 0.6, 0.1], "scale": 2},
+      {"name": "dflt", "type": "diffusetransmission", "scale": 0.5}])");
+  Material want{};
+  want.type = kMaterialDiffuseTransmission;
+  want.reflectance = vec3(0.1f, 0.5f, 0.2f);
+  want.transmittance = vec3(0.2f, 0.6f, 0.1f);
+  expectMaterial(m[0], want, "leaf");
+  // pbrt-v4 multiplies both by scale and clamps to [0, 1].
+  want.reflectance = vec3(0.2f, 1.0f, 0.4f);
+  want.transmittance = vec3(0.4f, 1.0f, 0.2f);
+  expectMaterial(m[1], want, "scaled");
+  want.reflectance = want.transmittance = vec3(0.125f);
+  expectMaterial(m[2], want, "dflt");
+}
+
+TEST(SceneMaterials, CoatedDiffuseParameters) {
+  TempDir dir;
+  const std::vector<Material> m = loadMaterials(dir, R"([
+      {"name": "wood", "type": "coateddiffuse", "reflectance": [0.3, 0.2, 0.1],
+       "roughness": 0.0625, "thickness": 0.1, "eta": 1.33, "albedo": [0.5, 0.25, 0],
+       "g": -0.5, "maxdepth": 20, "nsamples": 4, "emission": [1, 1, 1]},
+      {"name": "aniso", "type": "coateddiffuse", "uroughness": 0.01, "vroughness": 0.04,
+       "remaproughness": false, "maxdepth": 1000.0, "nsamples": 1}])");
+  Material want{};
+  want.type = kMaterialCoatedDiffuse;
+  want.reflectance = vec3(0.3f, 0.2f, 0.1f);
+  want.alphaX = want.alphaY = 0.25f;
+  want.thickness = 0.1f;
+  want.eta = vec3(1.33f, 0.0f, 0.0f);
+  want.transmittance = vec3(0.5f, 0.25f, 0.0f);  // the medium's albedo
+  want.g = -0.5f;
+  want.maxDepth = 20;
+  want.nSamples = 4;
+  want.emission = vec3(1.0f);
+  expectMaterial(m[0], want, "wood");
+  want = defaultMaterial(kMaterialCoatedDiffuse);
+  want.alphaX = 0.01f;
+  want.alphaY = 0.04f;
+  want.maxDepth = 1000;
+  expectMaterial(m[1], want, "aniso");
+}
+
+TEST(SceneMaterials, BadParametersOfTheNewTypes) {
+  TempDir dir;
+  // One material of the given JSON object text, and its error.
+  const auto withMaterial = [&](const std::string& material) {
+    return errorFor(dir, sceneJson("[" + material + "]", kUnitQuad));
+  };
+  const std::string file = (dir.path() / "scene.json").string();
+  // A key of another type: named with the type and what it takes.
+  EXPECT_EQ(withMaterial(R"({"name": "white", "type": "dielectric", "k": 1})"),
+            file +
+                ": materials[0].k: not a parameter of 'dielectric' (a 'dielectric' material "
+                "takes 'eta', 'roughness', 'uroughness', 'vroughness', 'remaproughness' and "
+                "'emission')");
+  EXPECT_EQ(withMaterial(R"({"name": "white", "roughness": 0.1})"),
+            file +
+                ": materials[0].roughness: not a parameter of 'diffuse' (a 'diffuse' material "
+                "takes 'reflectance' and 'emission')");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "mirror", "eta": 1.5})"),
+                  "materials[0].eta: not a parameter of 'mirror'");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "thindielectric", "roughness": 0})"),
+                  "materials[0].roughness: not a parameter of 'thindielectric' (a "
+                  "'thindielectric' material takes 'eta' and 'emission')");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "conductor", "albedo": [0, 0, 0]})"),
+                  "materials[0].albedo: not a parameter of 'conductor'");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "diffusetransmission", "g": 0})"),
+                  "materials[0].g: not a parameter of 'diffusetransmission'");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "coateddiffuse", "scale": 1})"),
+                  "materials[0].scale: not a parameter of 'coateddiffuse'");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "coateddiffuse", "k": [1, 1, 1]})"),
+                  "materials[0].k: not a parameter of 'coateddiffuse'");
+  // A key no type takes: unknown, with a suggestion among the type's keys.
+  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "dielectric", "rougness": 0.1})"),
+                  "materials[0].rougness: unknown key (did you mean 'roughness'?)");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "conductor", "displacement": 1})"),
+                  "materials[0].displacement: unknown key (expected 'name', 'type', 'eta', 'k', "
+                  "'reflectance', 'roughness', 'uroughness', 'vroughness', 'remaproughness' or "
+                  "'emission')");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "metal"})"),
+                  "materials[0].type: unknown material type 'metal' (expected 'diffuse', "
+                  "'mirror', 'conductor', 'dielectric', 'thindielectric', 'diffusetransmission' "
+                  "or 'coateddiffuse')");
+
+  // Conductor: reflectance or eta and k, not both (pbrt-v4's rule).
+  EXPECT_EQ(withMaterial(R"({"name": "w", "type": "conductor", "reflectance": [1, 1, 1],
+                             "eta": 1.5})"),
+            file +
+                ": materials[0].reflectance: a conductor takes either 'reflectance' or 'eta' "
+                "and 'k', not both (as in pbrt-v4); this one also has 'eta'");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "reflectance": [1, 1, 1],
+                                   "k": [1, 2, 3]})"),
+                  "materials[0].reflectance: a conductor takes either 'reflectance' or 'eta' and "
+                  "'k', not both (as in pbrt-v4); this one also has 'k'");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "reflectance": [1, 1.5, 1]})"),
+                  "materials[0].reflectance[1]: expected a number in [0, 1], got the number 1.5");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "eta": [1, 0, 1]})"),
+                  "materials[0].eta[1]: expected a positive number, got the number 0");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "eta": 1e-50})"),
+                  "materials[0].eta: expected a positive number, got the number 1e-50");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "k": -1})"),
+                  "materials[0].k: expected a non-negative number, got the number -1");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "k": [1, 2]})"),
+                  "materials[0].k: expected a number or an array of 3 numbers, got an array of 2 "
+                  "elements");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "k": "gold"})"),
+                  "materials[0].k: expected a number or an array of 3 numbers, got the string "
+                  "'gold'");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "eta": [1, 1e300, 1]})"),
+                  "materials[0].eta[1]: number 1e+300 is too large");
+  // Roughness.
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "roughness": -0.1})"),
+                  "materials[0].roughness: expected a non-negative number, got the number -0.1");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "dielectric", "vroughness": -1})"),
+                  "materials[0].vroughness: expected a non-negative number");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "coateddiffuse", "uroughness": 1e39})"),
+                  "materials[0].uroughness: number 1e+39 is too large");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "dielectric", "remaproughness": 1})"),
+                  "materials[0].remaproughness: expected true or false, got a number");
+  // Indices of refraction.
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "dielectric", "eta": 0})"),
+                  "materials[0].eta: expected a positive number, got the number 0");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "dielectric", "eta": [1.5, 1.5, 1.5]})"),
+                  "materials[0].eta: expected a number, got an array");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "thindielectric", "eta": -1.5})"),
+                  "materials[0].eta: expected a positive number, got the number -1.5");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "coateddiffuse", "eta": 0})"),
+                  "materials[0].eta: expected a positive number");
+  // Diffuse transmission.
+  EXPECT_CONTAINS(
+      withMaterial(R"({"name": "w", "type": "diffusetransmission", "transmittance": [2, 0, 0]})"),
+      "materials[0].transmittance[0]: expected a number in [0, 1], got the number 2");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "diffusetransmission", "scale": -1})"),
+                  "materials[0].scale: expected a non-negative number, got the number -1");
+  // Coated diffuse.
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "coateddiffuse", "thickness": 0})"),
+                  "materials[0].thickness: expected a positive number, got the number 0");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "coateddiffuse", "albedo": [0, 0, 1.1]})"),
+                  "materials[0].albedo[2]: expected a number in [0, 1], got the number 1.1");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "coateddiffuse", "g": 1})"),
+                  "materials[0].g: expected a number strictly between -1 and 1, got the number 1");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "coateddiffuse", "g": -1})"),
+                  "materials[0].g: expected a number strictly between -1 and 1");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "coateddiffuse", "maxdepth": 0})"),
+                  "materials[0].maxdepth: expected an integer in [1, 1000], got the number 0");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "coateddiffuse", "nsamples": 1.5})"),
+                  "materials[0].nsamples: expected an integer in [1, 1000], got the number 1.5");
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "coateddiffuse", "nsamples": 1001})"),
+                  "materials[0].nsamples: expected an integer in [1, 1000], got the number 1001");
+  // Emission stays allowed, and checked, on every type.
+  EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "dielectric", "emission": [0, -1, 0]})"),
+                  "materials[0].emission[1]: expected a non-negative number");
+}
+
+// The example scenes of the new materials load, with the materials they describe.
+TEST(SceneMaterials, ExampleScenesLoad) {
+  const Scene cornell = loadScene(test::kConfigs / "cornell-materials.json");
+  EXPECT_TRUE(cornell.warnings.empty());
+  ASSERT_EQ(cornell.triangles.size(), 32u);
+  std::vector<uint> types;
+  for (const Triangle& t : cornell.triangles) types.push_back(cornell.materials[t.material].type);
+  EXPECT_EQ(std::count(types.begin(), types.end(), kMaterialConductor), 10);   // tall block
+  EXPECT_EQ(std::count(types.begin(), types.end(), kMaterialDielectric), 10);  // short block
+  for (const Material& m : cornell.materials) {
+    if (m.type == kMaterialConductor) EXPECT_FLOAT_EQ(m.alphaX, std::sqrt(0.1f));
+    if (m.type == kMaterialDielectric) EXPECT_EQ(m.eta.x, 1.5f);
+  }
+
+  // Four plates of increasing alpha; four spherical lights of equal power (radiance times
+  // area), over a floor, a back wall and a dim fill.
+  const Scene veach = loadScene(test::kConfigs / "veach-mis.json");
+  EXPECT_TRUE(veach.warnings.empty());
+  std::vector<float> alphas;
+  for (const Material& m : veach.materials) {
+    if (m.type == kMaterialConductor) alphas.push_back(m.alphaX);
+  }
+  EXPECT_EQ(alphas, (std::vector<float>{0.005f, 0.02f, 0.05f, 0.1f}));
+  std::map<uint, double> power;  // per emissive material: emission.x times its area
+  for (const Triangle& t : veach.triangles) {
+    const Material& m = veach.materials[t.material];
+    if (m.emission.x == 0.0f) continue;
+    const double area =
+        0.5 * glm::length(glm::cross(glm::dvec3(t.v1 - t.v0), glm::dvec3(t.v2 - t.v0)));
+    power[t.material] += area * m.emission.x;
+  }
+  ASSERT_EQ(power.size(), 5u);  // the four lights and the fill
+  std::vector<double> lights;
+  for (const auto& [material, p] : power) {
+    if (veach.materialNames[material].rfind("light", 0) == 0) lights.push_back(p);
+  }
+  ASSERT_EQ(lights.size(), 4u);
+  for (const double p : lights) EXPECT_NEAR(p / lights[0], 1.0, 1e-3);
+}
+
 // ---- shapes -----------------------------------------------------------------------------
 
 TEST(SceneShapes, BadShapes) {
@@ -657,13 +1005,13 @@ TEST(SceneObj, LargePolygonIsFanned) {
 
 // ---- robustness -------------------------------------------------------------------------
 
-// Replaces every value of the valid scene, one at a time, by values of every JSON type and
+// Replaces every value of the scene `base`, one at a time, by values of every JSON type and
 // some awkward numbers: each variant must load or throw InputError with a one-line message
 // that starts with the file name, and nothing else.
-TEST(SceneRobustness, EveryValueReplacedByEveryKind) {
+void replaceEveryValueByEveryKind(const fs::path& base) {
   TempDir dir;
   fs::copy(kData / "meshes", dir.path() / "meshes");
-  std::ifstream in(kData / "valid.json");
+  std::ifstream in(base);
   const nlohmann::json valid = nlohmann::json::parse(in);
 
   std::vector<nlohmann::json::json_pointer> pointers;
@@ -727,6 +1075,15 @@ TEST(SceneRobustness, EveryValueReplacedByEveryKind) {
   }
   EXPECT_GT(loaded, 0);
   EXPECT_GT(rejected, 0);
+}
+
+TEST(SceneRobustness, EveryValueReplacedByEveryKind) {
+  replaceEveryValueByEveryKind(kData / "valid.json");
+}
+
+// The same for every material type and parameter (the scene fuzzer's seed of them).
+TEST(SceneRobustness, EveryMaterialParameterReplacedByEveryKind) {
+  replaceEveryValueByEveryKind(fs::path(PT_SOURCE_DIR) / "fuzz/corpus/scene/materials.json");
 }
 
 }  // namespace

@@ -2,9 +2,11 @@
 // a flat triangle list, validating everything and naming the field of any error.
 #include "scene/scene.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <optional>
@@ -108,12 +110,210 @@ IntegratorSettings readIntegrator(const JsonNode& node) {
 
 // ---- materials --------------------------------------------------------------------------
 
+constexpr NameTable<uint, 7> kMaterialTypes{{
+    {"diffuse", kMaterialDiffuse, "Lambertian"},
+    {"mirror", kMaterialMirror, "ideal specular reflection"},
+    {"conductor", kMaterialConductor, "metal"},
+    {"dielectric", kMaterialDielectric, "glass"},
+    {"thindielectric", kMaterialThinDielectric, "a thin pane"},
+    {"diffusetransmission", kMaterialDiffuseTransmission, "Lambertian, both sides"},
+    {"coateddiffuse", kMaterialCoatedDiffuse, "varnish over a Lambertian base"},
+}};
+
+// The most random-walk steps or walks a coated material may ask for per evaluation: far more
+// than pbrt-v4's defaults (10 and 1) need, and small enough that one evaluation stays short.
+constexpr std::int64_t kMaxCoatedWalk = 1000;
+
+// The keys a material of `type` takes: name, type and emission for all, then pbrt-v4's names
+// of the type's parameters (docs/scene-format.md).
+std::vector<std::string_view> materialKeys(uint type) {
+  std::vector<std::string_view> keys = {"name", "type"};
+  const std::initializer_list<std::string_view> roughness = {"roughness", "uroughness",
+                                                             "vroughness", "remaproughness"};
+  switch (type) {
+    case kMaterialDiffuse:
+    case kMaterialMirror:
+      keys.push_back("reflectance");
+      break;
+    case kMaterialConductor:
+      keys.insert(keys.end(), {"eta", "k", "reflectance"});
+      keys.insert(keys.end(), roughness);
+      break;
+    case kMaterialDielectric:
+      keys.push_back("eta");
+      keys.insert(keys.end(), roughness);
+      break;
+    case kMaterialThinDielectric:
+      keys.push_back("eta");
+      break;
+    case kMaterialDiffuseTransmission:
+      keys.insert(keys.end(), {"reflectance", "transmittance", "scale"});
+      break;
+    case kMaterialCoatedDiffuse:
+      keys.push_back("reflectance");
+      keys.insert(keys.end(), roughness);
+      keys.insert(keys.end(), {"thickness", "eta", "albedo", "g", "maxdepth", "nsamples"});
+      break;
+    default:
+      PT_CHECK(false, "material type without a key list");
+  }
+  keys.push_back("emission");
+  return keys;
+}
+
+// Fails on a key the material's type does not take. A key that another type takes gets
+// "not a parameter of 'type'" and the type's list (the user has the right name for the wrong
+// type); any other key is unknown, with a suggestion among the type's keys.
+void checkMaterialKeys(const JsonNode& m, uint type) {
+  const std::vector<std::string_view> keys = materialKeys(type);
+  for (const auto& [key, value] : m.json().items()) {
+    if (std::find(keys.begin(), keys.end(), key) != keys.end()) continue;
+    bool otherType = false;
+    for (const NamedValue<uint>& t : kMaterialTypes) {
+      const std::vector<std::string_view> other = materialKeys(t.value);
+      otherType = otherType || std::find(other.begin(), other.end(), key) != other.end();
+    }
+    if (!otherType) continue;  // checkKeys below reports it
+    std::string list;
+    for (std::size_t i = 2; i < keys.size(); ++i) {  // past "name" and "type"
+      if (i > 2) list += i + 1 == keys.size() ? " and " : ", ";
+      list += "'" + std::string(keys[i]) + "'";
+    }
+    const std::string name = singleQuoted(nameOf(kMaterialTypes, type));
+    m.find(key)->fail("not a parameter of " + name + " (a " + name + " material takes " + list +
+                      ")");
+  }
+  m.checkKeys(keys);
+}
+
+// A number that fits a float, checked against its bounds after rounding to float (1e-50
+// rounds to 0, 0.99999999999 to 1). `bounds` names them for the message.
+float readBounded(const JsonNode& n, double lo, bool loOpen, double hi, bool hiOpen,
+                  const char* bounds) {
+  const double v = n.floatNumber();
+  const double rounded = static_cast<float>(v);
+  const bool aboveLo = loOpen ? rounded > lo : rounded >= lo;
+  const bool belowHi = hiOpen ? rounded < hi : rounded <= hi;
+  if (!(aboveLo && belowHi)) n.fail(std::string("expected ") + bounds + ", got " + n.describe());
+  return static_cast<float>(v);
+}
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+float readPositive(const JsonNode& n) {
+  return readBounded(n, 0.0, true, kInf, false, "a positive number");
+}
+float readNonNegative(const JsonNode& n) {
+  return readBounded(n, 0.0, false, kInf, false, "a non-negative number");
+}
+
+// A colour whose components are albedos (reflectances, transmittances) in [0, 1].
+glm::vec3 readAlbedo(const JsonNode& n) {
+  const glm::dvec3 r = n.vec3();
+  for (std::size_t c = 0; c < 3; ++c) {
+    if (!(r[c] >= 0.0 && r[c] <= 1.0)) {
+      n[c].fail("expected a number in [0, 1], got " + n[c].describe());
+    }
+  }
+  return glm::vec3(r);
+}
+
+// A conductor's eta or k: one number for all three channels, or one per channel (pbrt-v4
+// takes a spectrum; this RGB renderer a value per channel).
+glm::vec3 readPerChannel(const JsonNode& n, float (*read)(const JsonNode&)) {
+  if (n.json().is_number()) return glm::vec3(read(n));
+  if (!n.json().is_array() || n.size() != 3) {
+    n.fail("expected a number or an array of 3 numbers, got " + n.describe());
+  }
+  return glm::vec3(read(n[0]), read(n[1]), read(n[2]));
+}
+
+// "roughness", "uroughness", "vroughness" and "remaproughness" as pbrt-v4 reads them: each
+// of u and v defaults to "roughness" (0), and with remaproughness (the default) the values
+// are mapped to Trowbridge-Reitz alphas by RoughnessToAlpha, alpha = sqrt(roughness).
+void readRoughness(const JsonNode& m, Material& material) {
+  float roughness = 0.0f;
+  if (auto n = m.find("roughness")) roughness = readNonNegative(*n);
+  float u = roughness, v = roughness;
+  if (auto n = m.find("uroughness")) u = readNonNegative(*n);
+  if (auto n = m.find("vroughness")) v = readNonNegative(*n);
+  bool remap = true;
+  if (auto n = m.find("remaproughness")) remap = n->boolean();
+  material.alphaX = remap ? std::sqrt(u) : u;
+  material.alphaY = remap ? std::sqrt(v) : v;
+}
+
+// The parameters of `material.type` beyond emission, over the type's defaults.
+void readMaterialParameters(const JsonNode& m, Material& material) {
+  switch (material.type) {
+    case kMaterialDiffuse:
+    case kMaterialMirror:
+      if (auto n = m.find("reflectance")) material.reflectance = readAlbedo(*n);
+      break;
+    case kMaterialConductor: {
+      const std::optional<JsonNode> reflectance = m.find("reflectance");
+      const std::optional<JsonNode> eta = m.find("eta");
+      const std::optional<JsonNode> k = m.find("k");
+      if (reflectance && (eta || k)) {
+        reflectance->fail(std::string("a conductor takes either 'reflectance' or 'eta' and 'k', "
+                                      "not both (as in pbrt-v4); this one also has ") +
+                          (eta ? "'eta'" : "'k'"));
+      }
+      // One of eta and k alone keeps the other's default (copper), as in pbrt-v4.
+      if (reflectance) setConductorReflectance(material, readAlbedo(*reflectance));
+      if (eta) material.eta = readPerChannel(*eta, readPositive);
+      if (k) material.k = readPerChannel(*k, readNonNegative);
+      readRoughness(m, material);
+      break;
+    }
+    case kMaterialDielectric:
+    case kMaterialThinDielectric:
+      // A single index: pbrt-v4's dielectrics refract all wavelengths alike unless eta is a
+      // spectrum, and this renderer has no wavelengths to disperse.
+      if (auto n = m.find("eta")) material.eta = glm::vec3(readPositive(*n), 0.0f, 0.0f);
+      if (material.type == kMaterialDielectric) readRoughness(m, material);
+      break;
+    case kMaterialDiffuseTransmission: {
+      if (auto n = m.find("reflectance")) material.reflectance = readAlbedo(*n);
+      if (auto n = m.find("transmittance")) material.transmittance = readAlbedo(*n);
+      if (auto n = m.find("scale")) {
+        // pbrt-v4 scales both colours and clamps the products to [0, 1].
+        const float scale = readNonNegative(*n);
+        material.reflectance = glm::clamp(material.reflectance * scale, 0.0f, 1.0f);
+        material.transmittance = glm::clamp(material.transmittance * scale, 0.0f, 1.0f);
+      }
+      break;
+    }
+    case kMaterialCoatedDiffuse:
+      if (auto n = m.find("reflectance")) material.reflectance = readAlbedo(*n);
+      readRoughness(m, material);
+      if (auto n = m.find("thickness")) material.thickness = readPositive(*n);
+      if (auto n = m.find("eta")) material.eta = glm::vec3(readPositive(*n), 0.0f, 0.0f);
+      if (auto n = m.find("albedo")) material.transmittance = readAlbedo(*n);
+      if (auto n = m.find("g")) {
+        material.g = readBounded(*n, -1.0, true, 1.0, true, "a number strictly between -1 and 1");
+      }
+      if (auto n = m.find("maxdepth")) {
+        material.maxDepth = static_cast<uint>(n->integer(1, kMaxCoatedWalk));
+      }
+      if (auto n = m.find("nsamples")) {
+        material.nSamples = static_cast<uint>(n->integer(1, kMaxCoatedWalk));
+      }
+      break;
+    default:
+      PT_CHECK(false, "material type without a reader");
+  }
+}
+
 void readMaterials(const JsonNode& node, Scene& scene) {
   if (node.size() == 0) node.fail("expected at least one material");
   std::unordered_map<std::string, std::size_t> firstIndex;
   for (std::size_t i = 0; i < node.size(); ++i) {
     const JsonNode m = node[i];
-    m.checkKeys({"name", "type", "reflectance", "emission"});
+    // The type first: it decides which keys are allowed.
+    uint type = kMaterialDiffuse;
+    if (auto n = m.find("type")) type = readChoice(*n, kMaterialTypes, "material type");
+    checkMaterialKeys(m, type);
     const JsonNode nameNode = m.require("name");
     const std::string name = nameNode.string();
     if (name.empty()) nameNode.fail("must not be empty");
@@ -122,26 +322,8 @@ void readMaterials(const JsonNode& node, Scene& scene) {
                     std::to_string(it->second) + "])");
     }
 
-    Material material{};
-    material.type = kMaterialDiffuse;
-    if (auto n = m.find("type")) {
-      static constexpr NameTable<uint, 2> kTypes{{
-          {"diffuse", kMaterialDiffuse, "Lambertian"},
-          {"mirror", kMaterialMirror, "ideal specular reflection"},
-      }};
-      material.type = readChoice(*n, kTypes, "material type");
-    }
-    material.reflectance = material.type == kMaterialMirror ? glm::vec3(1.0f) : glm::vec3(0.8f);
-    if (auto n = m.find("reflectance")) {
-      const glm::dvec3 r = n->vec3();
-      for (std::size_t c = 0; c < 3; ++c) {
-        if (!(r[c] >= 0.0 && r[c] <= 1.0)) {
-          (*n)[c].fail("expected a number in [0, 1], got " + (*n)[c].describe());
-        }
-      }
-      material.reflectance = glm::vec3(r);
-    }
-    material.emission = glm::vec3(0.0f);
+    Material material = defaultMaterial(type);
+    readMaterialParameters(m, material);
     if (auto n = m.find("emission")) {
       const glm::dvec3 e = n->vec3();
       for (std::size_t c = 0; c < 3; ++c) {
@@ -151,7 +333,6 @@ void readMaterials(const JsonNode& node, Scene& scene) {
       }
       material.emission = glm::vec3(e);
     }
-    material.reserved = 0;
     scene.materials.push_back(material);
     scene.materialNames.push_back(name);
   }
@@ -530,6 +711,52 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
 }
 
 }  // namespace
+
+Material defaultMaterial(uint type) {
+  Material m{};  // every field a type does not use stays zero
+  m.type = type;
+  switch (type) {
+    case kMaterialDiffuse:
+      m.reflectance = vec3(0.8f);
+      break;
+    case kMaterialMirror:
+      m.reflectance = vec3(1.0f);
+      break;
+    case kMaterialConductor:
+      // pbrt-v4's default is copper ("metal-Cu-eta", "metal-Cu-k"): these are RGB
+      // approximations of those spectra.
+      m.eta = vec3(0.200438f, 0.924033f, 1.10221f);
+      m.k = vec3(3.91295f, 2.45285f, 2.14219f);
+      break;
+    case kMaterialDielectric:
+    case kMaterialThinDielectric:
+      m.eta = vec3(1.5f, 0.0f, 0.0f);
+      break;
+    case kMaterialDiffuseTransmission:
+      m.reflectance = vec3(0.25f);
+      m.transmittance = vec3(0.25f);
+      break;
+    case kMaterialCoatedDiffuse:
+      m.reflectance = vec3(0.5f);
+      m.eta = vec3(1.5f, 0.0f, 0.0f);
+      m.thickness = 0.01f;
+      m.maxDepth = 10;
+      m.nSamples = 1;
+      break;
+    default:
+      PT_CHECK(false, "unknown material type");
+  }
+  return m;
+}
+
+void setConductorReflectance(Material& material, vec3 reflectance) {
+  material.eta = vec3(1.0f);
+  for (int c = 0; c < 3; ++c) {
+    // Clamped below 1 so that a white reflectance gives a large finite k (pbrt-v4's rule).
+    const double r = std::clamp(static_cast<double>(reflectance[c]), 0.0, 0.9999);
+    material.k[c] = static_cast<float>(2.0 * std::sqrt(r) / std::sqrt(1.0 - r));
+  }
+}
 
 Scene loadScene(const std::filesystem::path& path) {
   const std::string file = path.string();

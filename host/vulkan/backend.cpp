@@ -13,6 +13,7 @@
 #include "common/check.h"
 #include "pathtrace_debug_spv.h"  // kPathtraceDebugSpv: the same shader with debugPrintfEXT
 #include "pathtrace_spv.h"        // kPathtraceSpv: SPIR-V compiled at build time
+#include "pathtrace_base_spv.h"   // kPathtraceBaseSpv: the same without bsdf.h's materials
 #include "vulkan/context.h"
 #include "vulkan/gpu_bvh.h"
 #include "vulkan/resources.h"
@@ -123,9 +124,13 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   for (size_t i = 0; i < buffers.bound.size(); ++i) {
     bound.push_back(Binding{&buffers.bound[i], buffers.texels[i]});
   }
-  const std::span<const uint32_t> spirv = options.context.debugPrintf
-                                              ? std::span<const uint32_t>(kPathtraceDebugSpv)
-                                              : std::span<const uint32_t>(kPathtraceSpv);
+  // The variant without bsdf.h's materials where the scene needs none of them (the same
+  // image: it is the full shader with those effects switched off before compiling).
+  const bool full = all || fx.hasBsdfMaterials() || fx.shadingNormals;
+  const std::span<const uint32_t> spirv =
+      options.context.debugPrintf ? std::span<const uint32_t>(kPathtraceDebugSpv)
+      : full                      ? std::span<const uint32_t>(kPathtraceSpv)
+                                  : std::span<const uint32_t>(kPathtraceBaseSpv);
   return makeComputeProgram(ctx, spirv, bound, sizeof(PassConstants), &specInfo);
 }
 
@@ -417,12 +422,15 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
 }
 
 KeyValues vulkanImageSettings(const VulkanRenderOptions& options) {
+  // The shaders this build may run (which variant a scene takes follows from the scene).
   const std::span<const uint32_t> spirv = options.context.debugPrintf
                                               ? std::span<const uint32_t>(kPathtraceDebugSpv)
                                               : std::span<const uint32_t>(kPathtraceSpv);
+  const std::span<const uint32_t> base(kPathtraceBaseSpv);
   return {{"samples_per_fold", std::to_string(vulkanBatchSize(options))},
           {"specialize", options.specialize ? "on" : "off"},
-          {"shader", hexHash(hashBytes(spirv.data(), spirv.size_bytes()))}};
+          {"shader", hexHash(hashBytes(spirv.data(), spirv.size_bytes(),
+                                       hashBytes(base.data(), base.size_bytes())))}};
 }
 
 uint32_t vulkanBatchSize(const VulkanRenderOptions& options) {
