@@ -283,6 +283,17 @@ TEST(MaterialsShadingNormals, SmoothSphereAgreesAndDiffersFromFlat) {
   EXPECT_GT(diffImages(a.cpuImage, b.cpuImage, 1e-3).pixelsOverThreshold, 10u);
 }
 
+// The example scenes with these materials, on both backends.
+TEST(MaterialsExamples, AgreeOnBothBackends) {
+  for (const char* config : {"cornell-materials.json", "veach-mis.json"}) {
+    SCOPED_TRACE(config);
+    const SceneData data = prepareScene(loadScene(test::kConfigs / config),
+                                        RenderSettings{.width = 48, .height = 32});
+    EXPECT_TRUE(data.effects.conductor);
+    expectAgreement(renderBoth(data, 8));
+  }
+}
+
 TEST(Materials, DiffuseOnlySceneUsesNone) {
   const SceneData data = prepareScene(loadScene(test::kConfigs / "cornell-box.json"),
                                       RenderSettings{.width = 16, .height = 16});
