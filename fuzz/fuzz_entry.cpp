@@ -3,6 +3,7 @@
 // in a directory of this process's own.
 #include "fuzz/fuzz_entry.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -72,6 +73,20 @@ std::string text(const std::uint8_t* data, std::size_t size) {
   return std::string(reinterpret_cast<const char*>(data), size);
 }
 
+// What the mesh readers promise of an accepted file's normals: none, or one finite triple
+// per triangle. A broken promise is a finding (PT_CHECK exits, which libFuzzer reports).
+template <typename Mesh>
+void checkNormals(const Mesh& mesh) {
+  PT_CHECK(mesh.normals.empty() || mesh.normals.size() == mesh.triangles.size(),
+           "mesh normals not parallel to its triangles");
+  for (const auto& triple : mesh.normals) {
+    for (const auto& n : triple) {
+      PT_CHECK(std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z),
+               "non-finite mesh normal accepted");
+    }
+  }
+}
+
 }  // namespace
 
 Outcome fuzzScene(const std::uint8_t* data, std::size_t size) {
@@ -81,7 +96,8 @@ Outcome fuzzScene(const std::uint8_t* data, std::size_t size) {
 }
 
 Outcome fuzzObj(const std::uint8_t* data, std::size_t size) {
-  return guarded([&] { scene_detail::loadObjMesh(text(data, size), "fuzz.obj", ""); });
+  return guarded(
+      [&] { checkNormals(scene_detail::loadObjMesh(text(data, size), "fuzz.obj", "")); });
 }
 
 Outcome fuzzMtl(const std::uint8_t* data, std::size_t size) {
@@ -89,7 +105,8 @@ Outcome fuzzMtl(const std::uint8_t* data, std::size_t size) {
 }
 
 Outcome fuzzPly(const std::uint8_t* data, std::size_t size) {
-  return guarded([&] { scene_detail::loadPlyTriangles(text(data, size), "fuzz.ply", ""); });
+  return guarded(
+      [&] { checkNormals(scene_detail::loadPlyMesh(text(data, size), "fuzz.ply", "")); });
 }
 
 // The format is chosen by the magic number, as a user's misnamed file would not be: each

@@ -14,9 +14,9 @@ namespace pt::fuzz {
 enum class Outcome { kAccepted, kInputError };
 
 Outcome fuzzScene(const std::uint8_t* data, std::size_t size);  // JSON beside fixed meshes
-Outcome fuzzObj(const std::uint8_t* data, std::size_t size);    // loadObjMesh
+Outcome fuzzObj(const std::uint8_t* data, std::size_t size);    // loadObjMesh, its normals checked
 Outcome fuzzMtl(const std::uint8_t* data, std::size_t size);    // loadMtlMaterials
-Outcome fuzzPly(const std::uint8_t* data, std::size_t size);    // loadPlyTriangles
+Outcome fuzzPly(const std::uint8_t* data, std::size_t size);    // loadPlyMesh, its normals checked
 Outcome fuzzImage(const std::uint8_t* data, std::size_t size);  // readImage: EXR, PFM, PNG
 
 struct Target {

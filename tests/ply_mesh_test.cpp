@@ -1,6 +1,7 @@
 // Tests of the PLY reader (host/scene/ply_mesh): one mesh in many layouts and all three
-// formats gives exactly the OBJ reader's triangles; every kind of malformed file gives its
-// one-line message; no truncation or corruption of a file crashes the reader.
+// formats gives exactly the OBJ reader's triangles; vertex normals follow the triangles;
+// every kind of malformed file gives its one-line message; no truncation or corruption of a
+// file crashes the reader.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,7 +24,9 @@ namespace pt {
 namespace {
 
 using scene_detail::loadObjTriangles;
+using scene_detail::loadPlyMesh;
 using scene_detail::loadPlyTriangles;
+using scene_detail::PlyMesh;
 using Triangles = std::vector<std::array<glm::dvec3, 3>>;
 
 const std::string kContext = " (referenced by scene.json: shapes[0].file)";
@@ -236,9 +239,19 @@ TEST(PlyMesh, EveryFormatAndLayoutGivesTheObjTriangles) {
   for (const Layout& layout : kLayouts) {
     for (const std::string& format : kFormats) {
       SCOPED_TRACE(format + ", " + describe(layout));
-      const Triangles ply =
-          loadPlyTriangles(plyFile(format, meshElements(layout)), "mesh.ply", kContext);
-      EXPECT_TRUE(ply == obj);
+      const PlyMesh ply = loadPlyMesh(plyFile(format, meshElements(layout)), "mesh.ply", kContext);
+      EXPECT_TRUE(ply.triangles == obj);
+      // The extras include normals, all (0, 0, 1).
+      if (layout.extras) {
+        ASSERT_EQ(ply.normals.size(), obj.size());
+        for (const auto& triple : ply.normals) {
+          for (const glm::dvec3& n : triple) EXPECT_EQ(n, glm::dvec3(0, 0, 1));
+        }
+      } else {
+        EXPECT_TRUE(ply.normals.empty());
+      }
+      EXPECT_TRUE(loadPlyTriangles(plyFile(format, meshElements(layout)), "mesh.ply", kContext) ==
+                  obj);
     }
   }
 }
@@ -312,6 +325,120 @@ TEST(PlyMesh, TristripsAreAccepted) {
         EXPECT_EQ(t[i][k], kVertices[static_cast<std::size_t>(expected[i][k])]) << i << " " << k;
       }
     }
+  }
+}
+
+// ---- Vertex normals ----
+
+// A normal per vertex of kVertices, distinct, exact in a float, and not of unit length (the
+// reader keeps them as read).
+glm::dvec3 vertexNormal(std::size_t i) {
+  return {0.25 * double(i), -0.5, 1.0 + double(i)};
+}
+
+// The vertex element with normals: the components among the coordinates and out of order,
+// each of `type`; with `list`, a list property too (binary: entries of varying size).
+Elem normalVertices(const std::string& type, bool list) {
+  Elem vertex{"vertex",
+              {{type, "nz", ""},
+               {type, "x", ""},
+               {"uchar", "flags", ""},
+               {type, "nx", ""},
+               {type, "y", ""},
+               {type, "z", ""},
+               {type, "ny", ""}},
+              {}};
+  if (list) vertex.props.push_back({"float", "uv", "uint8"});
+  for (std::size_t i = 0; i < kVertices.size(); ++i) {
+    const glm::dvec3& v = kVertices[i];
+    const glm::dvec3 n = vertexNormal(i);
+    std::vector<double> row = {n.z, v.x, double(i), n.x, v.y, v.z, n.y};
+    if (list) {
+      row.push_back(double(i % 3));
+      for (std::size_t k = 0; k < i % 3; ++k) row.push_back(0.5 * double(k));
+    }
+    vertex.rows.push_back(row);
+  }
+  return vertex;
+}
+
+// Checks triangle t of `mesh` against the vertex indices `expected`, points and normals.
+void expectTriangle(const PlyMesh& mesh, std::size_t t, const std::array<int, 3>& expected) {
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::size_t v = static_cast<std::size_t>(expected[k]);
+    EXPECT_EQ(mesh.triangles[t][k], kVertices[v]) << "triangle " << t << " vertex " << k;
+    EXPECT_EQ(mesh.normals[t][k], vertexNormal(v)) << "triangle " << t << " vertex " << k;
+  }
+}
+
+TEST(PlyMesh, NormalsFollowTheFannedPolygons) {
+  // kFaces fanned as (0, i, i + 1).
+  const std::vector<std::array<int, 3>> expected = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {1, 6, 2},
+                                                    {1, 2, 4}, {1, 4, 3}, {4, 5, 6}};
+  for (const std::string& format : kFormats) {
+    for (const std::string type : {"float", "double"}) {
+      for (const bool list : {false, true}) {
+        SCOPED_TRACE(format + ", " + type + (list ? ", vertex list" : ""));
+        std::vector<Elem> elements = meshElements(kLayouts[0]);
+        elements[0] = normalVertices(type, list);
+        const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "normals.ply", kContext);
+        ASSERT_EQ(mesh.triangles.size(), expected.size());
+        ASSERT_EQ(mesh.normals.size(), expected.size());
+        for (std::size_t t = 0; t < expected.size(); ++t) expectTriangle(mesh, t, expected[t]);
+      }
+    }
+  }
+}
+
+TEST(PlyMesh, NormalsFollowTheTristrips) {
+  std::vector<Elem> elements = meshElements(kLayouts[0]);
+  elements[0] = normalVertices("float", false);
+  elements[1] = {"tristrips",
+                 {{"int", "vertex_indices", "int"}},
+                 {{15, 0, 1, 2, 3, -1, 4, 5, 6, 3, -1, 0, 1, 1, 2, 3}}};
+  const std::vector<std::array<int, 3>> expected = {
+      {0, 1, 2}, {2, 1, 3}, {4, 5, 6}, {6, 5, 3}, {1, 2, 3}};
+  for (const std::string& format : kFormats) {
+    SCOPED_TRACE(format);
+    const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "strips.ply", kContext);
+    ASSERT_EQ(mesh.triangles.size(), expected.size());
+    ASSERT_EQ(mesh.normals.size(), expected.size());
+    for (std::size_t t = 0; t < expected.size(); ++t) expectTriangle(mesh, t, expected[t]);
+  }
+}
+
+TEST(PlyMesh, DoubleNormalsKeepTheirPrecision) {
+  for (const std::string& format : kFormats) {
+    for (const std::string type : {"float", "double"}) {
+      SCOPED_TRACE(format + " " + type);
+      const std::vector<Elem> elements = {
+          {"vertex",
+           {{"float", "x", ""},
+            {"float", "y", ""},
+            {"float", "z", ""},
+            {type, "nx", ""},
+            {type, "ny", ""},
+            {type, "nz", ""}},
+           {{0, 0, 0, 0.1, 0, 0}, {1, 0, 0, 0, 0, 0}, {0, 1, 0, 0, 0, 0.3}}},
+          {"face", {{"int", "vertex_indices", "uchar"}}, {{3, 0, 1, 2}}}};
+      const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "m.ply", kContext);
+      ASSERT_EQ(mesh.normals.size(), 1u);
+      const bool isDouble = type == "double";
+      EXPECT_EQ(mesh.normals[0][0].x, isDouble ? 0.1 : double(0.1f));
+      EXPECT_EQ(mesh.normals[0][2].z, isDouble ? 0.3 : double(0.3f));
+      // A zero normal is passed on as it is (the scene loader replaces it).
+      EXPECT_EQ(mesh.normals[0][1], glm::dvec3(0.0));
+    }
+  }
+}
+
+TEST(PlyMesh, FilesWithoutNormalsHaveNone) {
+  for (const std::string& format : kFormats) {
+    SCOPED_TRACE(format);
+    const PlyMesh mesh =
+        loadPlyMesh(plyFile(format, meshElements(kLayouts[0])), "plain.ply", kContext);
+    EXPECT_EQ(mesh.triangles.size(), 7u);
+    EXPECT_TRUE(mesh.normals.empty());
   }
 }
 
@@ -580,6 +707,70 @@ TEST(PlyMesh, TristripErrors) {
   EXPECT_PLY_ERROR(plyFile("ascii", elements), "bad.ply: no faces (the 'tristrips' element");
 }
 
+// Lines 1-12 the header, 13-15 the vertices, 16 the face.
+const std::string kNormalHeader =
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+    "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+const std::string kNormalAscii = kNormalHeader + "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n";
+
+TEST(PlyMesh, NormalErrors) {
+  ASSERT_EQ(loadPlyMesh(kNormalAscii, "good.ply", kContext).normals.size(), 1u);
+  // Only some of nx, ny, nz: the line of the first of them.
+  const std::string needAll = " (a vertex normal needs all of 'nx', 'ny' and 'nz')" + kContext;
+  EXPECT_EQ(plyError(replaced(replaced(kNormalAscii, "property float ny\n", ""),
+                              "property float nz\n", "")),
+            "bad.ply: line 7: vertex property 'nx' without 'ny' and 'nz'" + needAll);
+  EXPECT_EQ(plyError(replaced(kNormalAscii, "property float ny\n", "")),
+            "bad.ply: line 7: vertex properties 'nx' and 'nz' without 'ny'" + needAll);
+  EXPECT_EQ(plyError(replaced(kNormalAscii, "property float nx\n", "")),
+            "bad.ply: line 7: vertex properties 'ny' and 'nz' without 'nx'" + needAll);
+  EXPECT_EQ(plyError(replaced(kNormalAscii, "property float nx\nproperty float ny\n",
+                              "property float ny\nproperty float nn\n")),
+            "bad.ply: line 7: vertex properties 'ny' and 'nz' without 'nx'" + needAll);
+  // Types, duplicates.
+  EXPECT_EQ(
+      plyError(replaced(kNormalAscii, "property float ny", "property uchar ny")),
+      "bad.ply: line 8: vertex property 'ny' is 'uchar' (it must be float or double)" + kContext);
+  EXPECT_EQ(
+      plyError(replaced(kNormalAscii, "property float nz", "property list uchar float nz")),
+      "bad.ply: line 9: vertex property 'nz' is a list (it must be float or double)" + kContext);
+  EXPECT_EQ(plyError(replaced(kNormalAscii, "property float nz\n",
+                              "property float nz\nproperty double nx\n")),
+            "bad.ply: line 10: element 'vertex' already has a property 'nx' (line 7)" + kContext);
+  // Values (ascii).
+  EXPECT_EQ(plyError(replaced(kNormalAscii, "1 0 0 0 0 1\n", "1 0 0 0 nan 1\n")),
+            "bad.ply: vertex 1 (line 14): normal is not finite (ny = 'nan')" + kContext);
+  EXPECT_EQ(plyError(replaced(kNormalAscii, "0 1 0 0 0 1\n", "0 1 0 0 0 -inf\n")),
+            "bad.ply: vertex 2 (line 15): normal is not finite (nz = '-inf')" + kContext);
+  EXPECT_EQ(plyError(replaced(kNormalAscii, "0 0 0 0 0 1\n", "0 0 0 1e39 0 1\n")),
+            "bad.ply: vertex 0 (line 13): normal is too large for a 32-bit float (nx = '1e39')" +
+                kContext);
+  EXPECT_EQ(plyError(replaced(kNormalAscii, "1 0 0 0 0 1\n", "1 0 0 0 abc 1\n")),
+            "bad.ply: vertex 1 (line 14): normal ny 'abc' is not a number" + kContext);
+  // Values (binary), for entries of one size and, with a vertex list, of varying size.
+  for (const std::string& format : {kFormats[1], kFormats[2]}) {
+    for (const bool list : {false, true}) {
+      SCOPED_TRACE(format + (list ? ", vertex list" : ""));
+      std::vector<Elem> elements = meshElements(kLayouts[0]);
+      elements[0] = normalVertices("float", list);
+      // Properties: nz x flags nx y z ny.
+      elements[0].rows[3][6] = std::numeric_limits<double>::quiet_NaN();
+      EXPECT_EQ(plyError(plyFile(format, elements)),
+                "bad.ply: vertex 3: normal is not finite (ny = nan)" + kContext);
+      elements[0] = normalVertices("float", list);
+      elements[0].rows[5][0] = -std::numeric_limits<double>::infinity();
+      EXPECT_EQ(plyError(plyFile(format, elements)),
+                "bad.ply: vertex 5: normal is not finite (nz = inf)" + kContext);
+      elements[0] = normalVertices("double", list);
+      elements[0].rows[2][3] = 1e300;
+      EXPECT_EQ(
+          plyError(plyFile(format, elements)),
+          "bad.ply: vertex 2: normal is too large for a 32-bit float (nx = 1e+300)" + kContext);
+    }
+  }
+}
+
 TEST(PlyMesh, MessagesCarryTheContextAndEscapeControlCharacters) {
   const std::string message = plyError(replaced(kAscii, "1 0 0\n", "1 \x01\x02 0\n"));
   EXPECT_NE(message.find("coordinate y '\\x01\\x02' is not a number"), std::string::npos)
@@ -596,9 +787,13 @@ TEST(PlyMesh, TruncationsAndCorruptionsNeverCrash) {
     const std::size_t headerSize = plyHeader(format, meshElements(kLayouts[5])).size();
     auto tryLoad = [&](const std::string& bytes) {
       try {
-        for (const auto& tri : loadPlyTriangles(bytes, "fuzz.ply", kContext)) {
-          for (const glm::dvec3& v : tri) {
-            ASSERT_TRUE(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z));
+        const PlyMesh mesh = loadPlyMesh(bytes, "fuzz.ply", kContext);
+        ASSERT_TRUE(mesh.normals.empty() || mesh.normals.size() == mesh.triangles.size());
+        for (const Triangles* list : {&mesh.triangles, &mesh.normals}) {
+          for (const auto& tri : *list) {
+            for (const glm::dvec3& v : tri) {
+              ASSERT_TRUE(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z));
+            }
           }
         }
       } catch (const InputError&) {

@@ -1,7 +1,7 @@
 // OBJ loading: a light pre-scan of the text gives line-accurate errors for what
 // tinyobjloader would silently accept or mangle (index 0, out-of-range indices, unparsable
-// or non-finite coordinates, polygons of more than 255 vertices); tinyobjloader then does
-// the actual load and the faces are fan-triangulated here.
+// or non-finite coordinates and normals, polygons of more than 255 vertices); tinyobjloader
+// then does the actual load and the faces are fan-triangulated here, with their normals.
 #include "scene/obj_mesh.h"
 
 #include <charconv>
@@ -132,6 +132,8 @@ class ObjScanner {
     } else if (key == "vt") {
       ++sofar_.texcoords;
     } else if (key == "vn") {
+      normal(rest);
+      normalLines_.push_back(lineNumber);
       ++sofar_.normals;
     } else if (key == "f" || key == "l" || key == "p") {
       element(key, rest);
@@ -150,6 +152,7 @@ class ObjScanner {
   const std::vector<ObjMesh::Statement>& mtllib() const { return mtllib_; }
 
   const std::vector<std::size_t>& vertexLines() const { return vertexLines_; }
+  const std::vector<std::size_t>& normalLines() const { return normalLines_; }
   std::int64_t faces() const { return sofar_.faces; }
 
   [[noreturn]] void fail(std::size_t line, const std::string& problem) const {
@@ -157,19 +160,26 @@ class ObjScanner {
   }
 
  private:
-  void vertex(std::string_view rest) const {
+  void vertex(std::string_view rest) const { threeReals(rest, "vertex", "coordinate"); }
+
+  // tinyobjloader reads missing components of a normal as 0 and stores them as floats: a
+  // short line or a value beyond the float range would give a normal other than the file's.
+  void normal(std::string_view rest) const { threeReals(rest, "normal", "component"); }
+
+  // The first three values of a `v` or `vn` line (more are allowed: colours, weights).
+  void threeReals(std::string_view rest, const std::string& what, const std::string& part) const {
     const std::vector<std::string_view> tokens = splitBlanks(rest);
     if (tokens.size() < 3) {
-      fail(line_, "vertex has " + std::to_string(tokens.size()) +
-                      (tokens.size() == 1 ? " coordinate" : " coordinates") + " (need 3)");
+      fail(line_, what + " has " + std::to_string(tokens.size()) + " " + part +
+                      (tokens.size() == 1 ? "" : "s") + " (need 3)");
     }
     for (int i = 0; i < 3; ++i) {
       double v = 0.0;
       if (!parseReal(tokens[i], &v)) {
-        fail(line_, "vertex coordinate " + singleQuoted(tokens[i]) + " is not a number");
+        fail(line_, what + " " + part + " " + singleQuoted(tokens[i]) + " is not a number");
       }
       if (!std::isfinite(static_cast<float>(v))) {
-        fail(line_, "non-finite vertex coordinate " + singleQuoted(tokens[i]) +
+        fail(line_, "non-finite " + what + " " + part + " " + singleQuoted(tokens[i]) +
                         (std::isfinite(v) ? " (too large for a 32-bit float)" : ""));
       }
     }
@@ -255,6 +265,7 @@ class ObjScanner {
   Counts sofar_;
   std::size_t line_ = 0;
   std::vector<std::size_t> vertexLines_;  // line of each vertex, for post-load checks
+  std::vector<std::size_t> normalLines_;  // line of each normal, ditto
   int currentMaterial_ = -1;
   std::vector<int> faceMaterials_;
   std::vector<ObjMesh::Statement> usemtl_, mtllib_;
@@ -313,18 +324,31 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
                     "tinyobjloader read " + std::to_string(vertexCount) + " vertices, expected " +
                         std::to_string(scanner.vertexLines().size()) + context);
   }
-  std::vector<glm::dvec3> vertices(vertexCount);
-  for (std::size_t i = 0; i < vertexCount; ++i) {
-    for (int c = 0; c < 3; ++c) {
-      const float value = attrib.vertices[3 * i + static_cast<std::size_t>(c)];
-      // tinyobjloader's own number parser may round differently near the float limit.
-      if (!std::isfinite(value)) {
-        throwInputError(file, "line " + std::to_string(scanner.vertexLines()[i]),
-                        "non-finite vertex coordinate" + context);
-      }
-      vertices[i][c] = value;
-    }
+  const std::size_t normalCount = attrib.normals.size() / 3;
+  if (normalCount != scanner.normalLines().size()) {
+    throwInputError(file, "",
+                    "tinyobjloader read " + std::to_string(normalCount) + " normals, expected " +
+                        std::to_string(scanner.normalLines().size()) + context);
   }
+  // tinyobjloader's own number parser may round differently near the float limit.
+  auto finite = [&](const std::vector<tinyobj::real_t>& values, std::size_t count,
+                    const std::vector<std::size_t>& lines, const std::string& what) {
+    std::vector<glm::dvec3> result(count);
+    for (std::size_t i = 0; i < count; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        const float value = values[3 * i + static_cast<std::size_t>(c)];
+        if (!std::isfinite(value)) {
+          throwInputError(file, "line " + std::to_string(lines[i]), "non-finite " + what + context);
+        }
+        result[i][c] = value;
+      }
+    }
+    return result;
+  };
+  const std::vector<glm::dvec3> vertices =
+      finite(attrib.vertices, vertexCount, scanner.vertexLines(), "vertex coordinate");
+  const std::vector<glm::dvec3> normals =
+      finite(attrib.normals, normalCount, scanner.normalLines(), "normal component");
 
   ObjMesh mesh;
   std::vector<std::array<glm::dvec3, 3>>& triangles = mesh.triangles;
@@ -332,7 +356,11 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
   // tinyobjloader keeps the faces in file order (shapes in order of appearance), so the
   // pre-scan's per-face material applies face by face.
   const std::vector<int>& faceMaterials = scanner.faceMaterials();
+  // Normals are kept from the first face that references one on; the triangles before it get
+  // their zeros then, so that a file without normals costs nothing.
+  bool anyNormals = false;
   std::vector<std::size_t> face;
+  std::vector<glm::dvec3> faceNormals;
   for (const tinyobj::shape_t& shape : shapes) {
     const tinyobj::mesh_t& faces = shape.mesh;
     std::size_t offset = 0;
@@ -341,17 +369,37 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
       if (offset + n > faces.indices.size()) break;  // reported by the count check below
       if (faceCount >= static_cast<std::int64_t>(faceMaterials.size())) break;  // ditto
       face.resize(n);
+      faceNormals.assign(n, glm::dvec3(0.0));
+      std::size_t withNormal = 0;
       for (std::size_t k = 0; k < n; ++k) {
-        const int index = faces.indices[offset + k].vertex_index;
+        const tinyobj::index_t& ref = faces.indices[offset + k];
+        const int index = ref.vertex_index;
         if (index < 0 || static_cast<std::size_t>(index) >= vertexCount) {
           throwInputError(file, "",
                           "tinyobjloader produced vertex index " + std::to_string(index) +
                               " out of range" + context);
         }
         face[k] = static_cast<std::size_t>(index);
+        // -1: no normal referenced (v or v/vt).
+        if (ref.normal_index == -1) continue;
+        if (ref.normal_index < 0 || static_cast<std::size_t>(ref.normal_index) >= normalCount) {
+          throwInputError(file, "",
+                          "tinyobjloader produced normal index " +
+                              std::to_string(ref.normal_index) + " out of range" + context);
+        }
+        faceNormals[k] = normals[static_cast<std::size_t>(ref.normal_index)];
+        ++withNormal;
       }
+      anyNormals = anyNormals || withNormal > 0;
+      // Normals at only some corners (tinyobjloader allows "f 1//1 2 3") cannot be
+      // interpolated over the face: it is shaded like a face without any.
+      if (withNormal != n) faceNormals.assign(n, glm::dvec3(0.0));
+      if (anyNormals) mesh.normals.resize(triangles.size(), {});
       for (std::size_t k = 1; k + 1 < n; ++k) {
         triangles.push_back({vertices[face[0]], vertices[face[k]], vertices[face[k + 1]]});
+        if (anyNormals) {
+          mesh.normals.push_back({faceNormals[0], faceNormals[k], faceNormals[k + 1]});
+        }
         mesh.material.push_back(faceMaterials[static_cast<std::size_t>(faceCount)]);
       }
       offset += n;

@@ -10,9 +10,17 @@
 
 namespace pt::scene_detail {
 
-// An OBJ file's triangles with the material statements that apply to them.
+// An OBJ file's triangles with their vertex normals and the material statements that apply
+// to them.
 struct ObjMesh {
   std::vector<std::array<glm::dvec3, 3>> triangles;  // file order, polygons fanned
+  // The normals at the three vertices of each triangle, parallel to `triangles` (same fan),
+  // from the faces' `v//vn` and `v/vt/vn` references; empty when no face references a
+  // normal. A face that does not reference one at each of its vertices gets all-zero
+  // triples, which the scene loader replaces by the geometric normal (so do the zeros of a
+  // file's own `vn 0 0 0`). As read: not normalized (the scene loader normalizes after
+  // transforming).
+  std::vector<std::array<glm::dvec3, 3>> normals;
   // Per triangle: index into usemtl (the `usemtl` in force for its face), or -1 before any.
   std::vector<int> material;
   struct Statement {
@@ -26,8 +34,9 @@ struct ObjMesh {
 // Triangles of an OBJ file in file order, each polygon fanned as (0, i, i + 1). `text` is
 // the file's content and `file` its name for messages; `context` is appended to every
 // message to say which scene entry referenced the file. Throws InputError
-// "<file>: line N: <problem>" for malformed content and "<file>: no faces" for a file
-// without faces.
+// "<file>: line N: <problem>" for malformed content (a `vn` line too: 3 numbers that fit a
+// 32-bit float, whether or not a face uses it) and "<file>: no faces" for a file without
+// faces.
 ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std::string& context);
 
 // Just the triangles (the scene's own material for all of them).

@@ -21,7 +21,6 @@ namespace pt::scene_detail {
 
 namespace {
 
-using Tri = std::array<glm::dvec3, 3>;
 using IndexTri = std::array<std::uint32_t, 3>;
 
 enum class Format { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
@@ -234,11 +233,24 @@ struct Element {
   std::size_t line = 0;  // of its "element" line
   Role role = Role::kOther;
   std::vector<Property> properties;
-  std::array<std::size_t, 3> coords{};  // vertex: the properties x, y and z
-  std::size_t indexList = 0;            // face, tristrips: the vertex index list
+  std::array<std::size_t, 3> coords{};   // vertex: the properties x, y and z
+  bool hasNormals = false;               // vertex: nx, ny and nz are all there
+  std::array<std::size_t, 3> normals{};  // vertex: the properties nx, ny and nz
+  std::size_t indexList = 0;             // face, tristrips: the vertex index list
 };
 
-constexpr std::array<char, 3> kAxes{'x', 'y', 'z'};
+// The property names of a vertex's coordinates and of its normal's components, which are
+// also their names in messages.
+constexpr std::array<std::string_view, 3> kCoordinateNames{"x", "y", "z"};
+constexpr std::array<std::string_view, 3> kNormalNames{"nx", "ny", "nz"};
+
+// What a vertex property holds, for reading and for messages.
+struct VectorKind {
+  const char* what;  // "coordinate" or "normal"
+  const std::array<std::string_view, 3>& names;
+};
+const VectorKind kCoordinate{"coordinate", kCoordinateNames};
+const VectorKind kNormal{"normal", kNormalNames};
 
 class PlyReader {
  public:
@@ -248,7 +260,7 @@ class PlyReader {
         file_(file),
         context_(context) {}
 
-  std::vector<Tri> load() {
+  PlyMesh load() {
     parseHeader();
     checkHeader();
     if (format_ == Format::kAscii) {
@@ -258,12 +270,19 @@ class PlyReader {
     }
     if (tris_.empty()) fail("", "no faces (the 'tristrips' element holds no triangle)");
     PT_CHECK(vertices_.size() == vertexCount_, "PLY vertices not all read");
-    std::vector<Tri> triangles;
-    triangles.reserve(tris_.size());
+    PT_CHECK(normals_.empty() || normals_.size() == vertexCount_, "PLY normals not all read");
+    PlyMesh mesh;
+    mesh.triangles.reserve(tris_.size());
     for (const IndexTri& t : tris_) {
-      triangles.push_back({vertices_[t[0]], vertices_[t[1]], vertices_[t[2]]});
+      mesh.triangles.push_back({vertices_[t[0]], vertices_[t[1]], vertices_[t[2]]});
     }
-    return triangles;
+    if (!normals_.empty()) {
+      mesh.normals.reserve(tris_.size());
+      for (const IndexTri& t : tris_) {
+        mesh.normals.push_back({normals_[t[0]], normals_[t[1]], normals_[t[2]]});
+      }
+    }
+    return mesh;
   }
 
  private:
@@ -453,19 +472,15 @@ class PlyReader {
       if (e.role == Role::kVertex) {
         vertex = &e;
         for (std::size_t c = 0; c < 3; ++c) {
-          const std::string name(1, kAxes[c]);
+          const std::string name(kCoordinateNames[c]);
           const std::size_t j = findProperty(e, {name});
           if (j == std::string::npos) {
             failLine(e.line, "element 'vertex' has no property '" + name + "'");
           }
-          const Property& p = e.properties[j];
-          if (p.isList || isInteger(p.type)) {
-            failLine(p.line, "vertex property '" + name + "' is " +
-                                 (p.isList ? "a list" : "'" + typeName(p.type) + "'") +
-                                 " (it must be float or double)");
-          }
+          checkRealProperty(e.properties[j]);
           e.coords[c] = j;
         }
+        checkNormalProperties(e);
       } else if (e.role == Role::kFace || e.role == Role::kTristrips) {
         const std::size_t j = e.role == Role::kFace
                                   ? findProperty(e, {"vertex_indices", "vertex_index"})
@@ -508,6 +523,48 @@ class PlyReader {
                              "header is " + std::to_string(dataBytes) + " bytes)");
       }
     }
+  }
+
+  // A vertex coordinate or normal component: a float or double scalar.
+  void checkRealProperty(const Property& p) const {
+    if (p.isList || isInteger(p.type)) {
+      failLine(p.line, "vertex property '" + p.name + "' is " +
+                           (p.isList ? "a list" : "'" + typeName(p.type) + "'") +
+                           " (it must be float or double)");
+    }
+  }
+
+  // Vertex normals: nx, ny and nz all or none. One or two of them alone is more likely a
+  // writer's mistake than some other meaning of the names, so it is an error rather than
+  // a mesh silently shaded flat.
+  void checkNormalProperties(Element& e) const {
+    std::array<std::size_t, 3> j{};
+    std::vector<std::size_t> present;
+    std::vector<std::size_t> missing;
+    for (std::size_t c = 0; c < 3; ++c) {
+      j[c] = findProperty(e, {kNormalNames[c]});
+      (j[c] == std::string::npos ? missing : present).push_back(c);
+    }
+    if (present.empty()) return;
+    if (!missing.empty()) {
+      auto names = [](const std::vector<std::size_t>& cs) {
+        std::string list;
+        for (std::size_t k = 0; k < cs.size(); ++k) {
+          list += std::string(k == 0 ? "" : " and ") + "'" + std::string(kNormalNames[cs[k]]) + "'";
+        }
+        return list;
+      };
+      // The line of the first normal property in the header.
+      std::size_t first = present[0];
+      for (std::size_t c : present) first = j[c] < j[first] ? c : first;
+      failLine(e.properties[j[first]].line,
+               std::string(present.size() == 1 ? "vertex property " : "vertex properties ") +
+                   names(present) + " without " + names(missing) +
+                   " (a vertex normal needs all of 'nx', 'ny' and 'nz')");
+    }
+    for (std::size_t c = 0; c < 3; ++c) checkRealProperty(e.properties[j[c]]);
+    e.normals = j;
+    e.hasNormals = true;
   }
 
   static bool hasList(const Element& e) {
@@ -603,23 +660,35 @@ class PlyReader {
   }
 
   // Coordinates must be finite and, like every vertex the renderer sees, fit a float.
-  void checkVertex(const Element& e, std::uint64_t entry, const glm::dvec3& p,
-                   std::size_t line) const {
+  // Normals too: the renderer keeps them as floats, and a finite double beyond that range
+  // would leave little room for the scene's transform before it overflowed.
+  void checkVector(const Element& e, std::uint64_t entry, const glm::dvec3& p,
+                   const VectorKind& kind, std::size_t line) const {
     for (int c = 0; c < 3; ++c) {
       const double v = p[c];
       if (std::fabs(v) <= std::numeric_limits<float>::max()) continue;
-      const std::string axis(1, kAxes[c]);
+      const std::string name(kind.names[static_cast<std::size_t>(c)]);
       if (!std::isfinite(v)) {
-        failEntry(
-            e, entry,
-            "coordinate is not finite (" + axis + " = " + (std::isnan(v) ? "nan" : "inf") + ")",
-            line);
+        failEntry(e, entry,
+                  std::string(kind.what) + " is not finite (" + name + " = " +
+                      (std::isnan(v) ? "nan" : "inf") + ")",
+                  line);
       }
-      failEntry(
-          e, entry,
-          "coordinate is too large for a 32-bit float (" + axis + " = " + formatNumber(v) + ")",
-          line);
+      failEntry(e, entry,
+                std::string(kind.what) + " is too large for a 32-bit float (" + name + " = " +
+                    formatNumber(v) + ")",
+                line);
     }
+  }
+
+  // One decoded vertex, with its normal where the file has normals.
+  void addVertex(const Element& e, std::uint64_t entry, const glm::dvec3& point,
+                 const glm::dvec3& normal, std::size_t line) {
+    checkVector(e, entry, point, kCoordinate, line);
+    vertices_.push_back(point);
+    if (!e.hasNormals) return;
+    checkVector(e, entry, normal, kNormal, line);
+    normals_.push_back(normal);
   }
 
   // ---- Binary ----
@@ -659,18 +728,22 @@ class PlyReader {
       return pos + static_cast<std::size_t>(e.count) * stride;
     }
 
-    if (e.role == Role::kVertex) vertices_.reserve(reserveFor(e, pos));
+    reserveVertices(e, pos);
     if (e.role == Role::kFace) tris_.reserve(tris_.size() + reserveFor(e, pos));
     for (std::uint64_t i = 0; i < e.count; ++i) {
       glm::dvec3 point(0.0);
+      glm::dvec3 normal(0.0);
       for (std::size_t j = 0; j < e.properties.size(); ++j) {
         const Property& p = e.properties[j];
         if (!p.isList) {
           const std::size_t bytes = sizeOf(p.type);
           if (size - pos < bytes) failTruncated(e, i);
           if (e.role == Role::kVertex) {
-            for (int c = 0; c < 3; ++c) {
+            for (std::size_t c = 0; c < 3; ++c) {
               if (e.coords[c] == j) point[c] = loadReal(data_ + pos, p.type, swap);
+              if (e.hasNormals && e.normals[c] == j) {
+                normal[c] = loadReal(data_ + pos, p.type, swap);
+              }
             }
           }
           pos += bytes;
@@ -708,30 +781,39 @@ class PlyReader {
           addStrips(e, i, static_cast<std::uint64_t>(n), 0, next);
         }
       }
-      if (e.role == Role::kVertex) {
-        checkVertex(e, i, point, 0);
-        vertices_.push_back(point);
-      }
+      if (e.role == Role::kVertex) addVertex(e, i, point, normal, 0);
     }
     return pos;
   }
 
+  void reserveVertices(const Element& e, std::size_t pos) {
+    if (e.role != Role::kVertex) return;
+    vertices_.reserve(reserveFor(e, pos));
+    if (e.hasNormals) normals_.reserve(reserveFor(e, pos));
+  }
+
   void readFixedVertices(const Element& e, const unsigned char* base, std::size_t stride,
                          bool swap) {
-    std::array<std::size_t, 3> offset{};
-    std::array<Type, 3> type{};
-    for (std::size_t c = 0; c < 3; ++c) {
-      for (std::size_t j = 0; j < e.coords[c]; ++j) offset[c] += sizeOf(e.properties[j].type);
-      type[c] = e.properties[e.coords[c]].type;
+    // Byte offsets and types of x, y, z and then nx, ny, nz within an entry.
+    std::array<std::size_t, 6> offset{};
+    std::array<Type, 6> type{};
+    for (std::size_t c = 0; c < 6; ++c) {
+      if (c >= 3 && !e.hasNormals) break;
+      const std::size_t property = c < 3 ? e.coords[c] : e.normals[c - 3];
+      for (std::size_t j = 0; j < property; ++j) offset[c] += sizeOf(e.properties[j].type);
+      type[c] = e.properties[property].type;
     }
-    vertices_.resize(static_cast<std::size_t>(e.count));
-    for (std::size_t i = 0; i < vertices_.size(); ++i) {
+    auto vector = [&](const unsigned char* entry, std::size_t first) {
+      return glm::dvec3(loadReal(entry + offset[first], type[first], swap),
+                        loadReal(entry + offset[first + 1], type[first + 1], swap),
+                        loadReal(entry + offset[first + 2], type[first + 2], swap));
+    };
+    const std::size_t count = static_cast<std::size_t>(e.count);
+    vertices_.reserve(count);
+    if (e.hasNormals) normals_.reserve(count);
+    for (std::size_t i = 0; i < count; ++i) {
       const unsigned char* entry = base + i * stride;
-      const glm::dvec3 point(loadReal(entry + offset[0], type[0], swap),
-                             loadReal(entry + offset[1], type[1], swap),
-                             loadReal(entry + offset[2], type[2], swap));
-      checkVertex(e, i, point, 0);
-      vertices_[i] = point;
+      addVertex(e, i, vector(entry, 0), e.hasNormals ? vector(entry, 3) : glm::dvec3(0.0), 0);
     }
   }
 
@@ -767,7 +849,7 @@ class PlyReader {
 
   void readAsciiElement(const Element& e) {
     if (e.properties.empty() || e.count == 0) return;
-    if (e.role == Role::kVertex) vertices_.reserve(reserveFor(e, pos_));
+    reserveVertices(e, pos_);
     if (e.role == Role::kFace) tris_.reserve(tris_.size() + reserveFor(e, pos_));
     const std::size_t propertyCount = e.properties.size();
     // Whether a list follows each property: then a short line's value count is a minimum.
@@ -801,6 +883,7 @@ class PlyReader {
         return token;
       };
       glm::dvec3 point(0.0);
+      glm::dvec3 normal(0.0);
       for (std::size_t j = 0; j < propertyCount; ++j) {
         const Property& p = e.properties[j];
         const std::size_t after = propertyCount - j - 1;
@@ -808,8 +891,11 @@ class PlyReader {
           const std::string_view token = value(1 + after, !listAfter[j]);
           // Other properties are only counted: their values do not matter here.
           if (e.role != Role::kVertex) continue;
-          for (int c = 0; c < 3; ++c) {
-            if (e.coords[c] == j) point[c] = asciiCoordinate(e, i, token, kAxes[c], p.type);
+          for (std::size_t c = 0; c < 3; ++c) {
+            if (e.coords[c] == j) point[c] = asciiReal(e, i, token, kCoordinate, c, p.type);
+            if (e.hasNormals && e.normals[c] == j) {
+              normal[c] = asciiReal(e, i, token, kNormal, c, p.type);
+            }
           }
           continue;
         }
@@ -841,10 +927,7 @@ class PlyReader {
                       std::to_string(consumed),
                   line_);
       }
-      if (e.role == Role::kVertex) {
-        checkVertex(e, i, point, line_);
-        vertices_.push_back(point);
-      }
+      if (e.role == Role::kVertex) addVertex(e, i, point, normal, line_);
     }
   }
 
@@ -864,8 +947,10 @@ class PlyReader {
         line_);
   }
 
-  double asciiCoordinate(const Element& e, std::uint64_t entry, std::string_view token, char axis,
-                         Type type) const {
+  // Component c of a coordinate or a normal.
+  double asciiReal(const Element& e, std::uint64_t entry, std::string_view token,
+                   const VectorKind& kind, std::size_t c, Type type) const {
+    const std::string name(kind.names[c]);
     // Parsed at the property's own precision: a float property rounds once, straight from
     // the decimal text, exactly as a binary file of the same mesh would hold it.
     double value = 0.0;
@@ -880,7 +965,7 @@ class PlyReader {
     if (!ok) {
       failEntry(
           e, entry,
-          "coordinate " + std::string(1, axis) + " " + singleQuoted(token) + " is not a number",
+          std::string(kind.what) + " " + name + " " + singleQuoted(token) + " is not a number",
           line_);
     }
     if (std::fabs(value) <= std::numeric_limits<float>::max()) return value;
@@ -888,11 +973,12 @@ class PlyReader {
     // overflow has already become an infinity).
     double asDouble = value;
     parseReal(token, &asDouble);
-    failEntry(e, entry,
-              std::string(std::isfinite(asDouble) ? "coordinate is too large for a 32-bit float"
-                                                  : "coordinate is not finite") +
-                  " (" + std::string(1, axis) + " = " + singleQuoted(token) + ")",
-              line_);
+    failEntry(
+        e, entry,
+        std::string(kind.what) +
+            (std::isfinite(asDouble) ? " is too large for a 32-bit float" : " is not finite") +
+            " (" + name + " = " + singleQuoted(token) + ")",
+        line_);
   }
 
   const std::string& bytes_;
@@ -910,14 +996,13 @@ class PlyReader {
   std::size_t line_ = 0;  // ascii: number of the line last read
 
   std::vector<glm::dvec3> vertices_;
+  std::vector<glm::dvec3> normals_;  // parallel to vertices_, or empty: the file has none
   std::vector<IndexTri> tris_;
 };
 
 }  // namespace
 
-std::vector<std::array<glm::dvec3, 3>> loadPlyTriangles(const std::string& bytes,
-                                                        const std::string& file,
-                                                        const std::string& context) {
+PlyMesh loadPlyMesh(const std::string& bytes, const std::string& file, const std::string& context) {
   return PlyReader(bytes, file, context).load();
 }
 

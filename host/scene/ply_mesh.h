@@ -10,6 +10,16 @@
 
 namespace pt::scene_detail {
 
+// A PLY file's triangles with the vertex normals the file gives for them.
+struct PlyMesh {
+  std::vector<std::array<glm::dvec3, 3>> triangles;  // file order, polygons fanned
+  // The normals at the three vertices of each triangle, parallel to `triangles` (same
+  // fanning, same strip order), or empty when the vertex element has no nx, ny, nz. As
+  // read: not normalized (the scene loader normalizes after transforming), and a file's
+  // own 0 0 0 stays a zero vector, which the scene loader replaces by the geometric normal.
+  std::vector<std::array<glm::dvec3, 3>> normals;
+};
+
 // Triangles of a PLY file in file order, each polygon fanned as (0, i, i + 1). `bytes` is
 // the file's whole content (binary-safe), `file` its name for messages; `context` is
 // appended to every message to say which scene entry referenced the file. Throws
@@ -17,11 +27,17 @@ namespace pt::scene_detail {
 // header, "<element> <index>" for binary data and "<element> <index> (line N)" for ascii
 // data (element indices count from 0, like the vertex indices of faces).
 //
-// Accepts the elements 'vertex' (float or double x, y, z), 'face' (a 'vertex_indices' or
-// 'vertex_index' list) and 'tristrips' (a 'vertex_indices' list, -1 restarting a strip);
-// every other element and property is skipped.
-std::vector<std::array<glm::dvec3, 3>> loadPlyTriangles(const std::string& bytes,
-                                                        const std::string& file,
-                                                        const std::string& context);
+// Accepts the elements 'vertex' (float or double x, y, z and, optionally, float or double
+// nx, ny, nz: all three or none), 'face' (a 'vertex_indices' or 'vertex_index' list) and
+// 'tristrips' (a 'vertex_indices' list, -1 restarting a strip); every other element and
+// property is skipped. Normals, like coordinates, must be finite and fit a 32-bit float.
+PlyMesh loadPlyMesh(const std::string& bytes, const std::string& file, const std::string& context);
+
+// Just the triangles.
+inline std::vector<std::array<glm::dvec3, 3>> loadPlyTriangles(const std::string& bytes,
+                                                               const std::string& file,
+                                                               const std::string& context) {
+  return loadPlyMesh(bytes, file, context).triangles;
+}
 
 }  // namespace pt::scene_detail

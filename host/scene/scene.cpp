@@ -481,6 +481,9 @@ MeshFile readMeshFile(const JsonNode& shape, const std::filesystem::path& sceneP
 struct ShapeTriangles {
   std::vector<Tri> triangles;
   std::vector<uint> materials;  // per triangle; empty: all take the shape's "material"
+  // Per triangle, the vertex normals as the mesh file gives them (not unit, untransformed;
+  // zero where a face has none), or empty when the mesh has no normals.
+  std::vector<Tri> normals;
 };
 
 // Scene materials made from MTL files, shared by every shape that uses the same file.
@@ -549,6 +552,7 @@ ShapeTriangles readObjWithMtl(const JsonNode& shape, const MeshFile& file,
   }
   ShapeTriangles out;
   out.triangles = std::move(obj.triangles);
+  out.normals = std::move(obj.normals);
   out.materials.reserve(obj.material.size());
   for (std::size_t t = 0; t < obj.material.size(); ++t) {
     if (obj.material[t] < 0) {
@@ -564,8 +568,31 @@ ShapeTriangles readObjWithMtl(const JsonNode& shape, const MeshFile& file,
   return out;
 }
 
+// A vertex normal in world space: transformed by the inverse transpose of the shape's linear
+// map (rotation times scale: the rotation times the inverse scale), normalized; the triangle's
+// geometric normal `ng` where the file's normal is zero or the result is not finite.
+vec3 worldNormal(glm::dvec3 n, const std::optional<Transform>& transform, vec3 ng) {
+  if (transform) {
+    const Transform& t = *transform;
+    n /= t.scale;
+    n = n * t.cosAngle + glm::cross(t.axis, n) * t.sinAngle +
+        t.axis * (glm::dot(t.axis, n) * (1.0 - t.cosAngle));
+  }
+  const double len = glm::length(n);
+  if (!(len > 0.0) || !std::isfinite(len)) return ng;
+  const vec3 unit = vec3(n / len);
+  return std::isfinite(unit.x) && std::isfinite(unit.y) && std::isfinite(unit.z) ? unit : ng;
+}
+
+TriangleNormals flatNormals(const Triangle& t) {
+  const vec3 ng = glm::normalize(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
+  return TriangleNormals{ng, 0.0f, ng, 0.0f, ng, 0.0f};
+}
+
 // Appends the triangles of one shape to the scene, transformed and rounded to float,
-// dropping those of zero area.
+// dropping those of zero area. Vertex normals, where the mesh has them, go to scene.normals;
+// once any shape has some, every triangle has an entry there (its geometric normal where its
+// mesh has none).
 void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
                    const std::optional<Transform>& transform, uint material, Scene& scene) {
   const std::vector<Tri>& triangles = shapeTriangles.triangles;
@@ -600,6 +627,21 @@ void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
     out.emitter = kNoEmitter;
     out.primitive = static_cast<uint>(scene.triangles.size());
     scene.triangles.push_back(out);
+    if (!shapeTriangles.normals.empty() && scene.normals.empty()) {
+      // The first triangle with vertex normals: the triangles before it shade flat.
+      for (std::size_t t = 0; t + 1 < scene.triangles.size(); ++t) {
+        scene.normals.push_back(flatNormals(scene.triangles[t]));
+      }
+    }
+    if (!shapeTriangles.normals.empty()) {
+      const vec3 ng = flatNormals(out).n0;
+      const Tri& n = shapeTriangles.normals[i];
+      scene.normals.push_back(TriangleNormals{worldNormal(n[0], transform, ng), 0.0f,
+                                              worldNormal(n[1], transform, ng), 0.0f,
+                                              worldNormal(n[2], transform, ng), 0.0f});
+    } else if (!scene.normals.empty()) {
+      scene.normals.push_back(flatNormals(out));
+    }
   }
   if (dropped > 0) {
     scene.warnings.push_back(shape.file() + ": " + shape.path() + ": dropped " +
@@ -690,15 +732,19 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
         if (useMtl) {
           triangles = readObjWithMtl(shape, file, material, mtlLibrary, scene);
         } else {
-          triangles.triangles =
-              scene_detail::loadObjTriangles(file.bytes, file.path.string(), file.context);
+          scene_detail::ObjMesh obj =
+              scene_detail::loadObjMesh(file.bytes, file.path.string(), file.context);
+          triangles.triangles = std::move(obj.triangles);
+          triangles.normals = std::move(obj.normals);
         }
         break;
       }
       case Kind::kPly: {
         const MeshFile file = readMeshFile(shape, scenePath);
-        triangles.triangles =
-            scene_detail::loadPlyTriangles(file.bytes, file.path.string(), file.context);
+        scene_detail::PlyMesh ply =
+            scene_detail::loadPlyMesh(file.bytes, file.path.string(), file.context);
+        triangles.triangles = std::move(ply.triangles);
+        triangles.normals = std::move(ply.normals);
         break;
       }
     }
