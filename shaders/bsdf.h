@@ -83,12 +83,6 @@ PT_INLINE float sqr(float x) {
 PT_INLINE float safeSqrt(float x) {
   return sqrt(max(0.0f, x));
 }
-// (cos phi, sin phi) of w about z; (1, 0) along the pole.
-PT_INLINE vec2 cosSinPhi(vec3 w) {
-  float sinTheta = safeSqrt(1.0f - w.z * w.z);
-  if (sinTheta == 0.0f) return vec2(1.0f, 0.0f);
-  return vec2(clamp(w.x / sinTheta, -1.0f, 1.0f), clamp(w.y / sinTheta, -1.0f, 1.0f));
-}
 PT_INLINE vec3 reflectAbout(vec3 wo, vec3 n) {
   return -wo + (2.0f * dot(wo, n)) * n;
 }
@@ -196,19 +190,19 @@ PT_INLINE float trD(TrowbridgeReitz d, vec3 wm) {
   float cos2Theta = wm.z * wm.z;
   float cos4Theta = cos2Theta * cos2Theta;
   if (cos4Theta < 1e-16f) return 0.0f;
-  float tan2Theta = max(0.0f, 1.0f - cos2Theta) / cos2Theta;
-  vec2 cs = cosSinPhi(wm);
-  float e = tan2Theta * (sqr(cs.x / d.alphaX) + sqr(cs.y / d.alphaY));
+  // tan^2(theta) (cos^2(phi) / ax^2 + sin^2(phi) / ay^2), from the components directly: pbrt-v4
+  // takes tan^2 from 1 - cos^2, which cancels near the pole, where a nearly smooth lobe lives
+  // (D was 23 % off at alpha 0.0015).
+  float e = (sqr(wm.x / d.alphaX) + sqr(wm.y / d.alphaY)) / cos2Theta;
   return 1.0f / (kPi * d.alphaX * d.alphaY * cos4Theta * sqr(1.0f + e));
 }
 
 PT_INLINE float trLambda(TrowbridgeReitz d, vec3 w) {
   float cos2Theta = w.z * w.z;
   if (cos2Theta == 0.0f) return 0.0f;  // pbrt-v4: an infinite tan^2 gives 0
-  float tan2Theta = max(0.0f, 1.0f - cos2Theta) / cos2Theta;
-  vec2 cs = cosSinPhi(w);
-  float alpha2 = sqr(cs.x * d.alphaX) + sqr(cs.y * d.alphaY);
-  return (sqrt(1.0f + alpha2 * tan2Theta) - 1.0f) * 0.5f;
+  // alpha^2(phi) tan^2(theta), from the components as in trD.
+  float alpha2Tan2 = (sqr(w.x * d.alphaX) + sqr(w.y * d.alphaY)) / cos2Theta;
+  return (sqrt(1.0f + alpha2Tan2) - 1.0f) * 0.5f;
 }
 
 PT_INLINE float trG1(TrowbridgeReitz d, vec3 w) {
@@ -394,8 +388,7 @@ PT_INLINE BsdfSample dielectricSample(TrowbridgeReitz d, float eta, vec3 wo, flo
     }
     float ft = T / absCosTheta(wi);
     if (radiance) ft /= sqr(etap);
-    return BsdfSample(vec3(ft), pt / (pr + pt), wi, kBsdfTransmission | kBsdfSpecular, etap,
-                      false);
+    return BsdfSample(vec3(ft), pt / (pr + pt), wi, kBsdfTransmission | kBsdfSpecular, etap, false);
   }
   // Rough: sample a visible microfacet normal, then reflect or refract about it.
   if (wo.z == 0.0f) return noBsdfSample();
@@ -443,8 +436,8 @@ PT_INLINE BsdfSample thinDielectricSample(float eta, vec3 wo, float uc) {
   if (wo.z == 0.0f) return noBsdfSample();
   if (uc < R / (R + T)) {
     vec3 wi = vec3(-wo.x, -wo.y, wo.z);
-    return BsdfSample(vec3(R / absCosTheta(wi)), R / (R + T), wi,
-                      kBsdfReflection | kBsdfSpecular, 1.0f, false);
+    return BsdfSample(vec3(R / absCosTheta(wi)), R / (R + T), wi, kBsdfReflection | kBsdfSpecular,
+                      1.0f, false);
   }
   vec3 wi = -wo;
   return BsdfSample(vec3(T / absCosTheta(wi)), T / (R + T), wi, kBsdfTransmission | kBsdfSpecular,
@@ -490,10 +483,10 @@ PT_INLINE BsdfSample diffuseTransmissionSample(vec3 r, vec3 t, vec3 wo, float uc
 struct RandomStream {
   uvec4 key;  // .w advances by one per number drawn
 };
-PT_CONST uint kStreamSample = 1u;      // sampling a direction
-PT_CONST uint kStreamEval = 2u;        // bsdfF at a light sample
-PT_CONST uint kStreamLightPdf = 3u;    // bsdfPdf at a light sample
-PT_CONST uint kStreamSamplePdf = 4u;   // bsdfPdf of a sampled direction (pdfIsProportional)
+PT_CONST uint kStreamSample = 1u;     // sampling a direction
+PT_CONST uint kStreamEval = 2u;       // bsdfF at a light sample
+PT_CONST uint kStreamLightPdf = 3u;   // bsdfPdf at a light sample
+PT_CONST uint kStreamSamplePdf = 4u;  // bsdfPdf of a sampled direction (pdfIsProportional)
 
 PT_INLINE RandomStream makeRandomStream(uvec2 pixel, uint sampleIndex, uint dimension, uint seed,
                                         uint purpose) {
@@ -532,7 +525,8 @@ PT_INLINE vec3 sampleHenyeyGreenstein(vec3 wo, float g, vec2 u, PT_OUT(float) pd
   if (abs(g) < 1e-3f) {
     cosTheta = 1.0f - 2.0f * u.x;
   } else {
-    cosTheta = -1.0f / (2.0f * g) * (1.0f + g * g - sqr((1.0f - g * g) / (1.0f + g - 2.0f * g * u.x)));
+    cosTheta =
+        -1.0f / (2.0f * g) * (1.0f + g * g - sqr((1.0f - g * g) / (1.0f + g - 2.0f * g * u.x)));
   }
   float sinTheta = safeSqrt(1.0f - cosTheta * cosTheta);
   vec2 cs = cosSinTwoPi(u.y);
@@ -560,9 +554,8 @@ struct CoatedDiffuse {
 };
 
 PT_INLINE CoatedDiffuse coatedDiffuseOf(Material m) {
-  return CoatedDiffuse(TrowbridgeReitz(m.alphaX, m.alphaY), m.eta.x, m.reflectance,
-                       m.transmittance, max(m.thickness, 1.17549435e-38f), m.g, m.maxDepth,
-                       m.nSamples);
+  return CoatedDiffuse(TrowbridgeReitz(m.alphaX, m.alphaY), m.eta.x, m.reflectance, m.transmittance,
+                       max(m.thickness, 1.17549435e-38f), m.g, m.maxDepth, m.nSamples);
 }
 
 // The medium's transmittance over depth dz along w (unit extinction).
@@ -587,8 +580,7 @@ PT_INLINE bool sampleUsable(BsdfSample s) {
   return s.flags != 0u && maxComponent(s.f) > 0.0f && s.pdf > 0.0f && s.wi.z != 0.0f;
 }
 
-PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance,
-                              RandomStream rng) {
+PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance, RandomStream rng) {
   if (wo.z < 0.0f) {
     wo = -wo;
     wi = -wi;
@@ -647,8 +639,7 @@ PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance,
           f += beta * c.albedo * henyeyGreenstein(dot(-w, -wis.wi), c.g) * wt *
                layerTransmittance(zp - exitZ, wis.wi) * wis.f / wis.pdf;
           float phasePdf;
-          vec3 wNew =
-              sampleHenyeyGreenstein(-w, c.g, nextRandom2(rng), phasePdf);
+          vec3 wNew = sampleHenyeyGreenstein(-w, c.g, nextRandom2(rng), phasePdf);
           if (!(phasePdf > 0.0f) || wNew.z == 0.0f) continue;
           // The phase function's value equals its pdf: beta *= albedo.
           beta *= c.albedo;
@@ -658,7 +649,10 @@ PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance,
           if (((z < exitZ && w.z > 0.0f) || (z > exitZ && w.z < 0.0f)) && !exitSpecular) {
             vec3 fExit = coatedInterfaceF(c, exitTop, -w, wi, radiance);
             if (maxComponent(fExit) > 0.0f) {
-              float exitPdf = coatedInterfacePdf(c, exitTop, -w, wi, kSampleTransmission);
+              // The other strategy, wis, samples the internal direction -w from wi: its
+              // density over -w (pbrt-v4 takes the density over wi here, another measure, and
+              // so its weights do not sum to one: f came out up to 8 % too bright).
+              float exitPdf = coatedInterfacePdf(c, exitTop, wi, -w, kSampleTransmission);
               float wt2 = powerHeuristic(phasePdf, exitPdf);
               f += beta * layerTransmittance(zp - exitZ, wNew) * fExit * wt2;
             }
@@ -671,8 +665,7 @@ PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance,
         // Reflection at the exit interface back into the layer.
         float uc2 = nextRandom(rng);
         vec2 u2 = nextRandom2(rng);
-        BsdfSample bs =
-            coatedInterfaceSample(c, exitTop, -w, uc2, u2, radiance, kSampleReflection);
+        BsdfSample bs = coatedInterfaceSample(c, exitTop, -w, uc2, u2, radiance, kSampleReflection);
         if (!sampleUsable(bs)) break;
         beta *= bs.f * absCosTheta(bs.wi) / bs.pdf;
         w = bs.wi;
@@ -681,12 +674,10 @@ PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance,
         if (!nonExitSpecular) {
           float wt = 1.0f;
           if (!exitSpecular) {
-            wt = powerHeuristic(wis.pdf,
-                                coatedInterfacePdf(c, !exitTop, -w, -wis.wi, kSampleAll));
+            wt = powerHeuristic(wis.pdf, coatedInterfacePdf(c, !exitTop, -w, -wis.wi, kSampleAll));
           }
-          f += beta * coatedInterfaceF(c, !exitTop, -w, -wis.wi, radiance) *
-               absCosTheta(wis.wi) * wt * layerTransmittance(c.thickness, wis.wi) * wis.f /
-               wis.pdf;
+          f += beta * coatedInterfaceF(c, !exitTop, -w, -wis.wi, radiance) * absCosTheta(wis.wi) *
+               wt * layerTransmittance(c.thickness, wis.wi) * wis.f / wis.pdf;
         }
         // Then a new direction from that interface's BSDF.
         float uc2 = nextRandom(rng);
@@ -702,7 +693,8 @@ PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance,
           if (maxComponent(fExit) > 0.0f) {
             float wt = 1.0f;
             if (!nonExitSpecular) {
-              float exitPdf = coatedInterfacePdf(c, exitTop, -w, wi, kSampleTransmission);
+              // wis's density over the internal direction -w (see above).
+              float exitPdf = coatedInterfacePdf(c, exitTop, wi, -w, kSampleTransmission);
               wt = powerHeuristic(bs.pdf, exitPdf);
             }
             f += beta * layerTransmittance(c.thickness, bs.wi) * fExit * wt;
@@ -714,8 +706,8 @@ PT_INLINE vec3 coatedDiffuseF(CoatedDiffuse c, vec3 wo, vec3 wi, bool radiance,
   return f / n;
 }
 
-PT_INLINE BsdfSample coatedDiffuseSample(CoatedDiffuse c, vec3 wo, float uc, vec2 u,
-                                         bool radiance, RandomStream rng) {
+PT_INLINE BsdfSample coatedDiffuseSample(CoatedDiffuse c, vec3 wo, float uc, vec2 u, bool radiance,
+                                         RandomStream rng) {
   bool flipWi = false;
   if (wo.z < 0.0f) {
     wo = -wo;
@@ -751,8 +743,7 @@ PT_INLINE BsdfSample coatedDiffuseSample(CoatedDiffuse c, vec3 wo, float uc, vec
       if (zp == z) return noBsdfSample();
       if (0.0f < zp && zp < c.thickness) {
         float phasePdf;
-        vec3 wNew =
-            sampleHenyeyGreenstein(-w, c.g, nextRandom2(rng), phasePdf);
+        vec3 wNew = sampleHenyeyGreenstein(-w, c.g, nextRandom2(rng), phasePdf);
         if (!(phasePdf > 0.0f) || wNew.z == 0.0f) return noBsdfSample();
         f *= c.albedo * phasePdf;
         pdf *= phasePdf;
@@ -782,6 +773,9 @@ PT_INLINE BsdfSample coatedDiffuseSample(CoatedDiffuse c, vec3 wo, float uc, vec
       uint flags = sameHemisphere(wo, w) ? kBsdfReflection : kBsdfTransmission;
       if (specularPath) flags |= kBsdfSpecular;
       if (flipWi) w = -w;
+      // A long walk can take f and pdf down to 0 together (float underflow): no sample, as
+      // pbrt-v4's BSDF::Sample_f drops a pdf of 0, rather than 0 / 0.
+      if (!(pdf > 0.0f) || !(maxComponent(f) > 0.0f)) return noBsdfSample();
       return BsdfSample(f, pdf, w, flags, 1.0f, true);
     }
     f *= absCosTheta(is.wi);
@@ -809,8 +803,8 @@ PT_INLINE float coatedDiffusePdf(CoatedDiffuse c, vec3 wo, vec3 wi, RandomStream
     uc = nextRandom(rng);
     u = nextRandom2(rng);
     BsdfSample wis = dielectricSample(c.coat, c.eta, wi, uc, u, false, kSampleTransmission);
-    if (wos.flags == 0u || !(maxComponent(wos.f) > 0.0f) || !(wos.pdf > 0.0f) ||
-        wis.flags == 0u || !(maxComponent(wis.f) > 0.0f) || !(wis.pdf > 0.0f)) {
+    if (wos.flags == 0u || !(maxComponent(wos.f) > 0.0f) || !(wos.pdf > 0.0f) || wis.flags == 0u ||
+        !(maxComponent(wis.f) > 0.0f) || !(wis.pdf > 0.0f)) {
       continue;
     }
     if (coatSmooth) {

@@ -12,39 +12,24 @@
 #include "render/prepare.h"
 #include "render_compare.h"
 #include "scene/scene.h"
+#include "test_materials.h"
 #include "test_util.h"
 
 namespace pt {
 namespace {
 
+using test::diffuseTransmission;
+using test::thinDielectric;
+
 // The types' parameters, as the scene reader would fill them (alphas already remapped).
 Material conductor(float alpha) {
-  Material m{};
-  m.type = kMaterialConductor;
-  m.eta = vec3(0.2f, 0.92f, 1.1f);  // copper-like
-  m.k = vec3(3.9f, 2.45f, 2.14f);
-  m.alphaX = m.alphaY = alpha;
-  return m;
+  return test::conductor(alpha, alpha);
 }
 Material dielectric(float eta, float alpha) {
-  Material m{};
-  m.type = kMaterialDielectric;
-  m.eta = vec3(eta);
-  m.alphaX = m.alphaY = alpha;
-  return m;
-}
-Material thinDielectric(float eta) {
-  Material m{};
-  m.type = kMaterialThinDielectric;
-  m.eta = vec3(eta);
-  return m;
+  return test::dielectric(alpha, alpha, eta);
 }
 Material diffuseTransmission() {
-  Material m{};
-  m.type = kMaterialDiffuseTransmission;
-  m.reflectance = vec3(0.5f, 0.4f, 0.3f);
-  m.transmittance = vec3(0.3f, 0.4f, 0.5f);
-  return m;
+  return diffuseTransmission(vec3(0.5f, 0.4f, 0.3f), vec3(0.3f, 0.4f, 0.5f));
 }
 Material coatedDiffuse(float alpha, vec3 albedo) {
   Material m{};
@@ -84,8 +69,7 @@ class MaterialsAgree : public ::testing::TestWithParam<Case> {};
 TEST_P(MaterialsAgree, OnBothBackends) {
   const Case& c = GetParam();
   const SceneData data = cornellWith(c.a, c.b, 32);
-  EXPECT_NE(data.effects.toString().find(c.effects), std::string::npos)
-      << data.effects.toString();
+  EXPECT_NE(data.effects.toString().find(c.effects), std::string::npos) << data.effects.toString();
   EXPECT_TRUE(data.effects.hasBsdfMaterials());
   const Comparison cmp = renderBoth(data, 8);
   expectAgreement(cmp);
@@ -104,8 +88,7 @@ INSTANTIATE_TEST_SUITE_P(
              }(),
              "conductor"},
         Case{"glass", dielectric(1.5f, 0.0f), dielectric(1.5f, 0.3f), "dielectric"},
-        Case{"glassBelowOne", dielectric(1.0f / 1.33f, 0.2f), dielectric(1.0f, 0.0f),
-             "dielectric"},
+        Case{"glassBelowOne", dielectric(1.0f / 1.33f, 0.2f), dielectric(1.0f, 0.0f), "dielectric"},
         Case{"thinAndTranslucent", thinDielectric(1.5f), diffuseTransmission(),
              "thindielectric+diffusetransmission"},
         Case{"coated", coatedDiffuse(0.0f, vec3(0.0f)), coatedDiffuse(0.3f, vec3(0.5f)),
@@ -113,8 +96,7 @@ INSTANTIATE_TEST_SUITE_P(
         // The hard cases: nearly smooth and fully rough, indices next to 1 and far from it
         // (glass blocks: total internal reflection inside), extreme anisotropy.
         Case{"conductorRoughnessExtremes", conductor(1e-4f), conductor(1.0f), "conductor"},
-        Case{"glassIndexExtremes", dielectric(1.0001f, 0.0f), dielectric(4.0f, 0.0f),
-             "dielectric"},
+        Case{"glassIndexExtremes", dielectric(1.0001f, 0.0f), dielectric(4.0f, 0.0f), "dielectric"},
         Case{"roughGlassExtremes", dielectric(1.0001f, 0.05f), dielectric(4.0f, 1.0f),
              "dielectric"},
         Case{"anisotropyExtremes",
@@ -213,12 +195,12 @@ TEST(MaterialsFurnace, NeverAboveOneAndOneWhenLossless) {
     Material m;
     bool lossless;
   };
-  for (const FurnaceCase& c : {FurnaceCase{"smooth glass", dielectric(1.5f, 0.0f), true},
-                               FurnaceCase{"thin glass", thinDielectric(1.5f), true},
-                               FurnaceCase{"diffuse transmission", transmissive, true},
-                               FurnaceCase{"rough glass", dielectric(1.5f, 0.3f), false},
-                               FurnaceCase{"rough metal", metal, false},
-                               FurnaceCase{"coated", coated, false}}) {
+  for (const FurnaceCase& c :
+       {FurnaceCase{"smooth glass", dielectric(1.5f, 0.0f), true},
+        FurnaceCase{"thin glass", thinDielectric(1.5f), true},
+        FurnaceCase{"diffuse transmission", transmissive, true},
+        FurnaceCase{"rough glass", dielectric(1.5f, 0.3f), false},
+        FurnaceCase{"rough metal", metal, false}, FurnaceCase{"coated", coated, false}}) {
     SCOPED_TRACE(c.name);
     const SceneData data = prepareScene(furnaceWith(c.m, 0.0f), RenderSettings{});
     EXPECT_TRUE(data.effects.shadingNormals);
@@ -237,11 +219,52 @@ TEST(MaterialsFurnace, NeverAboveOneAndOneWhenLossless) {
   }
 }
 
+// Light sampling weighs a BSDF's f (and, with MIS, its pdf), BSDF sampling only its sample
+// weights: in the furnace, whose light comes from every direction, light sampling alone, BSDF
+// sampling alone and MIS estimate the same image only if f, pdf and the sampler describe one
+// BSDF. CPU, every non-delta type, smooth-shaded sphere.
+TEST(MaterialsFurnace, LightSamplingAgreesWithBsdfSampling) {
+  Material transmissive = diffuseTransmission();
+  Material roughCoat = coatedDiffuse(0.5f, vec3(0.0f));
+  roughCoat.reflectance = vec3(0.8f);
+  Material mediumCoat = coatedDiffuse(0.3f, vec3(0.8f));
+  mediumCoat.thickness = 0.3f;
+  for (const Material& m :
+       {conductor(0.3f), dielectric(1.5f, 0.3f), transmissive, roughCoat, mediumCoat}) {
+    SCOPED_TRACE("type " + std::to_string(m.type) + " alpha " + std::to_string(m.alphaX));
+    Scene scene = furnaceWith(m, 0.0f);
+    scene.camera.width = scene.camera.height = 32;
+    Image images[3];
+    int i = 0;
+    for (uint strategy : {kStrategyBsdf, kStrategyNee, kStrategyMis}) {
+      RenderSettings settings;
+      settings.strategy = strategy;
+      const SceneData data = prepareScene(scene, settings);
+      Film film(32, 32);
+      const RenderStats stats = renderCpu(data, test::cpuOptions(2, 512), film);
+      EXPECT_EQ(stats.invalidSamples, 0u);
+      images[i++] = film.resolve();
+    }
+    // The mean of the per-pixel differences and its standard error: the image's own variation
+    // across pixels cancels.
+    for (int k = 1; k < 3; ++k) {
+      Image diff = images[k];
+      for (size_t p = 0; p < diff.pixels.size(); ++p) diff.pixels[p] -= images[0].pixels[p];
+      const ImageMean d = imageMean(diff);
+      const double reference = imageMean(images[0]).mean.x;
+      std::printf("furnace, type %u: %s - BSDF sampling = %+.5f (se %.5f) of %.5f\n", m.type,
+                  k == 1 ? "light sampling" : "MIS", d.mean.x, d.se.x, reference);
+      EXPECT_NEAR(d.mean.x, 0.0, 4.0 * d.se.x) << (k == 1 ? "light sampling" : "MIS");
+    }
+  }
+}
+
 // Shading normals twisted by 100 degrees, so that many point below their triangles: every
 // material still gives finite samples, and the backends still agree.
 TEST(MaterialsShadingNormals, TwistedNormalsStayFiniteOnBothBackends) {
-  for (const Material& m : {dielectric(1.5f, 0.0f), conductor(0.2f), coatedDiffuse(0.1f, vec3(0.0f)),
-                            Material{vec3(0.7f), kMaterialDiffuse, vec3(0.0f), 0}}) {
+  for (const Material& m :
+       {dielectric(1.5f, 0.0f), conductor(0.2f), coatedDiffuse(0.1f, vec3(0.0f)),
+        Material{vec3(0.7f), kMaterialDiffuse, vec3(0.0f), 0}}) {
     SCOPED_TRACE("type " + std::to_string(m.type));
     Scene scene = furnaceWith(m, 100.0f * kPi / 180.0f);
     scene.materials[0].reflectance = vec3(0.3f);  // the walls scatter too
@@ -287,8 +310,8 @@ TEST(MaterialsShadingNormals, SmoothSphereAgreesAndDiffersFromFlat) {
 TEST(MaterialsExamples, AgreeOnBothBackends) {
   for (const char* config : {"cornell-materials.json", "veach-mis.json"}) {
     SCOPED_TRACE(config);
-    const SceneData data = prepareScene(loadScene(test::kConfigs / config),
-                                        RenderSettings{.width = 48, .height = 32});
+    const SceneData data =
+        prepareScene(loadScene(test::kConfigs / config), RenderSettings{.width = 48, .height = 32});
     EXPECT_TRUE(data.effects.conductor);
     expectAgreement(renderBoth(data, 8));
   }
@@ -307,8 +330,7 @@ TEST(Materials, SmoothOnlySceneNeedsNoLightSampling) {
   scene.materials[0] = conductor(0.0f);
   scene.materials[1] = dielectric(1.5f, 0.0f);
   scene.materials[2] = thinDielectric(1.5f);
-  const SceneData data =
-      prepareScene(std::move(scene), RenderSettings{.width = 16, .height = 16});
+  const SceneData data = prepareScene(std::move(scene), RenderSettings{.width = 16, .height = 16});
   EXPECT_FALSE(data.effects.lightSampling);
   EXPECT_TRUE(data.effects.conductor && data.effects.dielectric && data.effects.thinDielectric);
 }

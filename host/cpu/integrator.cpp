@@ -36,7 +36,7 @@ int availableCpus() {
 // A uniform point on an emitter chosen from the alias table with uChoose (uLight: the point).
 struct LightPoint {
   vec3 point;
-  vec3 normal;      // the emitter's unit geometric normal (it emits on this side)
+  vec3 normal;  // the emitter's unit geometric normal (it emits on this side)
   float area;
   float magnitude;  // for the ray offset at the light
   float pmf;        // probability of choosing this emitter
@@ -76,13 +76,12 @@ ToLight towardsLight(const LightPoint& light, vec3 p) {
 }
 
 // --debug-pixel's line about a light sample.
-void printLightSample(const SceneData& scene, const LightPoint& light, float lightPdf,
-                      float weight, bool debugPrint, uint depth) {
+void printLightSample(const SceneData& scene, const LightPoint& light, float lightPdf, float weight,
+                      bool debugPrint, uint depth) {
   if (debugPrint) {
-    std::fprintf(stderr,
-                 "cpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g\n",
-                 depth, light.triangle, scene.bvh.triangles[light.triangle].primitive, lightPdf,
-                 weight);
+    std::fprintf(
+        stderr, "cpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g\n",
+        depth, light.triangle, scene.bvh.triangles[light.triangle].primitive, lightPdf, weight);
   }
 }
 
@@ -94,8 +93,9 @@ void printLightSample(const SceneData& scene, const LightPoint& light, float lig
 // along n, or with shading normals (n then interpolated) on the side of the geometric normal
 // ng that the light is on.
 vec3 sampleDirectLight(const SceneData& scene, const CpuSceneCopies& copies, vec3 p, vec3 n,
-                       vec3 ng, bool shadingNormals, float magnitude, vec3 beta, vec3 f, vec2 uChoose, vec2 uLight, bool misOn,
-                       Intersection test, uint64_t& rays, bool debugPrint, uint depth) {
+                       vec3 ng, bool shadingNormals, float magnitude, vec3 beta, vec3 f,
+                       vec2 uChoose, vec2 uLight, bool misOn, Intersection test, uint64_t& rays,
+                       bool debugPrint, uint depth) {
   // Pick an emitter from the alias table, then a uniform point on its triangle.
   const LightPoint light = pickLightPoint(scene, copies, uChoose, uLight);
 
@@ -249,11 +249,11 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
       const vec3 woLocal = toLocal(frame, wo);
       // Sample direct illumination from an emitter, unless the BSDF has only delta lobes.
       if (neeOn && bsdfHasNonSpecular(material)) {
-        L += sampleDirectLightBsdf(
-            scene, copies, p, ng, frame, material, woLocal, magnitude, beta, u.lightChoose,
-            u.lightPoint, makeRandomStream(pixel, sampleIndex, dim, seed, kStreamEval),
-            makeRandomStream(pixel, sampleIndex, dim, seed, kStreamLightPdf), misOn, test, rays,
-            debugPrint, depth);
+        L += sampleDirectLightBsdf(scene, copies, p, ng, frame, material, woLocal, magnitude, beta,
+                                   u.lightChoose, u.lightPoint,
+                                   makeRandomStream(pixel, sampleIndex, dim, seed, kStreamEval),
+                                   makeRandomStream(pixel, sampleIndex, dim, seed, kStreamLightPdf),
+                                   misOn, test, rays, debugPrint, depth);
       }
       // Sample the BSDF; the lobe choice takes the roulette dimension's second number.
       const BsdfSample bs =

@@ -1,0 +1,44 @@
+// Materials of bsdf.h's types as the scene reader fills them (struct Material, alphas already
+// remapped), for the tests.
+#pragma once
+
+#include "common/shared.h"
+
+namespace pt::test {
+
+inline Material conductor(float alphaX, float alphaY, vec3 eta = vec3(0.2f, 0.92f, 1.1f),
+                          vec3 k = vec3(3.9f, 2.45f, 2.14f)) {
+  Material m{};
+  m.type = kMaterialConductor;
+  m.alphaX = alphaX;
+  m.alphaY = alphaY;
+  m.eta = eta;
+  m.k = k;
+  return m;
+}
+// eta 0, k 1: Fresnel reflectance exactly 1 at every angle (a lossless ideal conductor).
+inline Material whiteConductor(float alphaX, float alphaY) {
+  return conductor(alphaX, alphaY, vec3(0.0f), vec3(1.0f));
+}
+inline Material dielectric(float alphaX, float alphaY, float eta) {
+  Material m{};
+  m.type = kMaterialDielectric;
+  m.alphaX = alphaX;
+  m.alphaY = alphaY;
+  m.eta = vec3(eta);
+  return m;
+}
+inline Material thinDielectric(float eta) {
+  Material m{};
+  m.type = kMaterialThinDielectric;
+  m.eta = vec3(eta);
+  return m;
+}
+inline Material diffuseTransmission(vec3 r, vec3 t) {
+  Material m{};
+  m.type = kMaterialDiffuseTransmission;
+  m.reflectance = r;
+  m.transmittance = t;
+  return m;
+}
+}  // namespace pt::test
