@@ -20,19 +20,6 @@
 #include "chi2.h"
 #include "test_materials.h"
 
-// Sanitized builds (ASan + UBSan at -O1) and unoptimized ones run the sampling tests on fewer
-// samples: the chi-square tests keep their significance, they only lose some power.
-#if defined(__SANITIZE_ADDRESS__)
-#define PT_BSDF_TEST_SLOW 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define PT_BSDF_TEST_SLOW 1
-#endif
-#endif
-#if !defined(PT_BSDF_TEST_SLOW) && !defined(__OPTIMIZE__)
-#define PT_BSDF_TEST_SLOW 1
-#endif
-
 namespace pt {
 namespace {
 

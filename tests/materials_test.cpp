@@ -241,7 +241,12 @@ TEST(MaterialsFurnace, LightSamplingAgreesWithBsdfSampling) {
       settings.strategy = strategy;
       const SceneData data = prepareScene(scene, settings);
       Film film(32, 32);
-      const RenderStats stats = renderCpu(data, test::cpuOptions(2, 512), film);
+#ifdef PT_BSDF_TEST_SLOW
+      constexpr int kSpp = 64;
+#else
+      constexpr int kSpp = 512;
+#endif
+      const RenderStats stats = renderCpu(data, test::cpuOptions(2, kSpp), film);
       EXPECT_EQ(stats.invalidSamples, 0u);
       images[i++] = film.resolve();
     }
