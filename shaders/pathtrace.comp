@@ -112,10 +112,10 @@ Material loadMaterial(uint i) {
     e = texelFetch(materialTexels, at + 4);
     f = texelFetch(materialTexels, at + 5);
   }
-  return Material(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
-                  uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.xyz),
-                  uintBitsToFloat(d.w), uintBitsToFloat(e.xyz), uintBitsToFloat(e.w),
-                  uintBitsToFloat(f.x), f.y, f.z, f.w);
+  return Material(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w, uintBitsToFloat(c.xyz),
+                  uintBitsToFloat(c.w), uintBitsToFloat(d.xyz), uintBitsToFloat(d.w),
+                  uintBitsToFloat(e.xyz), uintBitsToFloat(e.w), uintBitsToFloat(f.x), f.y, f.z,
+                  f.w);
 }
 
 #ifndef PT_NO_BSDF_MATERIALS
@@ -152,7 +152,7 @@ struct Retrace {
 // A uniform point on an emitter chosen from the alias table with uChoose (uLight: the point).
 struct LightPoint {
   vec3 point;
-  vec3 normal;      // the emitter's unit geometric normal (it emits on this side)
+  vec3 normal;  // the emitter's unit geometric normal (it emits on this side)
   float area;
   float magnitude;  // for the ray offset at the light
   float pmf;        // probability of choosing this emitter
@@ -193,8 +193,7 @@ uint traceShadowRay(vec3 from, LightPoint light, out vec3 direction) {
 
 // A clear shadow ray's contribution, or zero with `retrace` set to add it once the ray has been
 // traced again.
-vec3 addOrDefer(uint shadow, vec3 from, vec3 direction, vec3 contribution,
-                inout Retrace retrace) {
+vec3 addOrDefer(uint shadow, vec3 from, vec3 direction, vec3 contribution, inout Retrace retrace) {
   if (shadow != kShadowRetrace) return contribution;
   retrace = Retrace(true, true, from, direction, contribution);
   return vec3(0.0);
@@ -216,8 +215,9 @@ void debugLightSample(uint depth, LightPoint light, float lightPdf, float weight
 // sampling when misOn; zero when the point faces away or is occluded, and zero with `retrace`
 // set when the shadow ray is to be traced again. The shadow ray leaves along n, or with
 // shading normals (n then interpolated) on the side of the geometric normal ng the light is on.
-vec3 sampleDirectLight(vec3 p, vec3 n, vec3 ng, bool shadingNormals, float magnitude, vec3 beta, vec3 f, vec2 uChoose,
-                       vec2 uLight, bool misOn, uint depth, inout Retrace retrace) {
+vec3 sampleDirectLight(vec3 p, vec3 n, vec3 ng, bool shadingNormals, float magnitude, vec3 beta,
+                       vec3 f, vec2 uChoose, vec2 uLight, bool misOn, uint depth,
+                       inout Retrace retrace) {
   // Pick an emitter from the alias table, then a uniform point on its triangle.
   LightPoint light = pickLightPoint(uChoose, uLight);
 
@@ -247,8 +247,8 @@ vec3 sampleDirectLight(vec3 p, vec3 n, vec3 ng, bool shadingNormals, float magni
 // ray leaves from the side of the geometric normal ng the light is on.
 vec3 sampleDirectLightBsdf(vec3 p, vec3 ng, ShadingFrame frame, Material material, vec3 wo,
                            float magnitude, vec3 beta, vec2 uChoose, vec2 uLight,
-                           RandomStream evalStream, RandomStream pdfStream, bool misOn,
-                           uint depth, inout Retrace retrace) {
+                           RandomStream evalStream, RandomStream pdfStream, bool misOn, uint depth,
+                           inout Retrace retrace) {
   LightPoint light = pickLightPoint(uChoose, uLight);
   vec3 toLight = light.point - p;
   float dist2 = dot(toLight, toLight);
@@ -414,13 +414,13 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
     vec3 woLocal = toLocal(frame, wo);
     // Sample direct illumination from an emitter, unless the BSDF has only delta lobes.
     if (neeOn() && bsdfHasNonSpecular(material)) {
-      path.L += sampleDirectLightBsdf(
-          p, ng, frame, material, woLocal, magnitude, path.beta,
-          random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
-          random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
-          makeRandomStream(pixel, sampleIndex, dim, seed, kStreamEval),
-          makeRandomStream(pixel, sampleIndex, dim, seed, kStreamLightPdf), misOn(), path.depth,
-          retrace);
+      path.L +=
+          sampleDirectLightBsdf(p, ng, frame, material, woLocal, magnitude, path.beta,
+                                random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
+                                random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
+                                makeRandomStream(pixel, sampleIndex, dim, seed, kStreamEval),
+                                makeRandomStream(pixel, sampleIndex, dim, seed, kStreamLightPdf),
+                                misOn(), path.depth, retrace);
     }
     // Sample the BSDF; the lobe choice takes the roulette dimension's second number.
     BsdfSample bs = bsdfSample(material, woLocal,

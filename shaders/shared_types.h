@@ -86,12 +86,12 @@ struct Triangle {
 
 // Material types. Diffuse and mirror are the seed's; the rest follow pbrt-v4's materials of
 // the same names (its parameters, its definitions: shaders/bsdf.h).
-PT_CONST uint kMaterialDiffuse = 0u;  // ideal Lambertian, BRDF = reflectance / pi, two-sided
-PT_CONST uint kMaterialMirror = 1u;   // ideal specular reflection, no Fresnel, two-sided
-PT_CONST uint kMaterialConductor = 2u;    // metal: complex Fresnel, smooth or Trowbridge-Reitz
-PT_CONST uint kMaterialDielectric = 3u;   // glass: reflection and refraction, smooth or rough
-PT_CONST uint kMaterialThinDielectric = 4u;        // a pane: reflection, straight transmission
-PT_CONST uint kMaterialDiffuseTransmission = 5u;   // Lambertian reflection and transmission
+PT_CONST uint kMaterialDiffuse = 0u;         // ideal Lambertian, BRDF = reflectance / pi, two-sided
+PT_CONST uint kMaterialMirror = 1u;          // ideal specular reflection, no Fresnel, two-sided
+PT_CONST uint kMaterialConductor = 2u;       // metal: complex Fresnel, smooth or Trowbridge-Reitz
+PT_CONST uint kMaterialDielectric = 3u;      // glass: reflection and refraction, smooth or rough
+PT_CONST uint kMaterialThinDielectric = 4u;  // a pane: reflection, straight transmission
+PT_CONST uint kMaterialDiffuseTransmission = 5u;  // Lambertian reflection and transmission
 PT_CONST uint kMaterialCoatedDiffuse = 6u;  // dielectric coat over a Lambertian base (layered)
 PT_CONST uint kMaterialTypeCount = 7u;
 

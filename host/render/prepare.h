@@ -51,8 +51,8 @@ struct RenderSettings {
 
 // Which effects the scene calls for; the rest are compiled or switched out.
 struct EffectSet {
-  bool diffuse = false;        // some surface is Lambertian with non-zero reflectance
-  bool mirror = false;         // some surface is an ideal mirror
+  bool diffuse = false;  // some surface is Lambertian with non-zero reflectance
+  bool mirror = false;   // some surface is an ideal mirror
   // The material types of shaders/bsdf.h that some surface has.
   bool conductor = false;
   bool dielectric = false;
@@ -60,12 +60,12 @@ struct EffectSet {
   bool diffuseTransmission = false;
   bool coatedDiffuse = false;
   bool shadingNormals = false;  // some mesh has vertex normals: shading normals interpolated
-  bool lightSampling = false;  // next-event estimation (needs emitters, a diffuse surface)
-  bool bsdfEmission = false;   // emission found by BSDF-sampled rays is counted (MIS/BSDF)
-  bool mis = false;            // both of the above, weighed by the power heuristic
+  bool lightSampling = false;   // next-event estimation (needs emitters, a diffuse surface)
+  bool bsdfEmission = false;    // emission found by BSDF-sampled rays is counted (MIS/BSDF)
+  bool mis = false;             // both of the above, weighed by the power heuristic
   bool russianRoulette = false;
-  bool watertight = true;        // false: the faster, leaky Moller-Trumbore test
-  bool sobol = false;            // Owen-scrambled Sobol numbers instead of independent ones
+  bool watertight = true;  // false: the faster, leaky Moller-Trumbore test
+  bool sobol = false;      // Owen-scrambled Sobol numbers instead of independent ones
   bool hasBsdfMaterials() const {
     return conductor || dielectric || thinDielectric || diffuseTransmission || coatedDiffuse;
   }

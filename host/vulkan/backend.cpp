@@ -11,9 +11,9 @@
 #include <cstring>
 
 #include "common/check.h"
+#include "pathtrace_base_spv.h"   // kPathtraceBaseSpv: the same without bsdf.h's materials
 #include "pathtrace_debug_spv.h"  // kPathtraceDebugSpv: the same shader with debugPrintfEXT
 #include "pathtrace_spv.h"        // kPathtraceSpv: SPIR-V compiled at build time
-#include "pathtrace_base_spv.h"   // kPathtraceBaseSpv: the same without bsdf.h's materials
 #include "vulkan/context.h"
 #include "vulkan/gpu_bvh.h"
 #include "vulkan/resources.h"
@@ -69,8 +69,8 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       {"vertex normal", normals.data(), normals.size() * sizeof(TriangleNormals), true},
   };
   static_assert(PT_BINDING_PARAMS == 0 && PT_BINDING_NODES == 1 && PT_BINDING_TRIANGLES == 2 &&
-                PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 &&
-                PT_BINDING_NORMALS == 5 && PT_BINDING_ACCUM == 6 && PT_BINDING_COUNTERS == 7);
+                PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 && PT_BINDING_NORMALS == 5 &&
+                PT_BINDING_ACCUM == 6 && PT_BINDING_COUNTERS == 7);
   static_assert(std::size(uploads) + 2 == PT_BINDING_COUNT, "every binding is a buffer");
 
   // Every size is checked before anything is allocated: a scene too large for the device is
@@ -101,13 +101,12 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   const EffectSet& fx = scene.effects;
   const bool all = !options.specialize;
   const RenderParams& params = scene.params;
-  const SpecData spec{{all || fx.diffuse, all || fx.mirror, all || fx.lightSampling,
-                       all || fx.bsdfEmission, all || fx.mis, all || fx.russianRoulette,
-                       all ? kSpecAtRunTime : params.fastIntersection,
-                       all ? kSpecAtRunTime : params.samplerType, buffers.stackRows,
-                       all || fx.conductor, all || fx.dielectric, all || fx.thinDielectric,
-                       all || fx.diffuseTransmission, all || fx.coatedDiffuse,
-                       all || fx.shadingNormals}};
+  const SpecData spec{
+      {all || fx.diffuse, all || fx.mirror, all || fx.lightSampling, all || fx.bsdfEmission,
+       all || fx.mis, all || fx.russianRoulette, all ? kSpecAtRunTime : params.fastIntersection,
+       all ? kSpecAtRunTime : params.samplerType, buffers.stackRows, all || fx.conductor,
+       all || fx.dielectric, all || fx.thinDielectric, all || fx.diffuseTransmission,
+       all || fx.coatedDiffuse, all || fx.shadingNormals}};
   static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
                 PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
                 PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
@@ -127,10 +126,10 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   // The variant without bsdf.h's materials where the scene needs none of them (the same
   // image: it is the full shader with those effects switched off before compiling).
   const bool full = all || fx.hasBsdfMaterials() || fx.shadingNormals;
-  const std::span<const uint32_t> spirv =
-      options.context.debugPrintf ? std::span<const uint32_t>(kPathtraceDebugSpv)
-      : full                      ? std::span<const uint32_t>(kPathtraceSpv)
-                                  : std::span<const uint32_t>(kPathtraceBaseSpv);
+  const std::span<const uint32_t> spirv = options.context.debugPrintf
+                                              ? std::span<const uint32_t>(kPathtraceDebugSpv)
+                                          : full ? std::span<const uint32_t>(kPathtraceSpv)
+                                                 : std::span<const uint32_t>(kPathtraceBaseSpv);
   return makeComputeProgram(ctx, spirv, bound, sizeof(PassConstants), &specInfo);
 }
 
