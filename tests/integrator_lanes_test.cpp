@@ -26,7 +26,8 @@ struct Case {
 std::vector<Case> cases() {
   const RenderSettings small{.width = 20, .height = 14};
   std::vector<Case> list;
-  for (const char* config : {"cornell-box.json", "cornell-mirror.json", "bunny-box.json"}) {
+  for (const char* config : {"cornell-box.json", "cornell-mirror.json", "bunny-box.json",
+                             "cornell-materials.json", "veach-mis.json"}) {
     list.push_back({config, small});
   }
   auto variant = [&](auto&& change) {

@@ -146,6 +146,43 @@ vec3 sampleDirectLightBsdf(const SceneData& scene, const CpuSceneCopies& copies,
 
 }  // namespace
 
+bool scatterAtBsdfVertex(const SceneData& scene, const BsdfVertex& v, PathState& state, vec3& wi,
+                         vec3& side, uint64_t& rays, bool debugPrint) {
+  const CpuSceneCopies& copies = scene.cpuCopies();
+  const RenderParams& params = scene.params;
+  const Material& material = *v.material;
+  const bool misOn = params.strategy == kStrategyMis;
+  const bool neeOn = params.strategy != kStrategyBsdf && params.emitterCount > 0;
+  const Intersection test =
+      params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
+  auto stream = [&](uint purpose) {
+    return makeRandomStream(v.pixel, v.sampleIndex, v.dim, params.seed, purpose);
+  };
+  // The shading frame about the shading normal, not turned towards the ray: a dielectric
+  // tells inside from outside by it.
+  const ShadingFrame frame = makeShadingFrame(v.ns, v.triangle->v1 - v.triangle->v0);
+  const vec3 wo = toLocal(frame, v.wo);
+  // Sample direct illumination from an emitter, unless the BSDF has only delta lobes.
+  if (neeOn && bsdfHasNonSpecular(material)) {
+    state.L +=
+        sampleDirectLightBsdf(scene, copies, v.p, v.ng, frame, material, wo, v.magnitude,
+                              state.beta, v.u.lightChoose, v.u.lightPoint, stream(kStreamEval),
+                              stream(kStreamLightPdf), misOn, test, rays, debugPrint, v.depth);
+  }
+  // Sample the BSDF; the lobe choice takes the roulette dimension's second number.
+  const BsdfSample bs = bsdfSample(material, wo, v.u.roulette.y, v.u.bsdf, stream(kStreamSample));
+  if (bs.flags == 0u) return false;
+  wi = fromLocal(frame, bs.wi);
+  state.beta *= bs.f * (absCosTheta(bs.wi) / bs.pdf);
+  state.specularBounce = (bs.flags & kBsdfSpecular) != 0u;
+  state.bsdfPdf =
+      bs.pdfIsProportional ? bsdfPdf(material, wo, bs.wi, stream(kStreamSamplePdf)) : bs.pdf;
+  if ((bs.flags & kBsdfTransmission) != 0u) state.etaScale *= bs.eta * bs.eta;
+  // The new ray leaves from the side it goes to.
+  side = dot(v.ng, wi) > 0.0f ? v.ng : -v.ng;
+  return true;
+}
+
 Ray cameraRay(const Camera& cam, vec2 filmPoint) {
   return Ray{cam.position, cameraDirection(cam, filmPoint)};
 }
@@ -243,33 +280,17 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
       beta *= material.reflectance;
       specularBounce = true;
     } else if (material.type != kMaterialDiffuse) {
-      // One of bsdf.h's BSDFs, in the shading frame about the shading normal (not turned
-      // towards the ray: a dielectric tells inside from outside by it).
-      const ShadingFrame frame = makeShadingFrame(ns, tri.v1 - tri.v0);
-      const vec3 woLocal = toLocal(frame, wo);
-      // Sample direct illumination from an emitter, unless the BSDF has only delta lobes.
-      if (neeOn && bsdfHasNonSpecular(material)) {
-        L += sampleDirectLightBsdf(scene, copies, p, ng, frame, material, woLocal, magnitude, beta,
-                                   u.lightChoose, u.lightPoint,
-                                   makeRandomStream(pixel, sampleIndex, dim, seed, kStreamEval),
-                                   makeRandomStream(pixel, sampleIndex, dim, seed, kStreamLightPdf),
-                                   misOn, test, rays, debugPrint, depth);
-      }
-      // Sample the BSDF; the lobe choice takes the roulette dimension's second number.
-      const BsdfSample bs =
-          bsdfSample(material, woLocal, u.roulette.y, u.bsdf,
-                     makeRandomStream(pixel, sampleIndex, dim, seed, kStreamSample));
-      if (bs.flags == 0u) break;
-      wi = fromLocal(frame, bs.wi);
-      beta *= bs.f * (absCosTheta(bs.wi) / bs.pdf);
-      specularBounce = (bs.flags & kBsdfSpecular) != 0u;
-      bsdfPdf = bs.pdfIsProportional
-                    ? pt::bsdfPdf(material, woLocal, bs.wi,
-                                  makeRandomStream(pixel, sampleIndex, dim, seed, kStreamSamplePdf))
-                    : bs.pdf;
-      if ((bs.flags & kBsdfTransmission) != 0u) etaScale *= bs.eta * bs.eta;
-      // The new ray leaves from the side it goes to.
-      n = dot(ng, wi) > 0.0f ? ng : -ng;
+      // One of bsdf.h's BSDFs: light sampling and BSDF sampling in its shading frame.
+      PathState state{L, beta, etaScale, bsdfPdf, specularBounce};
+      const BsdfVertex vertex{&tri,      &material, p,     ng,          ns,  wo,
+                              magnitude, u,         pixel, sampleIndex, dim, depth};
+      const bool goesOn = scatterAtBsdfVertex(scene, vertex, state, wi, n, rays, debugPrint);
+      L = state.L;
+      beta = state.beta;
+      etaScale = state.etaScale;
+      bsdfPdf = state.bsdfPdf;
+      specularBounce = state.specularBounce;
+      if (!goesOn) break;
     } else {
       const vec3 f = material.reflectance * kInvPi;
       // Sample direct illumination from an emitter (next-event estimation).

@@ -35,6 +35,41 @@ Ray cameraRay(const Camera& camera, vec2 filmPoint);
 vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
                     bool debugPrint = false);
 
+// The path's state that a scattering event updates (sampleRadiance's variables of the same
+// names).
+struct PathState {
+  vec3 L;               // radiance gathered so far
+  vec3 beta;            // path throughput
+  float etaScale;       // product of the squared relative indices refracted through
+  float bsdfPdf;        // solid-angle pdf of the BSDF sample that produced the next ray
+  bool specularBounce;  // the next ray leaves a specular bounce
+};
+
+// A path vertex on one of bsdf.h's materials (not diffuse or mirror), and what its scattering
+// event needs: the hit triangle and point, the geometric normal ng, the shading normal ns, the
+// direction towards the viewer wo, the ray offsets' scale, this event's random numbers (u) and
+// the coordinates of its random streams (pixel, sample, dimension).
+struct BsdfVertex {
+  const Triangle* triangle;
+  const Material* material;
+  vec3 p, ng, ns, wo;
+  float magnitude;
+  BounceRandom u;
+  uvec2 pixel;
+  uint32_t sampleIndex;
+  uint dim;
+  uint depth;  // scattering events so far, this one included (for --debug-pixel)
+};
+
+// The scattering event at such a vertex, sampleRadiance's steps: light sampling with the
+// BSDF's f and pdf (unless it has only delta lobes), then BSDF sampling. Adds the light's
+// contribution to state.L, updates beta, etaScale, bsdfPdf and specularBounce, and returns
+// the new direction in wi with the geometric normal on its side (where the next ray starts) in
+// side; false when the path ends (no direction). sampleRadianceLanes runs it lane by lane, so
+// both give the same bits.
+bool scatterAtBsdfVertex(const SceneData& scene, const BsdfVertex& v, PathState& state, vec3& wi,
+                         vec3& side, uint64_t& rays, bool debugPrint);
+
 // Renders into film (which must have the camera's resolution), adding spp samples per pixel
 // in passes of one sample index each; stopped early (options.stop), it adds whole passes
 // only, stats.samplesDone of them. Uses every CPU the process may run on unless told.

@@ -312,6 +312,7 @@ struct Paths {
   Lanes3 origin, direction;                  // `ray`
   Lanes3 L, beta;
   Lanes bsdfPdf;
+  Lanes etaScale;         // squared relative indices refracted through (bsdf.h's materials)
   uint32_t specular = 0;  // bits: specularBounce
 };
 
@@ -366,7 +367,9 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   Lanes t, hitEmitterPmf;
   Lanes3 bary, reflectance, emission;
   TriangleLanes hitTriangle, lightTriangle;
-  Lanes uLightChooseX, uLightChooseY, uLightX, uLightY, uBsdfX, uBsdfY, uRoulette;
+  Lanes uLightChooseX, uLightChooseY, uLightX, uLightY, uBsdfX, uBsdfY, uRoulette, uRouletteY;
+  uint32_t hitIndex[kMaxLanes] = {};  // the hit triangle (Bvh::triangles)
+  Lanes3 shadingPoint, wiOther, sideOther;
   Lanes3 lightEmission, shadowFrom, shadowDir;
   Lanes lightPmf;
   RayPrecomputed prepared[kMaxLanes];
@@ -389,6 +392,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       path.L.set(i, vec3(0.0f));
       path.beta.set(i, vec3(1.0f));
       path.bsdfPdf.v[i] = 0.0f;
+      path.etaScale.v[i] = 1.0f;
       path.specular |= 1u << i;
       starting |= 1u << i;
     }
@@ -410,6 +414,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
     uint32_t live = 0;      // lanes whose path goes on through this step
     uint32_t emitting = 0;  // hit lanes whose triangle is an emitter
     uint32_t mirror = 0;    // hit lanes on a mirror
+    uint32_t other = 0;     // hit lanes on one of bsdf.h's materials
     uint32_t nonBlack = 0;  // hit lanes whose reflectance is not 0
     uint32_t degenerate = 0;
     const uint32_t enters =
@@ -441,7 +446,9 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
         emitting |= 1u << i;
         hitEmitterPmf.v[i] = scene.emitters[tri.emitter].pmf;
       }
+      hitIndex[i] = hit->triangle;
       mirror |= uint32_t(material.type == kMaterialMirror) << i;
+      other |= uint32_t(material.type != kMaterialMirror && material.type != kMaterialDiffuse) << i;
       nonBlack |= uint32_t(material.reflectance != vec3(0.0f)) << i;
     });
 
@@ -492,13 +499,13 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
                 &uLightChooseY);
     drawRandom2(sobol, path, sampleIndex, kDimLightPoint, seed, live, uLightX, &uLightY);
     drawRandom2(sobol, path, sampleIndex, kDimBsdf, seed, live, uBsdfX, &uBsdfY);
-    drawRandom2(sobol, path, sampleIndex, kDimRoulette, seed, live, uRoulette, nullptr);
+    drawRandom2(sobol, path, sampleIndex, kDimRoulette, seed, live, uRoulette, &uRouletteY);
 
     // Both materials are two-sided: shade with the normal facing the incoming ray.
     const V3 n = select(hn::Ge(cosOut, zero), ngv, -ngv);
     const V3 refl = load(reflectance);
     const V mag = hitTriangle.magnitude.load();
-    const uint32_t diffuse = live & ~mirror;
+    const uint32_t diffuse = live & ~mirror & ~other;
 
     // Mirror: ideal reflection.
     const V3 wiMirror = dir - hn::Mul(splat(2.0f), dot(dir, n)) * n;
@@ -562,16 +569,59 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       }
     }
 
+    // bsdf.h's materials: the reference's scattering event (scatterAtBsdfVertex), lane by
+    // lane, on the path state as the lanes hold it.
+    uint32_t otherSpecular = 0;
+    if ((live & other) != 0) {
+      store(path.L, L);
+      store(path.beta, beta);
+      store(shadingPoint, p);
+      forEachLane(live & other, [&](size_t i) {
+        const Triangle& tri = bvh.triangles[hitIndex[i]];
+        const vec3 ng = hitTriangle.normal.get(i);
+        const BounceRandom u{vec2(uLightChooseX.v[i], uLightChooseY.v[i]),
+                             vec2(uLightX.v[i], uLightY.v[i]), vec2(uBsdfX.v[i], uBsdfY.v[i]),
+                             vec2(uRoulette.v[i], uRouletteY.v[i])};
+        const BsdfVertex vertex{&tri,
+                                &scene.materials[tri.material],
+                                shadingPoint.get(i),
+                                ng,
+                                ng,
+                                -path.direction.get(i),
+                                hitTriangle.magnitude.v[i],
+                                u,
+                                uvec2(path.pixelX[i], path.pixelY[i]),
+                                sampleIndex,
+                                path.dim[i],
+                                path.depth[i]};
+        PathState state{path.L.get(i), path.beta.get(i), path.etaScale.v[i], path.bsdfPdf.v[i],
+                        (path.specular >> i & 1u) != 0u};
+        vec3 wi, side;
+        if (!scatterAtBsdfVertex(scene, vertex, state, wi, side, rays, /*debugPrint=*/false)) {
+          live &= ~(1u << i);
+        }
+        path.L.set(i, state.L);
+        path.beta.set(i, state.beta);
+        path.etaScale.v[i] = state.etaScale;
+        path.bsdfPdf.v[i] = state.bsdfPdf;
+        otherSpecular |= uint32_t(state.specularBounce) << i;
+        wiOther.set(i, wi);
+        sideOther.set(i, side);
+      });
+      L = load(path.L);
+    }
+
     // Diffuse: sample the BSDF, cosine-weighted (f * cos / pdf = reflectance); a direction in
     // the tangent plane contributes nothing and ends the path.
     const V3 wiDiffuse = localToWorld(sampleCosineHemisphere(uBsdfX.load(), uBsdfY.load()), n);
     const V pdf = hn::Mul(dot(wiDiffuse, n), splat(kInvPi));
     live &= ~(diffuse & ~bits(hn::Gt(pdf, zero)));
     const M isMirror = mask(mirror);
-    const V3 wi = select(isMirror, wiMirror, wiDiffuse);
-    path.bsdfPdf.store(hn::IfThenElse(isMirror, path.bsdfPdf.load(), pdf));
-    path.specular = mirror;
-    beta = beta * refl;
+    const M isOther = mask(other);
+    const V3 wi = select(isOther, load(wiOther), select(isMirror, wiMirror, wiDiffuse));
+    path.bsdfPdf.store(hn::IfThenElse(mask(mirror | other), path.bsdfPdf.load(), pdf));
+    path.specular = mirror | otherSpecular;
+    beta = select(isOther, load(path.beta), beta * refl);
     live &= ~bits(hn::Le(maxComponent(beta), zero));
 
     // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
@@ -580,14 +630,15 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
           live & ~bits(hn::RebindMask(
                      d, hn::Lt(hn::Load(du, path.depth), hn::Set(du, params.rrStartDepth))));
       if (roulette != 0) {
-        const V q = glmMax(zero, hn::Sub(splat(1.0f), maxComponent(beta)));
+        // beta * etaScale (etaScale is 1 but after refractions).
+        const V q = glmMax(zero, hn::Sub(splat(1.0f), maxComponent(path.etaScale.load() * beta)));
         live &= ~(roulette & bits(hn::Lt(uRoulette.load(), q)));
         beta = select(mask(roulette), beta / hn::Sub(splat(1.0f), q), beta);
       }
     }
 
     // Leave the surface on the side of the new direction.
-    store(path.origin, offsetRayOrigin(p, n, mag));
+    store(path.origin, offsetRayOrigin(p, select(isOther, load(sideOther), n), mag));
     store(path.direction, wi);
     store(path.L, L);
     store(path.beta, beta);
@@ -613,10 +664,9 @@ HWY_EXPORT(sampleRadianceLanesImpl);
 
 void sampleRadianceLanes(const SceneData& scene, const uvec2* pixels, size_t count,
                          uint32_t sampleIndex, vec3* out, uint64_t& rays) {
-  // The lanes transcribe diffuse and mirror surfaces about the geometric normal only; a scene
-  // with bsdf.h's materials or shading normals takes the reference path by path (the same
-  // results by definition).
-  if (scene.effects.hasBsdfMaterials() || scene.effects.shadingNormals) {
+  // The lanes shade about the geometric normal only; a scene with shading normals takes the
+  // reference path by path (the same results by definition).
+  if (scene.effects.shadingNormals) {
     for (size_t i = 0; i < count; ++i) out[i] = sampleRadiance(scene, pixels[i], sampleIndex, rays);
     return;
   }
