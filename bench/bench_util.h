@@ -26,7 +26,7 @@ inline double median(std::vector<double> values) {
 
 // A unit UV sphere about the origin: `rings` bands of latitude, `segments` of longitude, two
 // triangles per quad and one per quad at the poles: 2 * segments * (rings - 1) triangles,
-// 1,051,200 for uvSphere(726, 725). Triangles carry material `material`, no emitter, and
+// 1,051,250 for uvSphere(726, 725). Triangles carry material `material`, no emitter, and
 // their index as primitive.
 inline std::vector<Triangle> uvSphere(int rings, int segments, uint material = 0) {
   auto vertex = [&](int ring, int segment) {

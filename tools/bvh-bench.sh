@@ -1,8 +1,14 @@
 #!/usr/bin/env bash
 # BVH build benchmark: builds bench/bvh_build_bench (needs Embree 3: tools/setup.sh) and runs
-# it on the generated sphere, the bunny and the dragon. Build times are medians of RUNS runs
-# next to Embree's own build in the same run; also SAH costs and CPU trace speed. Then the
-# seed's scene through `pt`: load time, build time, SAH cost and time to an image per builder.
+# it on the generated sphere, the bunny and the dragon. Build times are medians of RUNS runs,
+# ours warm (repeated builds in one process) and cold (a fresh process per build, as `pt
+# render` builds), with the CPU backend's collapse to the wide tree, next to Embree's build in
+# the same run timed as Embree's authors time it (shared vertices, rtcCommitScene alone, after
+# a warm-up build) and next to Embree's own `buildbench` (embree-tools) on the same mesh files,
+# which bvh_build_bench runs once per run and parses (see runBuildbench there); also SAH costs
+# and CPU trace speed. Then the seed's scene through `pt`: load time, build time, SAH cost and
+# time to an image per builder. The date and the load average before and after say how busy
+# the machine was (the ratios move with it).
 #   tools/bvh-bench.sh [DRAGON_PLY]     (default assets/dragon_vrip.ply: tools/fetch-assets.sh)
 # Environment: BUILD (build directory, default build), RUNS (default 5), RAYS (default 200000),
 # SEED_SPP (samples per pixel of the seed scene's renders, default 16), SKIP_BENCH=1 (only the
@@ -13,12 +19,23 @@ build=${BUILD:-build}
 dragon=${1:-assets/dragon_vrip.ply}
 [ -f "$build/build.ninja" ] || cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release
 if ! cmake --build "$build" --target bvh_build_bench pt; then
-  echo "bvh-bench: bvh_build_bench not built (CMake builds it only where Embree 3 is found:" \
-    "libembree-dev)" >&2
+  echo "bvh-bench: bvh_build_bench or pt not built (see above; CMake builds bvh_build_bench" \
+    "only where Embree 3 is found: libembree-dev)" >&2
   exit 1
 fi
+printf 'bvh-bench: %s, %s cores, load average before: %s\n' "$(date -u '+%Y-%m-%d %H:%M UTC')" \
+  "$(nproc)" "$(cut -d' ' -f1-3 /proc/loadavg)"
 if [ -z "${SKIP_BENCH:-}" ]; then
-  "$build/bench/bvh_build_bench" --dragon "$dragon" --runs "${RUNS:-5}" --rays "${RAYS:-200000}"
+  buildbench=()
+  if command -v buildbench >/dev/null; then
+    buildbench=(--buildbench "$(command -v buildbench)")
+  else
+    echo "bvh-bench: Embree's buildbench not found (embree-tools): its column stays empty" >&2
+  fi
+  "$build/bench/bvh_build_bench" --dragon "$dragon" --runs "${RUNS:-5}" --rays "${RAYS:-200000}" \
+    "${buildbench[@]}"
+  printf 'bvh-bench: load average after the build benchmark: %s\n' \
+    "$(cut -d' ' -f1-3 /proc/loadavg)"
 fi
 
 # The seed's scene through `pt` itself, per builder: load time (PLY dragon + OBJ bunny), build
@@ -54,3 +71,4 @@ for b in "${builders[@]}"; do
   printf '%-6s %8s %10s %10s %12s %10s %14s\n' "$b" "$load" "$build_s" "$sah" "$render" "$mrays" \
     "$total"
 done
+printf 'bvh-bench: load average at the end: %s\n' "$(cut -d' ' -f1-3 /proc/loadavg)"
