@@ -122,12 +122,41 @@ Outcome fuzzImage(const std::uint8_t* data, std::size_t size) {
   return guarded([&] { readImage(path); });
 }
 
+// A pbrt-v4 scene through loadScene, as `pt render scene.pbrt` reads it, with "mesh.ply" to
+// include; an accepted scene must keep the Scene's promises (the renderer relies on them).
+Outcome fuzzPbrt(const std::uint8_t* data, std::size_t size) {
+  const fs::path path = workDir() / "scene.pbrt";
+  writeFile(path, data, size);
+  return guarded([&] {
+    const Scene scene = loadScene(path);
+    PT_CHECK(!scene.triangles.empty(), "pbrt: a scene without triangles accepted");
+    PT_CHECK(scene.normals.empty() || scene.normals.size() == scene.triangles.size(),
+             "pbrt: normals not parallel to the triangles");
+    PT_CHECK(scene.materials.size() == scene.materialNames.size(), "pbrt: material names");
+    for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
+      const Triangle& t = scene.triangles[i];
+      PT_CHECK(t.material < scene.materials.size() && t.primitive == i,
+               "pbrt: triangle with a bad material or primitive index");
+      for (const vec3& v : {t.v0, t.v1, t.v2}) {
+        PT_CHECK(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z),
+                 "pbrt: non-finite vertex accepted");
+      }
+    }
+    for (const Material& m : scene.materials) {
+      PT_CHECK(std::isfinite(m.emission.x + m.emission.y + m.emission.z) && m.emission.x >= 0 &&
+                   m.emission.y >= 0 && m.emission.z >= 0,
+               "pbrt: bad emission accepted");
+    }
+    PT_CHECK(scene.camera.width >= 1 && scene.camera.height >= 1 &&
+                 scene.camera.vfovDegrees > 0.0f && scene.camera.vfovDegrees < 180.0f,
+             "pbrt: bad camera accepted");
+  });
+}
+
 const std::vector<Target>& targets() {
-  static const std::vector<Target> all = {{"scene", fuzzScene},
-                                          {"obj", fuzzObj},
-                                          {"mtl", fuzzMtl},
-                                          {"ply", fuzzPly},
-                                          {"image", fuzzImage}};
+  static const std::vector<Target> all = {{"scene", fuzzScene}, {"obj", fuzzObj},
+                                          {"mtl", fuzzMtl},     {"ply", fuzzPly},
+                                          {"image", fuzzImage}, {"pbrt", fuzzPbrt}};
   return all;
 }
 

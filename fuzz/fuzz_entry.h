@@ -18,6 +18,7 @@ Outcome fuzzObj(const std::uint8_t* data, std::size_t size);    // loadObjMesh, 
 Outcome fuzzMtl(const std::uint8_t* data, std::size_t size);    // loadMtlMaterials
 Outcome fuzzPly(const std::uint8_t* data, std::size_t size);    // loadPlyMesh, its normals checked
 Outcome fuzzImage(const std::uint8_t* data, std::size_t size);  // readImage: EXR, PFM, PNG
+Outcome fuzzPbrt(const std::uint8_t* data, std::size_t size);   // a .pbrt scene beside fixed meshes
 
 struct Target {
   const char* name;  // the directory name under fuzz/corpus/ and tests/data/fuzz-regressions/

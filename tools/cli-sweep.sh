@@ -66,6 +66,13 @@ for dir in "$@"; do
     check scene "$f" "0 2" "$pt" render "$work/scene.json" --backend cpu --width 8 --height 8 \
       --spp 1 --threads 1 --out "$work/out.exr"
   done
+  for f in "$dir"/pbrt/*; do
+    [[ -f $f ]] || continue
+    # A pbrt-v4 scene file from the corpus (the meshes it names are the fixed ones, if any).
+    cp "$f" "$work/scene.pbrt"
+    check pbrt "$f" "0 2" "$pt" render "$work/scene.pbrt" --backend cpu --width 8 --height 8 \
+      --spp 1 --threads 1 --out "$work/out.exr"
+  done
   # Each mesh or material file in turn in place of the fixed scene's own.
   for kind_scene in obj:box-obj.json ply:box-ply.json mtl:box.json; do
     kind=${kind_scene%%:*} scene=${kind_scene#*:}

@@ -22,6 +22,7 @@
 #include "scene/json_reader.h"
 #include "scene/mtl_materials.h"
 #include "scene/obj_mesh.h"
+#include "scene/pbrt/pbrt_scene.h"
 #include "scene/ply_mesh.h"
 
 namespace pt {
@@ -119,10 +120,6 @@ constexpr NameTable<uint, 7> kMaterialTypes{{
     {"diffusetransmission", kMaterialDiffuseTransmission, "Lambertian, both sides"},
     {"coateddiffuse", kMaterialCoatedDiffuse, "varnish over a Lambertian base"},
 }};
-
-// The most random-walk steps or walks a coated material may ask for per evaluation: far more
-// than pbrt-v4's defaults (10 and 1) need, and small enough that one evaluation stays short.
-constexpr std::int64_t kMaxCoatedWalk = 1000;
 
 // The keys a material of `type` takes: name, type and emission for all, then pbrt-v4's names
 // of the type's parameters (docs/scene-format.md).
@@ -239,8 +236,7 @@ void readRoughness(const JsonNode& m, Material& material) {
   if (auto n = m.find("vroughness")) v = readNonNegative(*n);
   bool remap = true;
   if (auto n = m.find("remaproughness")) remap = n->boolean();
-  material.alphaX = remap ? std::sqrt(u) : u;
-  material.alphaY = remap ? std::sqrt(v) : v;
+  setRoughness(material, u, v, remap);
 }
 
 // The parameters of `material.type` beyond emission, over the type's defaults.
@@ -277,10 +273,7 @@ void readMaterialParameters(const JsonNode& m, Material& material) {
       if (auto n = m.find("reflectance")) material.reflectance = readAlbedo(*n);
       if (auto n = m.find("transmittance")) material.transmittance = readAlbedo(*n);
       if (auto n = m.find("scale")) {
-        // pbrt-v4 scales both colours and clamps the products to [0, 1].
-        const float scale = readNonNegative(*n);
-        material.reflectance = glm::clamp(material.reflectance * scale, 0.0f, 1.0f);
-        material.transmittance = glm::clamp(material.transmittance * scale, 0.0f, 1.0f);
+        scaleDiffuseTransmission(material, readNonNegative(*n));
       }
       break;
     }
@@ -795,6 +788,16 @@ Material defaultMaterial(uint type) {
   return m;
 }
 
+void setRoughness(Material& material, float uRoughness, float vRoughness, bool remap) {
+  material.alphaX = remap ? std::sqrt(uRoughness) : uRoughness;
+  material.alphaY = remap ? std::sqrt(vRoughness) : vRoughness;
+}
+
+void scaleDiffuseTransmission(Material& material, float scale) {
+  material.reflectance = glm::clamp(material.reflectance * scale, 0.0f, 1.0f);
+  material.transmittance = glm::clamp(material.transmittance * scale, 0.0f, 1.0f);
+}
+
 void setConductorReflectance(Material& material, vec3 reflectance) {
   material.eta = vec3(1.0f);
   for (int c = 0; c < 3; ++c) {
@@ -805,6 +808,7 @@ void setConductorReflectance(Material& material, vec3 reflectance) {
 }
 
 Scene loadScene(const std::filesystem::path& path) {
+  if (path.extension() == ".pbrt") return loadPbrtScene(path);  // docs/pbrt-format.md
   const std::string file = path.string();
   std::string text;
   std::string why;

@@ -2,6 +2,7 @@
 // Knows nothing of BVHs or Vulkan; the BVH builder reorders the triangles later.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -58,6 +59,19 @@ Material defaultMaterial(uint type);
 // ConductorMaterial::GetBxDF): eta = 1 and k = 2 sqrt(r) / sqrt(1 - r) per channel, with r
 // clamped to [0, 0.9999] so that white stays finite.
 void setConductorReflectance(Material& material, vec3 reflectance);
+
+// pbrt-v4's "roughness", "uroughness" and "vroughness" as a material stores them: Trowbridge-
+// Reitz alphas, mapped by RoughnessToAlpha (alpha = sqrt(roughness)) when `remap` (pbrt-v4's
+// "remaproughness", true by default). The JSON and pbrt readers both call it.
+void setRoughness(Material& material, float uRoughness, float vRoughness, bool remap);
+
+// diffusetransmission's "scale" as pbrt-v4 applies it: both colours scaled and the products
+// clamped to [0, 1].
+void scaleDiffuseTransmission(Material& material, float scale);
+
+// The most random-walk steps or walks a coated material may ask for per evaluation: far more
+// than pbrt-v4's defaults (10 and 1) need, and small enough that one evaluation stays short.
+inline constexpr std::int64_t kMaxCoatedWalk = 1000;
 
 // Builds the GPU camera for a film of width x height pixels.
 Camera makeCamera(const CameraDesc& desc, int width, int height);
