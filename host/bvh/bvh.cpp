@@ -19,6 +19,11 @@
 #include "bvh/bvh_build.h"
 #include "common/check.h"
 
+#ifdef PT_BVH_PROFILE
+#include <cstdio>
+#include <cstdlib>
+#endif
+
 namespace pt {
 namespace {
 
@@ -307,13 +312,18 @@ Bvh buildBvh(std::vector<Triangle> triangles, const BvhBuildOptions& options) {
   PT_CHECK(options.maxLeafSize >= 1);
   PT_CHECK(options.threads >= 0);
   PT_CHECK(triangles.size() < size_t(UINT32_MAX));
+  PT_BVH_PROFILE_BEGIN();
   const auto start = std::chrono::steady_clock::now();
   const size_t leafSize = size_t(options.maxLeafSize);
   // Threads beyond one per chunk of work would only wait.
   int threads = options.threads > 0 ? options.threads
                                     : int(std::max(1u, std::thread::hardware_concurrency()));
   threads = int(std::min(size_t(threads), triangles.size() / kGrain + 1));
+#ifdef PT_BVH_PROFILE
+  if (const char* forced = std::getenv("PT_BVH_THREADS")) threads = std::atoi(forced);
+#endif
   Workers workers(threads);
+  PT_BVH_PHASE("start the threads");
   Bvh bvh;
   switch (options.builder) {
     case BvhBuilder::kLbvh:
@@ -323,13 +333,32 @@ Bvh buildBvh(std::vector<Triangle> triangles, const BvhBuildOptions& options) {
       bvh = buildBinnedSahBvh(std::move(triangles), leafSize);
       break;
     case BvhBuilder::kPloc:
-      bvh = buildPlocBvh(triangles, leafSize, workers);
+      bvh = buildPlocBvh(std::move(triangles), leafSize, workers);
       break;
   }
   PT_CHECK(bvh.maxDepth <= int(kBvhStackSize));
+  PT_BVH_PHASE("(builder's end)");
   bvh.sahCost = sahCostOf(bvh.nodes, workers);
+  PT_BVH_PHASE("SAH cost");
   bvh.buildSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  PT_BVH_PROFILE_END("buildBvh");
+#ifdef PT_BVH_PROFILE
+  if (std::getenv("PT_BVH_HASH")) {
+    // The tree's identity, to check that a change kept it: FNV-1a over the nodes and the
+    // triangles' load-order indices.
+    uint64_t hash = 1469598103934665603ull;
+    auto add = [&hash](const void* data, size_t size) {
+      const unsigned char* p = static_cast<const unsigned char*>(data);
+      for (size_t i = 0; i < size; ++i) hash = (hash ^ p[i]) * 1099511628211ull;
+    };
+    add(bvh.nodes.data(), bvh.nodes.size() * sizeof(BvhNode));
+    for (const Triangle& t : bvh.triangles) add(&t.primitive, sizeof t.primitive);
+    std::fprintf(stderr, "tree hash %016llx nodes %zu sah %.6f depth %d\n",
+                 static_cast<unsigned long long>(hash), bvh.nodes.size(), bvh.sahCost,
+                 bvh.maxDepth);
+  }
+#endif
   return bvh;
 }
 

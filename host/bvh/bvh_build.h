@@ -107,7 +107,7 @@ double sahCostOf(const std::vector<BvhNode>& nodes, Workers& workers);
 // depthLimit below kBvhStackSize (at least balancedLevels(triangles, leafSize)) is for tests
 // of PLOC's fallback for trees deeper than the traversal stack.
 Bvh buildBinnedSahBvh(std::vector<Triangle> triangles, size_t leafSize);
-Bvh buildPlocBvh(const std::vector<Triangle>& triangles, size_t leafSize, Workers& workers,
+Bvh buildPlocBvh(std::vector<Triangle> triangles, size_t leafSize, Workers& workers,
                  int depthLimit = int(kBvhStackSize));
 
 }  // namespace pt

@@ -15,14 +15,18 @@
 // of node ids. So the tree is the same for any thread count.
 //
 // Memory: every page a build touches for the first time costs a page fault and the kernel's
-// zeroing, and on a loaded virtual machine the faults of the old builder's arrays (250 MB
-// for the 1M-triangle sphere, the output included) took about a fifth of its time. So the
-// phases share two blocks (the Morton keys, then the clusters of the rounds, ping-ponging
-// between them, then the top levels' references in the one the last round left); the
-// per-cluster data that only merges read (triangle counts, collapsed sizes, costs) lives in
-// the inner nodes, where merges write it anyway; inner nodes keep no boxes (the
-// linearization unites them again from the triangles); and the large arrays ask for huge
-// pages (adviseHugePages).
+// zeroing (about 0.2 ms per MB on the test machine, several times more when the host has not
+// backed the memory yet), so the phases pass memory on (docs/bvh-build.md has the profile):
+// the Morton keys live in the inner nodes' memory until the first merge; the centroids, then
+// the first round's clusters in block 0; the input triangles, once copied in Morton order
+// (sorted_), give their memory, already touched by the caller, to block 1, which holds the
+// clusters of every other round and then the top levels' state, and at the end the output
+// triangles, without the zeroing of a resize. The per-cluster data that only merges read
+// (triangle counts, collapsed sizes, costs) lives in the inner nodes, where merges write it
+// anyway; inner nodes keep no boxes (the linearization unites them again from the
+// triangles); and the large arrays ask for huge pages (adviseHugePages). The neighbour
+// search, the compaction and the pair marking of the rounds also run in sixteen AVX-512
+// lanes where the CPU has them (the same arithmetic: the same tree).
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -37,6 +41,9 @@
 
 #ifdef __linux__
 #include <sys/mman.h>
+#endif
+#ifdef __x86_64__
+#include <immintrin.h>
 #endif
 
 namespace pt {
@@ -215,12 +222,13 @@ class Block {
 };
 
 // The clusters of a round in a Block: their boxes as a structure of arrays, so that the
-// neighbour search loads eight at a time, and their ids. Cluster i is at i + kPadding of each
-// box array; the padding on both sides (enough for the last eight lanes too) holds infinite
+// neighbour search loads a block of lanes at a time, and their ids. Cluster i is at
+// i + kPadding of each box array; the padding on both sides (enough for the last block's
+// sixteen lanes too) holds infinite
 // boxes, whose merged area is infinite: never anyone's nearest neighbour. The pointers are
 // at cluster 0 (the loops keep them in registers, which they could not do with members of a
 // class that the stores might alias).
-constexpr size_t kPadding = kRadius + 8;
+constexpr size_t kPadding = kRadius + 16;
 struct ClusterArrays {
   float *lx, *ly, *lz, *hx, *hy, *hz;
   uint32_t* id;
@@ -253,80 +261,91 @@ struct ClusterArrays {
 
 // found[i - begin] for i in [begin, end): the cluster j within kRadius places of i with the
 // least area of the merged box, the lower index on a tie; i itself when every area is
-// infinite or NaN. Eight clusters at a time, one per lane. Each pair's area is computed once,
-// by its first cluster (j = i + 1 .. i + kRadius), and offered to both: to i at once, and
-// to j from a ring of the last blocks' areas, where the areas of j's pairs with j - kRadius
-// .. j - 1 lie side by side. (The min and max of two numbers do not depend on their order,
-// so it is the area j would compute, NaN coordinates aside: this halves the search's work.)
-// The candidates before i are offered from the lowest index up, as are those after it, and
-// those after win only when strictly less, so "strictly less" keeps the lower index on ties.
-// This loop is much of the build time, so it is also compiled for AVX2 (picked at load time
-// where the CPU has it): eight lanes in one register instead of two; the arithmetic, and so
-// the tree, is the same. (No helper function takes or returns 32-byte vectors by value: that
-// would change its calling convention between the two versions.)
-__attribute__((target_clones("avx2", "default"))) void findNeighbours(const ClusterArrays& c,
-                                                                      size_t begin, size_t end,
-                                                                      uint32_t* found) {
+// infinite or NaN. A block of clusters at a time, one per lane (kLanes of them: eight, or
+// sixteen with AVX-512). Each pair's area is computed once, by its first cluster (j = i + 1
+// .. i + kRadius), and offered to both: to i at once, and to j from a ring of the last
+// blocks' areas, where the areas of j's pairs with j - kRadius .. j - 1 lie side by side.
+// (The min and max of two numbers do not depend on their order, so it is the area j would
+// compute, NaN coordinates aside: this halves the search's work.) The candidates before i
+// are offered from the lowest index up, as are those after it, and those after win only
+// when strictly less, so "strictly less" keeps the lower index on ties. This loop is much of
+// the build time, so it is compiled three times, picked at load time by what the CPU has:
+// eight lanes in two SSE registers, eight in one AVX2 register, sixteen in one AVX-512
+// register (half the instructions of AVX2: 6 to 8 % of the build). Every version computes
+// each pair's area with the same operations, so the tree is the same. (No helper function
+// takes or returns vectors wider than 16 bytes by value: that would change its calling
+// convention between the versions.)
+template <typename FloatN, typename IntN>
+[[gnu::always_inline]] inline void findNeighboursIn(const ClusterArrays& c, size_t begin,
+                                                    size_t end, uint32_t* found) {
+  constexpr size_t kLanes = sizeof(FloatN) / sizeof(float);
+  static_assert(sizeof(IntN) == sizeof(FloatN) && kLanes <= kPadding - kRadius + 1);
   const float *lx = c.lx, *ly = c.ly, *lz = c.lz, *hx = c.hx, *hy = c.hy, *hz = c.hz;
-  // The boxes of the clusters q .. q + 7, lane by lane.
-  auto load = [&](ptrdiff_t q, Float8& x0, Float8& y0, Float8& z0, Float8& x1, Float8& y1,
-                  Float8& z1) {
-    std::memcpy(&x0, lx + q, sizeof x0);
-    std::memcpy(&y0, ly + q, sizeof y0);
-    std::memcpy(&z0, lz + q, sizeof z0);
-    std::memcpy(&x1, hx + q, sizeof x1);
-    std::memcpy(&y1, hy + q, sizeof y1);
-    std::memcpy(&z1, hz + q, sizeof z1);
-  };
-  static_assert(kRadius % 8 == 0);
-  constexpr size_t kBehind = kRadius / 8;  // blocks of eight that reach into a block
-  constexpr size_t kSlots = kBehind + 2;   // with the current one, and room to wrap around
-  // ring[k - 1][8 * slot + lane]: the area of cluster i + lane's pair with i + lane + k for
-  // the block i in that slot, every block stored twice, kSlots slots apart, so that the
+  static_assert(kRadius % kLanes == 0);
+  constexpr size_t kBehind = kRadius / kLanes;  // blocks that reach into a block
+  constexpr size_t kSlots = kBehind + 2;        // with the current one, and room to wrap around
+  // ring[k - 1][kLanes * slot + lane]: the area of cluster i + lane's pair with i + lane + k
+  // for the block i in that slot, every block stored twice, kSlots slots apart, so that the
   // areas of any kBehind + 1 successive blocks lie side by side.
-  alignas(32) float ring[kRadius][16 * kSlots];
-  const Int8 laneOffsets = {0, 1, 2, 3, 4, 5, 6, 7};
-  const Float8 infinity = {INFINITY, INFINITY, INFINITY, INFINITY,
-                           INFINITY, INFINITY, INFINITY, INFINITY};
+  alignas(64) float ring[kRadius][2 * kLanes * kSlots];
+  IntN laneOffsets;
+  FloatN infinity;
+  for (size_t lane = 0; lane < kLanes; ++lane) {
+    laneOffsets[lane] = int32_t(lane);
+    infinity[lane] = INFINITY;
+  }
   // The first kBehind blocks, before `begin`, only fill the ring (clusters before 0 are
   // padding: infinite areas).
   size_t block = 0;
-  for (ptrdiff_t i = ptrdiff_t(begin) - ptrdiff_t(kRadius); i < ptrdiff_t(end); i += 8, ++block) {
-    Float8 x0, y0, z0, x1, y1, z1;
-    load(i, x0, y0, z0, x1, y1, z1);
-    Float8 afterArea = infinity;
-    Int8 after = laneOffsets + int32_t(i);
-    const size_t slot = 8 * (block % kSlots);
+  for (ptrdiff_t i = ptrdiff_t(begin) - ptrdiff_t(kRadius); i < ptrdiff_t(end);
+       i += ptrdiff_t(kLanes), ++block) {
+    // The boxes of the clusters i .. i + kLanes - 1, lane by lane.
+    FloatN x0, y0, z0, x1, y1, z1;
+    std::memcpy(&x0, lx + i, sizeof x0);
+    std::memcpy(&y0, ly + i, sizeof y0);
+    std::memcpy(&z0, lz + i, sizeof z0);
+    std::memcpy(&x1, hx + i, sizeof x1);
+    std::memcpy(&y1, hy + i, sizeof y1);
+    std::memcpy(&z1, hz + i, sizeof z1);
+    FloatN afterArea = infinity;
+    IntN after = laneOffsets + int32_t(i);
+    const size_t slot = kLanes * (block % kSlots);
 #pragma GCC unroll 16
     for (size_t k = 1; k <= kRadius; ++k) {
-      Float8 qx0, qy0, qz0, qx1, qy1, qz1;
-      load(i + ptrdiff_t(k), qx0, qy0, qz0, qx1, qy1, qz1);
+      const ptrdiff_t q = i + ptrdiff_t(k);
+      FloatN qx0, qy0, qz0, qx1, qy1, qz1;
+      std::memcpy(&qx0, lx + q, sizeof qx0);
+      std::memcpy(&qy0, ly + q, sizeof qy0);
+      std::memcpy(&qz0, lz + q, sizeof qz0);
+      std::memcpy(&qx1, hx + q, sizeof qx1);
+      std::memcpy(&qy1, hy + q, sizeof qy1);
+      std::memcpy(&qz1, hz + q, sizeof qz1);
       // max(a, b) - min(a, b) per axis as a < b ? b : a and b < a ? b : a (maxps, minps).
-      const Float8 dx = (x1 < qx1 ? qx1 : x1) - (qx0 < x0 ? qx0 : x0);
-      const Float8 dy = (y1 < qy1 ? qy1 : y1) - (qy0 < y0 ? qy0 : y0);
-      const Float8 dz = (z1 < qz1 ? qz1 : z1) - (qz0 < z0 ? qz0 : z0);
-      const Float8 area = dx * dy + dy * dz + dz * dx;
+      const FloatN dx = (x1 < qx1 ? qx1 : x1) - (qx0 < x0 ? qx0 : x0);
+      const FloatN dy = (y1 < qy1 ? qy1 : y1) - (qy0 < y0 ? qy0 : y0);
+      const FloatN dz = (z1 < qz1 ? qz1 : z1) - (qz0 < z0 ? qz0 : z0);
+      const FloatN area = dx * dy + dy * dz + dz * dx;
       std::memcpy(&ring[k - 1][slot], &area, sizeof area);
-      std::memcpy(&ring[k - 1][slot + 8 * kSlots], &area, sizeof area);
-      const Int8 better = area < afterArea;
+      std::memcpy(&ring[k - 1][slot + kLanes * kSlots], &area, sizeof area);
+      const IntN better = area < afterArea;
       afterArea = better ? area : afterArea;
-      after = better ? laneOffsets + int32_t(i + ptrdiff_t(k)) : after;
+      after = better ? laneOffsets + int32_t(q) : after;
     }
     if (i < ptrdiff_t(begin)) continue;
     // The pairs with the kRadius clusters before, from the blocks kBehind back on.
-    const size_t first = 8 * ((block - kBehind) % kSlots);
-    Float8 beforeArea = infinity;
-    Int8 before = laneOffsets + int32_t(i);
+    const size_t first = kLanes * ((block - kBehind) % kSlots);
+    FloatN beforeArea = infinity;
+    IntN before = laneOffsets + int32_t(i);
 #pragma GCC unroll 16
     for (size_t k = kRadius; k > 0; --k) {
-      Float8 area;
+      FloatN area;
       std::memcpy(&area, &ring[k - 1][first + kRadius - k], sizeof area);
-      const Int8 better = area < beforeArea;
+      const IntN better = area < beforeArea;
       beforeArea = better ? area : beforeArea;
       before = better ? laneOffsets + int32_t(i - ptrdiff_t(k)) : before;
     }
-    const Int8 best = afterArea < beforeArea ? after : before;
-    if (size_t(i) + 8 <= end) {
+    const IntN best = afterArea < beforeArea ? after : before;
+    if (size_t(i) + kLanes <= end) {
       std::memcpy(&found[size_t(i) - begin], &best, sizeof best);
     } else {
       for (size_t lane = 0; size_t(i) + lane < end; ++lane) {
@@ -334,6 +353,20 @@ __attribute__((target_clones("avx2", "default"))) void findNeighbours(const Clus
       }
     }
   }
+}
+using Float16 = float __attribute__((vector_size(64)));
+using Int16 = int32_t __attribute__((vector_size(64)));
+__attribute__((target("default"))) void findNeighbours(const ClusterArrays& c, size_t begin,
+                                                       size_t end, uint32_t* found) {
+  findNeighboursIn<Float8, Int8>(c, begin, end, found);
+}
+__attribute__((target("avx2"))) void findNeighbours(const ClusterArrays& c, size_t begin,
+                                                    size_t end, uint32_t* found) {
+  findNeighboursIn<Float8, Int8>(c, begin, end, found);
+}
+__attribute__((target("avx512f"))) void findNeighbours(const ClusterArrays& c, size_t begin,
+                                                       size_t end, uint32_t* found) {
+  findNeighboursIn<Float16, Int16>(c, begin, end, found);
 }
 
 // kSpread11[x]: the 11 bits of x spread out so that bit i moves to bit 3i.
@@ -427,9 +460,8 @@ template <bool kAvx2>
       std::fill_n(axis.count, binCount, 0u);
     }
   }
-  for (size_t i = begin; i < end; ++i) {
+  auto binOne = [&](size_t i, Bins & target) __attribute__((always_inline)) {
     const TopRef& cluster = refs[i];
-    Bins& target = twoSets && i % 2 ? odd : bins;
     Int8 bits;
     std::memcpy(&bits, &cluster, sizeof bits);
     const Float8 box = Float8(bits & mask);
@@ -448,8 +480,19 @@ template <bool kAvx2>
       }
       target[a].count[k] += count;
     }
+  };
+  if (!twoSets) {
+    for (size_t i = begin; i < end; ++i) binOne(i, bins);
+    return;
   }
-  if (!twoSets) return;
+  // Even positions into `bins`, odd ones into `odd`, two at a time.
+  size_t i = begin;
+  if (i % 2) binOne(i++, odd);
+  for (; i + 1 < end; i += 2) {
+    binOne(i, bins);
+    binOne(i + 1, odd);
+  }
+  if (i < end) binOne(i, bins);
   for (size_t a = 0; a < 3; ++a) {
     for (int k = 0; k < binCount; ++k) {
       grow8(bins[a].box[k], odd[a].box[k]);
@@ -468,16 +511,75 @@ __attribute__((target("avx2"))) void binClusters(const TopRef* refs, size_t begi
   binClustersIn<true>(refs, begin, end, lo, scale, binCount, bins, binIndex);
 }
 
+#ifdef __x86_64__
+// Whether the CPU (and the system) runs AVX-512 (F): then the rounds take compactAvx512.
+bool hasAvx512() {
+  static const bool has = __builtin_cpu_supports("avx512f");
+  return has;
+}
+#endif
+
+// Per cluster i in [begin, end), given its nearest neighbour found[i - first]: the offset to
+// its partner in a merge (partners[i], 0: none), the merges its chunk makes (m: mutual pairs
+// counted at their first cluster) and the clusters that survive (s: those without a partner
+// and the first of each pair). Also for AVX-512, sixteen clusters at a time, the same counts
+// and offsets.
+__attribute__((target("default"))) void markPairs(const uint32_t* found, size_t first, size_t begin,
+                                                  size_t end, int8_t* partners, uint32_t& m,
+                                                  uint32_t& s) {
+  for (size_t i = begin; i < end; ++i) {
+    const uint32_t j = found[i - first];
+    const bool mutual = j != i && found[j - first] == i;
+    m += mutual && i < j;
+    s += !mutual || i < j;
+    partners[i] = int8_t(mutual ? int(j) - int(i) : 0);
+  }
+}
+#ifdef __x86_64__
+__attribute__((target("avx512f"))) void markPairs(const uint32_t* found, size_t first, size_t begin,
+                                                  size_t end, int8_t* partners, uint32_t& m,
+                                                  uint32_t& s) {
+  const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const __m512i base = _mm512_set1_epi32(int(first));
+  size_t i = begin;
+  for (; i + 16 <= end; i += 16) {
+    const __m512i self = _mm512_add_epi32(lanes, _mm512_set1_epi32(int(i)));
+    const __m512i j = _mm512_loadu_si512(found + (i - first));
+    // Every neighbour is within the searched range, whose neighbours `found` holds.
+    const __m512i back = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), 0xFFFF,
+                                                     _mm512_sub_epi32(j, base), found, 4);
+    const __mmask16 mutual =
+        _mm512_cmpneq_epi32_mask(j, self) & _mm512_cmpeq_epi32_mask(back, self);
+    const __mmask16 after = _mm512_cmpgt_epu32_mask(j, self);
+    m += uint32_t(__builtin_popcount(mutual & after));
+    s += uint32_t(__builtin_popcount(__mmask16(~mutual | after)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(partners + i),
+                     _mm512_maskz_cvtepi32_epi8(0xFFFF, _mm512_maskz_sub_epi32(mutual, j, self)));
+  }
+  for (; i < end; ++i) {
+    const uint32_t j = found[i - first];
+    const bool mutual = j != i && found[j - first] == i;
+    m += mutual && i < j;
+    s += !mutual || i < j;
+    partners[i] = int8_t(mutual ? int(j) - int(i) : 0);
+  }
+}
+#endif
+
 class PlocBuilder {
  public:
-  PlocBuilder(const std::vector<Triangle>& triangles, size_t leafSize, int depthLimit,
-              Workers& workers)
-      : triangles_(triangles),
-        n_(triangles.size()),
+  PlocBuilder(std::vector<Triangle> triangles, size_t leafSize, int depthLimit, Workers& workers)
+      : input_(std::move(triangles)),
+        n_(input_.size()),
         leafSize_(leafSize),
         depthLimit_(depthLimit),
         workers_(workers),
-        blocks_{Block(ClusterArrays::bytes(n_)), outputBlock()} {}
+        sorted_(std::make_unique_for_overwrite<Triangle[]>(n_)),
+        innerBlock_(std::max((n_ - 1) * sizeof(Inner), 2 * n_ * sizeof(uint64_t))),
+        blocks_{Block(ClusterArrays::bytes(n_)), inputBlock()} {
+    adviseHugePages(sorted_.get(), n_ * sizeof(Triangle));
+    PT_BVH_PHASE("allocate");
+  }
 
   Bvh build() {
     const uint64_t* keys = mortonKeys();
@@ -485,16 +587,16 @@ class PlocBuilder {
   }
 
  private:
-  // Block 1 in the memory of the output triangles, where it fits (from 58 triangles on): the
-  // scratch arrays are dead by the time the linearization writes the triangles there (as new
-  // objects: std::construct_at), and the pages are touched once instead of twice.
-  Block outputBlock() {
-    bvh_.triangles.reserve(n_);
-    adviseHugePages(bvh_.triangles.data(), n_ * sizeof(Triangle));
-    bvh_.triangles.resize(n_);
+  // Block 1 in the memory of the input triangles, where it fits (from 77 triangles on): once
+  // they are copied in Morton order (sorted_), the rounds' clusters use it, and at the end it
+  // holds the output triangles (written as new objects: std::construct_at). Its pages are
+  // already touched (the caller wrote the triangles), while fresh memory costs a page fault
+  // and the kernel's zeroing of every page, and the vector needs no resize (which would
+  // zero it again).
+  Block inputBlock() {
     static_assert(alignof(Triangle) >= 4 && __STDCPP_DEFAULT_NEW_ALIGNMENT__ >= 8);
     if (n_ * sizeof(Triangle) < ClusterArrays::bytes(n_)) return Block(ClusterArrays::bytes(n_));
-    return Block(reinterpret_cast<std::byte*>(bvh_.triangles.data()));
+    return Block(reinterpret_cast<std::byte*>(input_.data()));
   }
 
   // ---- Morton order ----------------------------------------------------------------------
@@ -511,35 +613,24 @@ class PlocBuilder {
 
   // The triangles in Morton order of their centroids, normalised to the centroids' bounding
   // box, as sortByMorton (bvh.cpp) orders them with skipBits 30 (its codes, its stable
-  // order), here with 8 bytes a triangle: keys code << 31 | triangle index, in block 1.
-  // Returns the sorted keys. A stable LSD radix sort by the code, kDigitBits a pass: each
-  // worker counts the digits of its own slice, the counts become output offsets bucket by
-  // bucket and, within a bucket, slice by slice (earlier slices first, which keeps the sort
-  // stable), and each worker scatters its slice. A pass in which every code has the same
-  // digit would move nothing and is skipped.
+  // order), here with 8 bytes a triangle: keys code << 31 | triangle index, in the memory
+  // of the inner nodes (not written before the first round's merges). Returns the sorted
+  // keys. One pass over the triangles stores their centroids (12 bytes a triangle, in block
+  // 0, where the first round's clusters go next) and their bounds; the keys are made from
+  // the centroids, not from the triangles again (a quarter of the bytes to read). Then a
+  // stable LSD radix sort by the code, kDigitBits a pass: each worker counts the digits of
+  // its own slice (the first pass's as the keys are made), the counts become output offsets
+  // bucket by bucket and, within a bucket, slice by slice (earlier slices first, which keeps
+  // the sort stable), and each worker scatters its slice. A pass in which every code has the
+  // same digit would move nothing and is skipped.
   const uint64_t* mortonKeys() {
     const size_t n = n_;
-    std::vector<Box4> chunkBounds((n + kChunk - 1) / kChunk);
-    workers_.forChunks(n, kChunk, [&](size_t begin, size_t end) {
-      Box4 b{splat4(INFINITY), splat4(-INFINITY)};
-      for (size_t i = begin; i < end; ++i) {
-        const Float4 c = centroid(triangles_[i]);
-        b = Box4{min4(b.lo, c), max4(b.hi, c)};
-      }
-      chunkBounds[begin / kChunk] = b;
-    });
-    Box4 bounds{splat4(INFINITY), splat4(-INFINITY)};
-    for (const Box4& b : chunkBounds) bounds = unite4(bounds, b);
-    const Float4 extent = bounds.hi - bounds.lo;
-    // A flat axis (all centroids in one plane) gets scale 0 instead of a division by zero.
-    Float4 scale = splat4(0.0f);
-    for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0 ? 1 / extent[a] : 0;
-
     constexpr size_t kBuckets = size_t(1) << kDigitBits;
     constexpr int kFirstShift = 64 - kMortonBits;
     static_assert(kMortonBits % kDigitBits == 0 && kFirstShift >= 31);
-    uint64_t* keys = blocks_[1].array<uint64_t>(0, n);
-    uint64_t* sorted = blocks_[1].array<uint64_t>(n * sizeof(uint64_t), n);
+    uint64_t* keys = innerBlock_.array<uint64_t>(0, n);
+    uint64_t* sorted = innerBlock_.array<uint64_t>(n * sizeof(uint64_t), n);
+    float* const centroids = blocks_[0].array<float>(0, 3 * n);
     const int slices = n < kChunk ? 1 : workers_.count();
     auto sliceBegin = [&](int s) { return n * size_t(s) / size_t(slices); };
     auto forSlices = [&](const auto& body) {
@@ -549,6 +640,29 @@ class PlocBuilder {
         workers_.run([&](int worker) { body(worker); });
       }
     };
+    // The centroids (x, y, z of triangle i at 3i: stored as 16 bytes, the next centroid's x
+    // overwriting the fourth, but for each slice's last) and their bounds.
+    std::vector<Box4> sliceBounds(static_cast<size_t>(slices));
+    forSlices([&](int s) {
+      const Triangle* const triangles = input_.data();
+      float* const out = centroids;
+      const size_t sliceEnd = sliceBegin(s + 1);
+      Box4 b{splat4(INFINITY), splat4(-INFINITY)};
+      for (size_t i = sliceBegin(s); i < sliceEnd; ++i) {
+        const Float4 c = centroid(triangles[i]);
+        b = Box4{min4(b.lo, c), max4(b.hi, c)};
+        std::memcpy(out + 3 * i, &c, i + 1 < sliceEnd ? sizeof c : 3 * sizeof(float));
+      }
+      sliceBounds[size_t(s)] = b;
+    });
+    PT_BVH_PHASE("centroids and their bounds");
+    Box4 bounds{splat4(INFINITY), splat4(-INFINITY)};
+    for (const Box4& b : sliceBounds) bounds = unite4(bounds, b);
+    const Float4 extent = bounds.hi - bounds.lo;
+    // A flat axis (all centroids in one plane) gets scale 0 instead of a division by zero.
+    Float4 scale = splat4(0.0f);
+    for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0 ? 1 / extent[a] : 0;
+
     std::vector<size_t> offsets(size_t(slices) * kBuckets);  // [slice][bucket]
     // The keys, in load order, and the counts of the first pass's digits.
     // (The loops take their bounds and pointers in locals: their 8-byte stores could
@@ -556,15 +670,16 @@ class PlocBuilder {
     forSlices([&](int s) {
       size_t* const counts = &offsets[size_t(s) * kBuckets];
       uint64_t* const out = keys;
-      const Triangle* const triangles = triangles_.data();
+      const float* const in = centroids;
       const size_t sliceEnd = sliceBegin(s + 1);
-      std::fill(counts, counts + kBuckets, 0);
       for (size_t i = sliceBegin(s); i < sliceEnd; ++i) {
-        const uint64_t code = mortonCode33((centroid(triangles[i]) - bounds.lo) * scale);
+        const Float4 c = {in[3 * i], in[3 * i + 1], in[3 * i + 2], 0.0f};
+        const uint64_t code = mortonCode33((c - bounds.lo) * scale);
         out[i] = code << kFirstShift | i;
         counts[code & (kBuckets - 1)]++;
       }
     });
+    PT_BVH_PHASE("Morton keys and first counts");
     for (int shift = kFirstShift; shift < 64; shift += kDigitBits) {
       if (shift != kFirstShift) {
         forSlices([&](int s) {
@@ -598,6 +713,7 @@ class PlocBuilder {
           out[next[(in[i] >> digit) & (kBuckets - 1)]++] = in[i];
         }
       });
+      PT_BVH_PHASE("radix pass (shift " + std::to_string(shift) + ")");
       std::swap(keys, sorted);
     }
     return keys;
@@ -608,31 +724,38 @@ class PlocBuilder {
   // Runs the rounds of nearest-neighbour merging over the triangles in the order of the
   // Morton keys; returns the root's id.
   uint32_t cluster(const uint64_t* keys) {
-    // The first round's clusters: the triangles' boxes, in block 0; the order for the
-    // linearization.
+    // The triangles in Morton order (sorted_, for the linearization) and the first round's
+    // clusters, their boxes, in block 0.
     const ClusterArrays triangleClusters(blocks_[0], n_);
-    order_ = std::make_unique_for_overwrite<uint32_t[]>(n_);
-    adviseHugePages(order_.get(), n_ * sizeof(uint32_t));
     workers_.forChunks(n_, kChunk, [&](size_t begin, size_t end) {
       const ClusterArrays& c = triangleClusters;
-      uint32_t* const order = order_.get();
+      const Triangle* const in = input_.data();
+      Triangle* const out = sorted_.get();
       for (size_t i = begin; i < end; ++i) {
         // The triangles are read in Morton order, all over memory: fetch ahead.
-        if (i + kPrefetch < end) prefetchTriangle(uint32_t(keys[i + kPrefetch]) & kIndexMask);
-        order[i] = uint32_t(keys[i]) & kIndexMask;
-        c.set(i, triangleBox(triangles_[order[i]]), uint32_t(i));
+        if (i + kPrefetch < end) {
+          const char* ahead =
+              reinterpret_cast<const char*>(in + (keys[i + kPrefetch] & kIndexMask));
+          __builtin_prefetch(ahead);
+          __builtin_prefetch(ahead + sizeof(Triangle) - 1);
+        }
+        const Triangle& t = in[keys[i] & kIndexMask];
+        out[i] = t;
+        c.set(i, triangleBox(t), uint32_t(i));
       }
     });
     triangleClusters.pad(n_);
-    // The keys are done with: block 1 holds the next round's clusters.
+    PT_BVH_PHASE("gather in Morton order");
+    // The input triangles and the keys are done with: block 1 holds the next round's
+    // clusters, and the keys' memory the inner nodes. Not value-initialised: every entry is
+    // written before it is read.
     const ClusterArrays clusters[2] = {triangleClusters, ClusterArrays(blocks_[1], n_)};
-    // Not value-initialised: every entry is written before it is read.
-    inner_ = std::make_unique_for_overwrite<Inner[]>(n_ - 1);
-    adviseHugePages(inner_.get(), (n_ - 1) * sizeof(Inner));
+    inner_ = innerBlock_.array<Inner>(0, n_ - 1);
     // Per cluster of a round: the offset to its partner in a merge (0: none), from -kRadius
     // to kRadius.
     static_assert(kRadius <= 127);
     const auto partner = std::make_unique_for_overwrite<int8_t[]>(n_);
+    [[maybe_unused]] int round = 0;
     int current = 0;
     size_t count = n_;
     uint32_t created = 0;  // inner nodes so far
@@ -654,18 +777,13 @@ class PlocBuilder {
         findNeighbours(from, first, last, found.data());
         // (Pointers in locals: the compiler must assume that byte stores change anything
         // else in memory.)
-        int8_t* const partners = partner.get();
         uint32_t m = 0, s = 0;
-        for (size_t i = begin; i < end; ++i) {
-          const uint32_t j = found[i - first];
-          const bool mutual = j != i && found[j - first] == i;
-          m += mutual && i < j;
-          s += !mutual || i < j;
-          partners[i] = int8_t(mutual ? int(j) - int(i) : 0);
-        }
+        markPairs(found.data(), first, begin, end, partner.get(), m, s);
         merges[begin / kChunk] = m;
         survivors[begin / kChunk] = s;
       });
+      PT_BVH_PHASE("round " + std::to_string(++round) + " neighbours (" + std::to_string(count) +
+                   ")");
       size_t merged = 0;
       for (uint32_t m : merges) merged += m;
       if (merged < std::max<size_t>(1, count / kMinMergeShare)) {
@@ -693,6 +811,7 @@ class PlocBuilder {
         compact(from, to, partner.get(), begin, end, count, merges[begin / kChunk],
                 survivors[begin / kChunk]);
       });
+      PT_BVH_PHASE("round " + std::to_string(round) + " compact");
       created = nodeSum;
       count = outSum;
       to.pad(count);
@@ -704,11 +823,121 @@ class PlocBuilder {
   }
 
   // Moves the clusters [begin, end) of `from` that do not merge to `to` from position `out`
-  // on, in order, and makes the merges, as inner nodes from `node` on, in their place.
-  // (Everything in arguments and locals, so that the loop keeps it in registers.)
-  void compact(const ClusterArrays from, const ClusterArrays to, const int8_t* const partner,
+  // on, in order, and makes the merges, as inner nodes from `node` on, in their place. With
+  // AVX-512, sixteen clusters at a time (compactAvx512), the rest one by one.
+  void compact(const ClusterArrays& from, const ClusterArrays& to, const int8_t* partner,
                size_t begin, size_t end, size_t count, uint32_t node, uint32_t out) const {
-    Inner* const inner = inner_.get();
+#ifdef __x86_64__
+    if (hasAvx512()) {
+      const size_t blocksEnd = begin + (end - begin) / 16 * 16;
+      compactAvx512(from, to, partner, begin, blocksEnd, count, node, out);
+      begin = blocksEnd;
+    }
+#endif
+    compactOneByOne(from, to, partner, begin, end, count, node, out);
+  }
+
+#ifdef __x86_64__
+  // compact for [begin, end), a whole number of blocks of sixteen clusters, each block with
+  // a few vector instructions: the partners' boxes and ids permuted from the 32 clusters from
+  // the block's first on (a partner is at most kRadius = 16 places on), the merged boxes
+  // (min and max in the operand order of unite: the same boxes), the survivors and the
+  // merges compressed into place in order; then the merges' inner nodes one by one, from
+  // areas computed by lane (with halfArea's operations). Leaves `node` and `out` past what
+  // it wrote.
+  __attribute__((target("avx512f"))) void compactAvx512(const ClusterArrays& from,
+                                                        const ClusterArrays& to,
+                                                        const int8_t* const partner, size_t begin,
+                                                        size_t end, size_t count, uint32_t& node,
+                                                        uint32_t& out) const {
+    static_assert(kRadius == 16, "the partners are permuted from two blocks of sixteen");
+    Inner* const inner = inner_;
+    const uint32_t n = uint32_t(n_);
+    const float* const rows[6] = {from.lx, from.ly, from.lz, from.hx, from.hy, from.hz};
+    float* const outRows[6] = {to.lx, to.ly, to.lz, to.hx, to.hy, to.hz};
+    const uint32_t* const ids = from.id;
+    uint32_t* const outIds = to.id;
+    const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const __m512i zero = _mm512_setzero_si512();
+    alignas(64) float mergedArea[16], leftArea[16], rightArea[16];
+    alignas(64) uint32_t leftId[16], rightId[16];
+    for (size_t i = begin; i < end; i += 16) {
+      // Partners of the next block: fetch the summaries of those that merge (made rounds
+      // ago, by now out of the caches).
+      if (i + 32 <= count) {
+        const __m512i ahead = _mm512_maskz_cvtepi8_epi32(
+            0xFFFF, _mm_loadu_si128(reinterpret_cast<const __m128i*>(partner + i + 16)));
+        const __m512i aheadId = _mm512_loadu_si512(ids + i + 16);
+        for (unsigned k = _mm512_cmpneq_epi32_mask(ahead, zero) &
+                          _mm512_cmpge_epu32_mask(aheadId, _mm512_set1_epi32(int(n)));
+             k != 0; k &= k - 1) {
+          __builtin_prefetch(&inner[ids[i + 16 + unsigned(__builtin_ctz(k))] - n].summary);
+        }
+      }
+      const __m512i offset = _mm512_maskz_cvtepi8_epi32(
+          0xFFFF, _mm_loadu_si128(reinterpret_cast<const __m128i*>(partner + i)));
+      const __mmask16 keep = _mm512_cmpge_epi32_mask(offset, zero);
+      const __mmask16 merges = _mm512_cmpgt_epi32_mask(offset, zero);
+      // Each lane's partner, or itself (the second of a pair is not kept).
+      const __m512i index = _mm512_add_epi32(lanes, _mm512_maskz_max_epi32(0xFFFF, offset, zero));
+      __m512 box[6], other[6], merged[6];
+      for (int r = 0; r < 6; ++r) {
+        // (Rows are padded by more than sixteen after the last cluster.)
+        box[r] = _mm512_loadu_ps(rows[r] + i);
+        other[r] = _mm512_permutex2var_ps(box[r], index, _mm512_loadu_ps(rows[r] + i + 16));
+        // unite(box, other): lo = other < box ? other : box (minps returns its first
+        // operand where it is less, else the second), hi = box < other ? other : box.
+        merged[r] = r < 3 ? _mm512_maskz_min_ps(0xFFFF, other[r], box[r])
+                          : _mm512_maskz_max_ps(0xFFFF, other[r], box[r]);
+      }
+      const __m512i id = _mm512_loadu_si512(ids + i);
+      const size_t rest = count - (i + 16);  // (ids are not padded)
+      const __mmask16 nextValid = rest >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << rest) - 1);
+      const __m512i otherId =
+          _mm512_permutex2var_epi32(id, index, _mm512_maskz_loadu_epi32(nextValid, ids + i + 16));
+      // The merges' new ids, n + node on in lane order, in their lanes.
+      const __m512i outId = _mm512_mask_expand_epi32(
+          id, merges, _mm512_add_epi32(lanes, _mm512_set1_epi32(int(n + node))));
+      for (int r = 0; r < 6; ++r) _mm512_mask_compressstoreu_ps(outRows[r] + out, keep, merged[r]);
+      _mm512_mask_compressstoreu_epi32(outIds + out, keep, outId);
+      out += uint32_t(__builtin_popcount(keep));
+      if (merges == 0) continue;
+      halfArea16(merged, mergedArea);
+      halfArea16(box, leftArea);
+      halfArea16(other, rightArea);
+      _mm512_store_si512(leftId, id);
+      _mm512_store_si512(rightId, otherId);
+      auto summaryOf = [&](uint32_t clusterId, float area) {
+        return clusterId < n ? Summary{1, 1, kCollapseTriangleCost * area}
+                             : inner[clusterId - n].summary;
+      };
+      for (unsigned k = merges; k != 0; k &= k - 1) {
+        const unsigned lane = unsigned(__builtin_ctz(k));
+        Inner& parent = inner[node++];
+        parent.left = leftId[lane];
+        parent.right = rightId[lane];
+        parent.summary = merge(mergedArea[lane], summaryOf(leftId[lane], leftArea[lane]),
+                               summaryOf(rightId[lane], rightArea[lane]));
+      }
+    }
+  }
+
+  // halfArea of sixteen boxes (lo, hi in b[0..2], b[3..5]), lane by lane, to `area`.
+  [[gnu::always_inline]] __attribute__((target("avx512f"))) static inline void halfArea16(
+      const __m512* b, float* area) {
+    const __m512 dx = _mm512_sub_ps(b[3], b[0]), dy = _mm512_sub_ps(b[4], b[1]),
+                 dz = _mm512_sub_ps(b[5], b[2]);
+    _mm512_store_ps(area, _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dy), _mm512_mul_ps(dy, dz)),
+                                        _mm512_mul_ps(dz, dx)));
+  }
+#endif
+
+  // compact one cluster at a time. (Everything in arguments and locals, so that the loop
+  // keeps it in registers.)
+  void compactOneByOne(const ClusterArrays from, const ClusterArrays to,
+                       const int8_t* const partner, size_t begin, size_t end, size_t count,
+                       uint32_t node, uint32_t out) const {
+    Inner* const inner = inner_;
     const uint32_t n = uint32_t(n_);
     auto summaryOf = [&](uint32_t id, const Box& box) {
       return id < n ? Summary{1, 1, kCollapseTriangleCost * halfArea(box)} : inner[id - n].summary;
@@ -736,13 +965,7 @@ class PlocBuilder {
     }
   }
 
-  static constexpr uint32_t kIndexMask = 0x7fffffffu;
-
-  void prefetchTriangle(uint32_t index) const {
-    const char* t = reinterpret_cast<const char*>(&triangles_[index]);
-    __builtin_prefetch(t);
-    __builtin_prefetch(t + sizeof(Triangle) - 1);
-  }
+  static constexpr uint64_t kIndexMask = 0x7fffffffu;
 
   // The summary of cluster `id` with box `box`: a triangle's is its own.
   Summary summaryOf(uint32_t id, const Box& box) const {
@@ -750,8 +973,12 @@ class PlocBuilder {
   }
 
   // Subtree sizes by id; a triangle is a leaf of its own.
-  uint32_t countOf(uint32_t id) const { return id < n_ ? 1u : inner_[id - n_].summary.count; }
-  uint32_t sizeOf(uint32_t id) const { return id < n_ ? 1u : inner_[id - n_].summary.size; }
+  uint32_t countOf(uint32_t id) const {
+    return id < n_ ? 1u : inner_[id - n_].summary.count;
+  }
+  uint32_t sizeOf(uint32_t id) const {
+    return id < n_ ? 1u : inner_[id - n_].summary.size;
+  }
 
   // The summary of a merge of half area `area` of subtrees summarised by `l` and `r`, deciding
   // the SAH collapse bottom-up as the tree is made: a subtree of at most leafSize triangles
@@ -825,6 +1052,7 @@ class PlocBuilder {
       }
       chunkBounds[begin / kChunk] = bounds;
     });
+    PT_BVH_PHASE("top: references (" + std::to_string(count) + ")");
     TopRange all{0, count, 0, {}};
     for (const CenterBounds& b : chunkBounds) all.bounds.grow(b);
     pieceSize_ = workers_.count() == 1
@@ -832,6 +1060,7 @@ class PlocBuilder {
                      : std::max<size_t>(kTopPieceMin, count / size_t(8 * workers_.count()));
     plan_.clear();
     cut(all, base);
+    PT_BVH_PHASE("top: parallel splits");
     std::vector<uint32_t> pieces;
     for (uint32_t i = 0; i < plan_.size(); ++i) {
       if (plan_[i].piece) pieces.push_back(i);
@@ -840,6 +1069,7 @@ class PlocBuilder {
       TopItem& item = plan_[pieces[p]];
       item.root = buildTopSerial(item.range, item.base);
     });
+    PT_BVH_PHASE("top: subtrees");
     for (size_t i = plan_.size(); i-- > 0;) {
       TopItem& item = plan_[i];
       if (!item.piece) {
@@ -1010,35 +1240,41 @@ class PlocBuilder {
     };
     const Float8 empty = {INFINITY, INFINITY, INFINITY, INFINITY,
                           INFINITY, INFINITY, INFINITY, INFINITY};
+    // The three axes side by side, so that their dependency chains (each bin's box grows
+    // the last one's) overlap. An empty bin changes neither side: the cost of the right side
+    // from it on is the one from the next bin on, and a split after it costs what the split
+    // before it costs (not chosen: the first of equal costs wins), so every bin is taken as
+    // it comes, without branches.
+    std::array<std::array<float, kTopBins>, 3> rightCost, cost;
+    Float8 acc[3] = {empty, empty, empty};
+    uint32_t count[3] = {0, 0, 0};
+    for (int k = binCount - 1; k > 0; --k) {
+#pragma GCC unroll 3
+      for (size_t a = 0; a < 3; ++a) {
+        grow8(acc[a], bins[a].box[k]);
+        count[a] += uint32_t(bins[a].count[k]);
+        rightCost[a][size_t(k)] = area(acc[a]) * float(count[a]);
+      }
+    }
+    for (size_t a = 0; a < 3; ++a) acc[a] = empty, count[a] = 0;
+    for (int k = 1; k < binCount; ++k) {
+#pragma GCC unroll 3
+      for (size_t a = 0; a < 3; ++a) {
+        grow8(acc[a], bins[a].box[k - 1]);
+        count[a] += uint32_t(bins[a].count[k - 1]);
+        // (NaN: not a split, both sides must have triangles)
+        cost[a][size_t(k)] = count[a] == 0 || count[a] == total
+                                 ? NAN
+                                 : area(acc[a]) * float(count[a]) + rightCost[a][size_t(k)];
+      }
+    }
     int bestAxis = -1, bestBin = 0;
     float bestCost = INFINITY;
     for (int a = 0; a < 3; ++a) {
       if (scale[a] == 0.0f) continue;
-      const AxisBins& axis = bins[size_t(a)];
-      std::array<float, kTopBins> rightCost;
-      Float8 acc = empty;
-      uint32_t count = 0;
-      // An empty bin changes neither side: a split after it costs what the split before it
-      // costs, so it is skipped (the first of equal costs wins anyway), and the cost of the
-      // right side from it on is the one from the next bin on.
-      for (int k = binCount - 1; k > 0; --k) {
-        if (axis.count[k] == 0 && k < binCount - 1) {
-          rightCost[size_t(k)] = rightCost[size_t(k) + 1];
-          continue;
-        }
-        grow8(acc, axis.box[k]);
-        count += uint32_t(axis.count[k]);
-        rightCost[size_t(k)] = area(acc) * float(count);
-      }
-      acc = empty;
-      count = 0;
       for (int k = 1; k < binCount; ++k) {
-        if (axis.count[k - 1] == 0) continue;
-        grow8(acc, axis.box[k - 1]);
-        count += uint32_t(axis.count[k - 1]);
-        if (count == 0 || count == total) continue;
-        const float cost = area(acc) * float(count) + rightCost[size_t(k)];
-        if (cost < bestCost) bestCost = cost, bestAxis = a, bestBin = k;
+        const float c = cost[size_t(a)][size_t(k)];
+        if (c < bestCost) bestCost = c, bestAxis = a, bestBin = k;
       }
     }
     if (bestAxis < 0) {
@@ -1107,18 +1343,21 @@ class PlocBuilder {
   // ---- Linearization ---------------------------------------------------------------------
 
   Bvh linearize(uint32_t root) {
-    Bvh bvh = std::move(bvh_);
+    Bvh bvh;
+    bvh.triangles = std::move(input_);  // (its memory, block 1, is free again)
     out_ = bvh.triangles.data();
     bvh.nodes.reserve(sizeOf(root));
     adviseHugePages(bvh.nodes.data(), sizeOf(root) * sizeof(BvhNode));
     bvh.nodes.resize(sizeOf(root));
     nodes_ = bvh.nodes.data();
+    PT_BVH_PHASE("alloc nodes");
     std::vector<Piece> pieces;
     int maxDepth = plan(root, 0, 0, 0, pieces);
     std::vector<int> pieceDepths(pieces.size());
     workers_.forChunks(pieces.size(), 1, [&](size_t p, size_t) {
       pieceDepths[p] = place(pieces[p].id, pieces[p].position, pieces[p].first, pieces[p].depth);
     });
+    PT_BVH_PHASE("linearize");
     for (int depth : pieceDepths) maxDepth = std::max(maxDepth, depth);
     if (maxDepth <= depthLimit_) {
       uniteAbovePieces(root, 0);
@@ -1186,34 +1425,14 @@ class PlocBuilder {
 
   // Writes the collapsed subtree of `id`, at `depth` in the tree, with its root at
   // nodes_[position] and its triangles from out_[first] on, depth first, left child first;
-  // returns the depth of its deepest leaf. First the triangles, then the nodes over them.
+  // returns the depth of its deepest leaf.
   int place(uint32_t id, uint32_t position, uint32_t first, int depth) {
-    copyTriangles(id, first);
     return placeNodes(id, position, first, depth).depth;
   }
 
-  // The triangles of the subtree of `id` in depth-first order, to out_[first] on. They lie
-  // all over memory: the ranks are listed first, so that the copies can fetch ahead.
+  // The triangles of the subtree of `id` in depth-first order, to out_[first] on.
   void copyTriangles(uint32_t id, uint32_t first) {
-    std::vector<uint32_t> ranks;
-    ranks.reserve(countOf(id));
-    listRanks(id, ranks);
-    const size_t count = ranks.size();
-    for (size_t k = 0; k < count; ++k) {
-      if (k + kPrefetch < count) prefetchTriangle(order_[ranks[k + kPrefetch]]);
-      std::construct_at(out_ + first + k, triangles_[order_[ranks[k]]]);
-    }
-  }
-
-  void listRanks(uint32_t id, std::vector<uint32_t>& ranks) const {
-    if (id < n_) {
-      ranks.push_back(id);
-      return;
-    }
-    const Inner& node = inner_[id - n_];
-    if (node.right >= n_) __builtin_prefetch(&inner_[node.right - n_]);
-    listRanks(node.left, ranks);
-    listRanks(node.right, ranks);
+    leafBox(id, first);
   }
 
   // What placeNodes hands its caller: the subtree's box (Box4) and the depth of its deepest
@@ -1223,14 +1442,16 @@ class PlocBuilder {
     int depth;
   };
 
-  // The nodes of place, over the triangles already in out_.
+  // The nodes and triangles of place. The triangles of a subtree lie close together in
+  // sorted_ (in Morton order), so the copies mostly hit the caches.
   Placed placeNodes(uint32_t id, uint32_t position, uint32_t first, int depth) {
     if (id < n_) {
-      const Box4 box = triangleBox4(out_[first]);
+      const Box4 box = copyTriangle(id, first);
       writeNode(position, box, first, 1);
       return Placed{box, depth};
     }
     const Inner& node = inner_[id - n_];
+    if (node.right >= n_) __builtin_prefetch(&inner_[node.right - n_]);
     if (node.summary.size == 1) {  // collapsed into a leaf
       uint32_t next = first;
       const Box4 box = leafBox(id, next);
@@ -1245,13 +1466,20 @@ class PlocBuilder {
     return Placed{box, std::max(l.depth, r.depth)};
   }
 
-  // The box of the subtree of `id`, its triangles in out_ from `first` on (`first` moves past
-  // them), united as the merges united them.
-  Box4 leafBox(uint32_t id, uint32_t& first) const {
-    if (id < n_) return triangleBox4(out_[first++]);
+  // Copies the triangles of the subtree of `id` to out_ from `first` on (`first` moves past
+  // them) and returns their box, united as the merges united them.
+  Box4 leafBox(uint32_t id, uint32_t& first) {
+    if (id < n_) return copyTriangle(id, first++);
     const Inner& node = inner_[id - n_];
     const Box4 left = leafBox(node.left, first);
     return unite4(left, leafBox(node.right, first));
+  }
+
+  // Copies the triangle of Morton rank `rank` to out_[at]; returns its box.
+  Box4 copyTriangle(uint32_t rank, uint32_t at) {
+    const Triangle& t = sorted_[rank];
+    std::construct_at(out_ + at, t);
+    return triangleBox4(t);
   }
 
   void writeNode(uint32_t position, const Box4& box, uint32_t offset, uint32_t count) {
@@ -1265,11 +1493,13 @@ class PlocBuilder {
 
   // The box of `id` (boxes_ is set).
   Box boxOf(uint32_t id) const {
-    return id < n_ ? triangleBox(triangles_[order_[id]]) : boxes_[id - n_];
+    return id < n_ ? triangleBox(sorted_[id]) : boxes_[id - n_];
   }
 
   // The depth of the deepest leaf below `id` in its collapsed form (heights_ is set).
-  int heightOf(uint32_t id) const { return id < n_ ? 0 : heights_[id - n_]; }
+  int heightOf(uint32_t id) const {
+    return id < n_ ? 0 : heights_[id - n_];
+  }
 
   // The rare tree deeper than the traversal stack (top-down splits that peel one cluster off
   // at a time, as nested boxes can make them): serially,
@@ -1309,16 +1539,20 @@ class PlocBuilder {
     maxDepth = std::max(maxDepth, emitter.maxDepth());
   }
 
-  const std::vector<Triangle>& triangles_;
+  // The triangles as given, until they are copied in Morton order; then the memory of block
+  // 1; then the output.
+  std::vector<Triangle> input_;
   const size_t n_;
   const size_t leafSize_;
   const int depthLimit_;  // deepest leaf allowed: kBvhStackSize, less in tests
   Workers& workers_;
-  Bvh bvh_;  // the tree being built; its triangles' memory lent to block 1 until linearize
-  // Scratch memory: the Morton keys, the clusters of the rounds, the top levels' state.
+  std::unique_ptr<Triangle[]> sorted_;  // the triangles in Morton order (by id)
+  // The Morton keys, then the inner nodes (inner_).
+  Block innerBlock_;
+  // Scratch memory: the centroids, then the clusters of the rounds (ping-ponging between the
+  // two blocks), then the top levels' state.
   Block blocks_[2];
-  std::unique_ptr<uint32_t[]> order_;  // Morton rank -> input index
-  std::unique_ptr<Inner[]> inner_;
+  Inner* inner_ = nullptr;
   // By inner node, only for a tree too deep for the stack: heights and boxes.
   std::unique_ptr<int[]> heights_;
   std::unique_ptr<Box[]> boxes_;
@@ -1337,11 +1571,11 @@ class PlocBuilder {
 
 }  // namespace
 
-Bvh buildPlocBvh(const std::vector<Triangle>& triangles, size_t leafSize, Workers& workers,
+Bvh buildPlocBvh(std::vector<Triangle> triangles, size_t leafSize, Workers& workers,
                  int depthLimit) {
   PT_CHECK(triangles.size() < (size_t(1) << 31), "ids of triangles and merges share 32 bits");
   PT_CHECK(depthLimit >= balancedLevels(triangles.size(), leafSize));
-  return PlocBuilder(triangles, leafSize, depthLimit, workers).build();
+  return PlocBuilder(std::move(triangles), leafSize, depthLimit, workers).build();
 }
 
 }  // namespace pt

@@ -5,11 +5,18 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <thread>
+#include <vector>
 
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
+#ifdef PT_BVH_PROFILE
+#include <cstdio>
+#include <cstdlib>
+#endif
 
+#include "bvh/workers.h"
 #include "common/check.h"
 
 namespace pt {
@@ -34,31 +41,102 @@ void laneNodes(const Bvh& bvh, uint32_t index, uint32_t (&lanes)[kWideLanes]) {
   place(place, index, 0, 0);
 }
 
-// The number of wide nodes that Collapse::fill makes of binary node `index` and below: its
-// own, and those of its lanes that are interior nodes.
-size_t wideNodeCount(const Bvh& bvh, uint32_t index) {
+// What Collapse::fill allocates for the wide node of binary node `index` and below: wide
+// nodes below it (not its own), and triangle packets (of its leaf lanes and below).
+struct Counts {
+  size_t nodes = 0, packets = 0;
+};
+Counts countBelow(const Bvh& bvh, uint32_t index) {
   uint32_t lanes[kWideLanes];
   laneNodes(bvh, index, lanes);
-  size_t count = 1;
+  Counts counts;
   for (uint32_t n : lanes) {
-    if (n != kWideEmpty && bvh.nodes[n].count == 0) count += wideNodeCount(bvh, n);
+    if (n == kWideEmpty) continue;
+    const BvhNode& node = bvh.nodes[n];
+    if (node.count > 0) {
+      counts.packets += (node.count + kPacketLanes - 1) / kPacketLanes;
+    } else {
+      const Counts below = countBelow(bvh, n);
+      counts.nodes += 1 + below.nodes;
+      counts.packets += below.packets;
+    }
   }
-  return count;
+  return counts;
 }
 
+// Fills the wide tree depth first, into arrays of their final sizes: a node's interior
+// children take consecutive slots (allocated as the node is filled, before anything below
+// them), and its leaf children's packets are consecutive, so that the children a ray visits
+// after one another tend to share pages and cache lines. The subtrees below kPieceDepth
+// are filled by the workers: each one's slots and packets start where the serial order
+// would put them (the counts of the subtrees before it), so the tree is the same for any
+// number of workers.
 class Collapse {
  public:
-  Collapse(const Bvh& bvh, WideBvh& wide) : bvh_(bvh), wide_(wide) {}
+  // Wide nodes this deep are the roots of the pieces the workers fill (at most 8^2 = 64).
+  static constexpr int kPieceDepth = 2;
 
-  // Fills wide node `at` (already allocated) from binary node `index` (interior, or the
-  // root when the whole tree is one leaf), then everything below it. A node's interior
-  // children take consecutive slots, and its leaf children's packets are consecutive, so
-  // that the children a ray visits after one another tend to share pages and cache lines.
-  void fill(uint32_t at, uint32_t index, int depth) {
-    wide_.maxDepth = std::max(wide_.maxDepth, depth);
+  Collapse(const Bvh& bvh, WideBvh& wide, size_t nextNode, size_t nextPacket)
+      : bvh_(bvh), wide_(wide), nextNode_(nextNode), nextPacket_(nextPacket) {}
+
+  // A subtree below the top levels: its root `at` (allocated by its parent) over binary node
+  // `index`, and where its allocations start.
+  struct Piece {
+    uint32_t at, index;
+    int depth;
+    Counts counts;
+    size_t firstNode = 0, firstPacket = 0;
+  };
+
+  // With `write`, fills wide node `at` (already allocated) from binary node `index`
+  // (interior, or the root when the whole tree is one leaf), then everything below it; but
+  // a child at kPieceDepth is listed in `pieces` instead (without `write`: only that,
+  // allocating nothing; with it: the piece, already listed in this order, gets its start).
+  void fillTop(uint32_t at, uint32_t index, int depth, bool write, std::vector<Piece>& pieces,
+               size_t& piece) {
     uint32_t lanes[kWideLanes];
     laneNodes(bvh_, index, lanes);
-    WideNode wide;
+    if (write) fillNode(at, depth, lanes);
+    for (int i = 0; i < kWideLanes; ++i) {
+      if (lanes[i] == kWideEmpty || bvh_.nodes[lanes[i]].count > 0) continue;
+      const uint32_t child = write ? wide_.nodes[at].child[i] : 0;
+      if (depth + 1 < kPieceDepth) {
+        fillTop(child, lanes[i], depth + 1, write, pieces, piece);
+      } else if (!write) {
+        pieces.push_back(Piece{0, lanes[i], depth + 1, {}});
+      } else {
+        Piece& p = pieces[piece++];
+        p.at = child;
+        p.firstNode = nextNode_;
+        p.firstPacket = nextPacket_;
+        nextNode_ += p.counts.nodes;
+        nextPacket_ += p.counts.packets;
+      }
+    }
+  }
+
+  // Fills wide node `at` and everything below it.
+  void fill(uint32_t at, uint32_t index, int depth) {
+    uint32_t lanes[kWideLanes];
+    laneNodes(bvh_, index, lanes);
+    const WideNode& wide = fillNode(at, depth, lanes);
+    for (int i = 0; i < kWideLanes; ++i) {
+      if (wide.child[i] != kWideEmpty && !(wide.child[i] & kWideLeaf)) {
+        fill(wide.child[i], lanes[i], depth + 1);
+      }
+    }
+  }
+
+  size_t nodesAllocated() const { return nextNode_; }
+  size_t packetsAllocated() const { return nextPacket_; }
+  int maxDepth() const { return maxDepth_; }
+
+ private:
+  // Wide node `at` from the binary nodes in its lanes, allocating its interior children's
+  // slots and packing its leaf children's triangles.
+  const WideNode& fillNode(uint32_t at, int depth, const uint32_t (&lanes)[kWideLanes]) {
+    maxDepth_ = std::max(maxDepth_, depth);
+    WideNode& wide = wide_.nodes[at];
     for (int i = 0; i < kWideLanes; ++i) {
       wide.child[i] = kWideEmpty;
       wide.packetCount[i] = 0;
@@ -70,11 +148,10 @@ class Collapse {
         lo = b.boundsMin;
         hi = b.boundsMax;
         if (b.count > 0) {
-          wide.child[i] = kWideLeaf | uint32_t(wide_.packets.size());
+          wide.child[i] = kWideLeaf | uint32_t(nextPacket_);
           wide.packetCount[i] = emitPackets(b.offset, b.count);
         } else {
-          wide.child[i] = uint32_t(wide_.nodes.size());
-          wide_.nodes.emplace_back();
+          wide.child[i] = uint32_t(nextNode_++);
         }
       }
       for (int axis = 0; axis < 3; ++axis) {
@@ -82,20 +159,14 @@ class Collapse {
         wide.bounds[axis + 3][i] = hi[axis];
       }
     }
-    wide_.nodes[at] = wide;
-    for (int i = 0; i < kWideLanes; ++i) {
-      if (wide.child[i] != kWideEmpty && !(wide.child[i] & kWideLeaf)) {
-        fill(wide.child[i], lanes[i], depth + 1);
-      }
-    }
+    return wide;
   }
 
- private:
   // Packs triangles [first, first + count) four at a time; returns the number of packets.
   uint32_t emitPackets(uint32_t first, uint32_t count) {
     uint32_t packets = 0;
     for (uint32_t begin = first; begin < first + count; begin += kPacketLanes, ++packets) {
-      TrianglePacket& p = wide_.packets.emplace_back();
+      TrianglePacket& p = wide_.packets[nextPacket_++];
       p.first = begin;
       p.count = std::min(uint32_t(kPacketLanes), first + count - begin);
       for (uint32_t lane = 0; lane < uint32_t(kPacketLanes); ++lane) {
@@ -108,13 +179,37 @@ class Collapse {
         }
       }
     }
-    PT_CHECK(wide_.packets.size() < size_t(kWideLeaf), "too many triangle packets");
     return packets;
   }
 
   const Bvh& bvh_;
   WideBvh& wide_;
+  size_t nextNode_, nextPacket_;  // the next slot and packet to allocate
+  int maxDepth_ = 0;
 };
+
+// countBelow of binary node `index` at `depth`, from the counts of the pieces below it (from
+// pieces[piece] on, in the order fillTop lists them; `piece` moves past them).
+Counts countTop(const Bvh& bvh, uint32_t index, int depth,
+                const std::vector<Collapse::Piece>& pieces, size_t& piece) {
+  uint32_t lanes[kWideLanes];
+  laneNodes(bvh, index, lanes);
+  Counts counts;
+  for (uint32_t n : lanes) {
+    if (n == kWideEmpty) continue;
+    const BvhNode& node = bvh.nodes[n];
+    if (node.count > 0) {
+      counts.packets += (node.count + kPacketLanes - 1) / kPacketLanes;
+      continue;
+    }
+    const Counts below = depth + 1 < Collapse::kPieceDepth
+                             ? countTop(bvh, n, depth + 1, pieces, piece)
+                             : pieces[piece++].counts;
+    counts.nodes += 1 + below.nodes;
+    counts.packets += below.packets;
+  }
+  return counts;
+}
 
 // Asks Linux for transparent huge pages over a vector's reserved storage, before it is first
 // touched (the usual setting gives them to regions that ask). The traversal's reads jump
@@ -137,22 +232,65 @@ void adviseHugePages([[maybe_unused]] const std::vector<T>& v) {
 
 WideBvh buildWideBvh(const Bvh& bvh) {
   PT_CHECK(!bvh.nodes.empty() && !bvh.triangles.empty());
+  PT_BVH_PROFILE_BEGIN();
   const auto start = std::chrono::steady_clock::now();
   WideBvh wide;
-  // Exact sizes, so that the arrays are allocated once, untouched, and can be advised.
-  size_t packets = 0;
-  for (const BvhNode& node : bvh.nodes) packets += (node.count + kPacketLanes - 1) / kPacketLanes;
-  wide.packets.reserve(packets);
-  wide.nodes.reserve(wideNodeCount(bvh, 0));
-  adviseHugePages(wide.packets);
-  adviseHugePages(wide.nodes);
   wide.rootMin = bvh.nodes[0].boundsMin;
   wide.rootMax = bvh.nodes[0].boundsMax;
-  wide.nodes.emplace_back();
-  Collapse(bvh, wide).fill(0, 0, 0);
-  PT_CHECK(wide.packets.size() == packets && wide.nodes.size() == wide.nodes.capacity());
+  // The top levels' pieces, their sizes (counted in parallel), and from them the arrays'.
+  std::vector<Collapse::Piece> pieces;
+  size_t piece = 0;
+  Collapse top(bvh, wide, 1, 0);
+  top.fillTop(0, 0, 0, false, pieces, piece);
+  // (One worker per hardware thread, fewer for small trees: the work is that of the nodes.)
+  Workers workers(int(std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()),
+                                       bvh.nodes.size() / 32768 + 1)));
+  workers.forChunks(pieces.size(), 1,
+                    [&](size_t p, size_t) { pieces[p].counts = countBelow(bvh, pieces[p].index); });
+  // The whole tree's size from the pieces'; then the top again, writing.
+  piece = 0;
+  const Counts all = countTop(bvh, 0, 0, pieces, piece);
+  PT_CHECK(all.packets < size_t(kWideLeaf), "too many triangle packets");
+  wide.nodes.reserve(1 + all.nodes);
+  wide.packets.reserve(all.packets);
+  adviseHugePages(wide.packets);
+  adviseHugePages(wide.nodes);
+  wide.nodes.resize(1 + all.nodes);  // (not initialised: see WideNode)
+  wide.packets.resize(all.packets);
+  PT_BVH_PHASE("count and allocate");
+  piece = 0;
+  top.fillTop(0, 0, 0, true, pieces, piece);
+  PT_BVH_PHASE("fill the top");
+  std::vector<int> depths(pieces.size());
+  workers.forChunks(pieces.size(), 1, [&](size_t p, size_t) {
+    Collapse collapse(bvh, wide, pieces[p].firstNode, pieces[p].firstPacket);
+    collapse.fill(pieces[p].at, pieces[p].index, pieces[p].depth);
+    PT_CHECK(collapse.nodesAllocated() == pieces[p].firstNode + pieces[p].counts.nodes &&
+             collapse.packetsAllocated() == pieces[p].firstPacket + pieces[p].counts.packets);
+    depths[p] = collapse.maxDepth();
+  });
+  PT_BVH_PHASE("fill the pieces");
+  PT_CHECK(top.nodesAllocated() == wide.nodes.size() &&
+           top.packetsAllocated() == wide.packets.size());
+  wide.maxDepth = top.maxDepth();
+  for (int depth : depths) wide.maxDepth = std::max(wide.maxDepth, depth);
   wide.buildSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  PT_BVH_PROFILE_END("buildWideBvh");
+#ifdef PT_BVH_PROFILE
+  if (std::getenv("PT_BVH_HASH")) {
+    uint64_t hash = 1469598103934665603ull;
+    auto add = [&hash](const void* data, size_t size) {
+      const unsigned char* p = static_cast<const unsigned char*>(data);
+      for (size_t i = 0; i < size; ++i) hash = (hash ^ p[i]) * 1099511628211ull;
+    };
+    add(wide.nodes.data(), wide.nodes.size() * sizeof(WideNode));
+    add(wide.packets.data(), wide.packets.size() * sizeof(TrianglePacket));
+    std::fprintf(stderr, "wide hash %016llx nodes %zu packets %zu depth %d\n",
+                 static_cast<unsigned long long>(hash), wide.nodes.size(), wide.packets.size(),
+                 wide.maxDepth);
+  }
+#endif
   return wide;
 }
 

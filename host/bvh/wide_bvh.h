@@ -41,10 +41,14 @@ inline constexpr int kPacketLanes = 4;  // triangles per packet
 // A binary leaf less than three levels below N takes the first lane of the lanes under it;
 // the others are unused: kWideEmpty, with an inverted box (lo = +inf, hi = -inf) that no ray
 // enters.
+// (Default construction leaves the fields unset, also in a vector's resize: buildWideBvh
+// writes every field of every node and packet, in parallel, and a value-initialising resize
+// would first zero the arrays on one thread.)
 struct alignas(64) WideNode {
   float bounds[6][kWideLanes];       // lo.x, lo.y, lo.z, hi.x, hi.y, hi.z of each child
   uint32_t child[kWideLanes];        // see above
   uint32_t packetCount[kWideLanes];  // leaf: its packets (>= 1); else 0
+  WideNode() {}                      // (see above)
 };                                   // 256 bytes: four cache lines
 inline constexpr uint32_t kWideLeaf = 0x80000000u;
 inline constexpr uint32_t kWideEmpty = 0xFFFFFFFFu;
@@ -57,6 +61,8 @@ struct alignas(16) TrianglePacket {
   uint32_t primitive[kPacketLanes];  // each lane's Triangle::primitive (isCloserHit's ties)
   uint32_t first;                    // Bvh::triangles index of lane 0; lane i holds first + i
   uint32_t count;                    // 1 to 4 lanes in use
+
+  TrianglePacket() {}  // (fields left unset: see WideNode)
 
   Triangle triangle(uint32_t lane) const {
     Triangle tri{};

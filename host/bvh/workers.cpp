@@ -1,6 +1,13 @@
 // The BVH builders' thread team; see workers.h.
 #include "bvh/workers.h"
 
+#ifdef PT_BVH_PROFILE
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cstdio>
+#endif
+
 namespace pt {
 
 Workers::Workers(int threads) {
@@ -67,3 +74,65 @@ void Workers::loop(int worker) {
 }
 
 }  // namespace pt
+
+#ifdef PT_BVH_PROFILE
+namespace pt::build_profile {
+namespace {
+
+struct Mark {
+  double wall, cpu, sys;
+  long faults;
+};
+
+Mark now() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+  return Mark{
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(),
+      seconds(usage.ru_utime) + seconds(usage.ru_stime), seconds(usage.ru_stime), usage.ru_minflt};
+}
+
+struct Phase {
+  std::string name;
+  Mark delta;
+};
+std::vector<Phase> phases;
+Mark last = now();
+
+}  // namespace
+
+void begin() {
+  phases.clear();
+  last = now();
+}
+
+void phase(const std::string& name) {
+  const Mark m = now();
+  phases.push_back(Phase{
+      name, Mark{m.wall - last.wall, m.cpu - last.cpu, m.sys - last.sys, m.faults - last.faults}});
+  last = now();  // (the bookkeeping is not counted)
+}
+
+void end(const char* title) {
+  phase("(rest)");
+  Mark total{0, 0, 0, 0};
+  std::fprintf(stderr, "%s\n%-34s %8s %6s %8s %8s %7s\n", title, "phase", "wall_ms", "share",
+               "cpu_ms", "sys_ms", "faults");
+  for (const Phase& p : phases) {
+    total.wall += p.delta.wall, total.cpu += p.delta.cpu, total.sys += p.delta.sys;
+    total.faults += p.delta.faults;
+  }
+  for (const Phase& p : phases) {
+    std::fprintf(stderr, "%-34s %8.2f %5.1f%% %8.2f %8.2f %7ld\n", p.name.c_str(),
+                 1e3 * p.delta.wall, 100 * p.delta.wall / total.wall, 1e3 * p.delta.cpu,
+                 1e3 * p.delta.sys, p.delta.faults);
+  }
+  std::fprintf(stderr, "profile %s wall_ms=%.2f cpu_ms=%.2f sys_ms=%.2f faults=%ld\n", title,
+               1e3 * total.wall, 1e3 * total.cpu, 1e3 * total.sys, total.faults);
+  phases.clear();
+  last = now();
+}
+
+}  // namespace pt::build_profile
+#endif

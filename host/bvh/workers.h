@@ -13,6 +13,27 @@
 #include <thread>
 #include <vector>
 
+// Phase timers for profiling a build (docs/bvh-build.md): compiled only with -DPT_BVH_PROFILE,
+// where PT_BVH_PHASE(name) ends the phase so named (wall time, the process's CPU time, which
+// over the wall time says how parallel it ran, and its minor page faults since the previous
+// mark; PT_BVH_PROFILE_BEGIN() starts the clock) and PT_BVH_PROFILE_END(title) prints the
+// phases on stderr. Nothing in other builds.
+#ifdef PT_BVH_PROFILE
+#include <string>
+namespace pt::build_profile {
+void begin();
+void phase(const std::string& name);
+void end(const char* title);
+}  // namespace pt::build_profile
+#define PT_BVH_PROFILE_BEGIN() ::pt::build_profile::begin()
+#define PT_BVH_PHASE(name) ::pt::build_profile::phase(name)
+#define PT_BVH_PROFILE_END(title) ::pt::build_profile::end(title)
+#else
+#define PT_BVH_PROFILE_BEGIN() static_cast<void>(0)
+#define PT_BVH_PHASE(name) static_cast<void>(0)
+#define PT_BVH_PROFILE_END(title) static_cast<void>(0)
+#endif
+
 namespace pt {
 
 class Workers {
