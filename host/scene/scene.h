@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/shared.h"
@@ -72,6 +73,11 @@ void scaleDiffuseTransmission(Material& material, float scale);
 // The most random-walk steps or walks a coated material may ask for per evaluation: far more
 // than pbrt-v4's defaults (10 and 1) need, and small enough that one evaluation stays short.
 inline constexpr std::int64_t kMaxCoatedWalk = 1000;
+
+// cos and sin of an angle in degrees, exact for multiples of 90 degrees so that axis-aligned
+// geometry stays exactly axis-aligned (cos(radians(90)) is 6e-17, not 0). Both scene readers
+// rotate with it.
+std::pair<double, double> cosSinDegrees(double degrees);
 
 // Builds the GPU camera for a film of width x height pixels.
 Camera makeCamera(const CameraDesc& desc, int width, int height);

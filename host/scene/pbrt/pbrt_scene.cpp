@@ -36,32 +36,6 @@ namespace fs = std::filesystem;
 
 namespace pbrt {
 
-namespace {
-
-// cos and sin of an angle in degrees, exact for multiples of 90 degrees so that axis-aligned
-// geometry stays axis-aligned (cos(radians(90)) is 6e-17, not 0).
-std::pair<double, double> cosSinDegrees(double degrees) {
-  const double reduced = std::fmod(degrees, 360.0);  // exact
-  if (std::fmod(reduced, 90.0) == 0.0) {
-    switch (static_cast<int>(reduced < 0 ? reduced + 360.0 : reduced)) {
-      case 0:
-        return {1.0, 0.0};
-      case 90:
-        return {0.0, 1.0};
-      case 180:
-        return {-1.0, 0.0};
-      case 270:
-        return {0.0, -1.0};
-      default:
-        break;
-    }
-  }
-  const double radians = reduced * (3.14159265358979323846 / 180.0);
-  return {std::cos(radians), std::sin(radians)};
-}
-
-}  // namespace
-
 glm::dmat4 translateMatrix(glm::dvec3 delta) {
   glm::dmat4 m(1.0);
   m[3] = glm::dvec4(delta, 1.0);
