@@ -137,8 +137,10 @@ Scene sphereScene() {
   scene.camera.position = vec3(0.0f, 0.0f, -3.4f);
   scene.camera.target = vec3(0.0f);
   scene.camera.vfovDegrees = 45.0f;
-  scene.materials = {Material{vec3(0.8f), kMaterialDiffuse, vec3(0.0f), 0},
-                     Material{vec3(0.0f), kMaterialDiffuse, vec3(10.0f), 0}};
+  scene.materials = {defaultMaterial(kMaterialDiffuse), defaultMaterial(kMaterialDiffuse)};
+  scene.materials[0].reflectance = vec3(0.8f);
+  scene.materials[1].reflectance = vec3(0.0f);
+  scene.materials[1].emission = vec3(10.0f);
   scene.materialNames = {"white", "light"};
   scene.triangles = bench::uvSphere(726, 725, 0);
   // Wound so that the geometric normal, cross(v1 - v0, v2 - v0), points down: the lit side.

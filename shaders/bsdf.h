@@ -40,8 +40,6 @@ namespace pt {
 #define PT_LOOP_TICK()
 #endif
 
-PT_CONST float kInv4Pi = 0.07957747154594766788f;
-
 // ---- Sample records and flags ------------------------------------------------------------
 
 PT_CONST uint kBsdfReflection = 1u;    // wi on wo's side of the surface

@@ -34,6 +34,9 @@ const bool kThinDielectric = false;
 const bool kDiffuseTransmission = false;
 const bool kCoatedDiffuse = false;
 const bool kShadingNormals = false;
+const bool kDeltaLights = false;
+const bool kEnvironment = false;
+const bool kTwoSidedEmitters = false;
 #else
 layout(constant_id = PT_SPEC_CONDUCTOR) const bool kConductor = true;
 layout(constant_id = PT_SPEC_DIELECTRIC) const bool kDielectric = true;
@@ -41,7 +44,12 @@ layout(constant_id = PT_SPEC_THIN_DIELECTRIC) const bool kThinDielectric = true;
 layout(constant_id = PT_SPEC_DIFFUSE_TRANSMISSION) const bool kDiffuseTransmission = true;
 layout(constant_id = PT_SPEC_COATED_DIFFUSE) const bool kCoatedDiffuse = true;
 layout(constant_id = PT_SPEC_SHADING_NORMALS) const bool kShadingNormals = true;
+layout(constant_id = PT_SPEC_DELTA_LIGHTS) const bool kDeltaLights = true;
+layout(constant_id = PT_SPEC_ENVIRONMENT) const bool kEnvironment = true;
+layout(constant_id = PT_SPEC_TWO_SIDED_EMITTERS) const bool kTwoSidedEmitters = true;
 #endif
+// Some emitter is one of lights.h's (not a triangle).
+const bool kAnalyticLights = kDeltaLights || kEnvironment;
 // Some surface has one of bsdf.h's materials; bsdf.h's switch sees only the types in use.
 const bool kBsdfMaterials =
     kConductor || kDielectric || kThinDielectric || kDiffuseTransmission || kCoatedDiffuse;
@@ -61,6 +69,7 @@ layout(set = 0, binding = PT_BINDING_TRIANGLES) uniform usamplerBuffer triangleT
 layout(set = 0, binding = PT_BINDING_MATERIALS) uniform usamplerBuffer materialTexels;
 layout(set = 0, binding = PT_BINDING_EMITTERS) uniform usamplerBuffer emitterTexels;
 layout(set = 0, binding = PT_BINDING_NORMALS) uniform usamplerBuffer normalTexels;
+layout(set = 0, binding = PT_BINDING_LIGHTS) uniform usamplerBuffer lightTexels;
 layout(std430, set = 0, binding = PT_BINDING_ACCUM) buffer AccumBuffer {
   AccumPixel accum[];
 };
@@ -90,6 +99,7 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 #define PT_HAS_COATED_DIFFUSE kCoatedDiffuse
 #define PT_LOOP_TICK() gLoopIterations++
 #include "bsdf.h"
+#include "lights.h"
 #endif
 
 // Watertight unless switched off by specialization or, unspecialized, by the parameters.
@@ -99,6 +109,9 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 #define PT_SOBOL \
   (kSampler == kSpecAtRunTime ? params.samplerType == kSamplerSobol : kSampler == kSamplerSobol)
 #include "bvh.glsl"
+// The camera's samples (pixel filter, thin lens), the bisection loops counted.
+#define PT_FILTER_LOOP_TICK() gLoopIterations++
+#include "filter.h"
 
 // The rows beyond the first two only where a scene has bsdf.h's materials.
 Material loadMaterial(uint i) {
@@ -133,6 +146,17 @@ Emitter loadEmitter(uint i) {
   return Emitter(a.x, uintBitsToFloat(a.y), uintBitsToFloat(a.z), a.w);
 }
 
+#ifndef PT_NO_BSDF_MATERIALS
+Light loadLight(uint i) {
+  int at = int(kLightTexels * i);
+  uvec4 a = texelFetch(lightTexels, at);
+  uvec4 b = texelFetch(lightTexels, at + 1);
+  uvec4 c = texelFetch(lightTexels, at + 2);
+  return Light(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), uintBitsToFloat(b.w),
+               uintBitsToFloat(c.xyz), uintBitsToFloat(c.w));
+}
+#endif
+
 // A ray whose first traversal gave up at an edge function of exactly zero (traceRayWith in
 // bvh.glsl), traced again with the exact test once the bounce is done (main): a shadow ray,
 // whose light sample then adds `contribution` to the path's radiance unless occluded, or the
@@ -159,18 +183,35 @@ struct LightPoint {
   vec3 Le;
   uint triangle;
   uint primitive;
+  bool twoSided;  // emits on both sides
 };
 
-LightPoint pickLightPoint(vec2 uChoose, vec2 uLight) {
+// The emitter the alias table gives for uChoose.
+Emitter pickEmitter(vec2 uChoose) {
   uint slot = aliasTableSlot(uChoose.x, params.emitterCount);
-  Emitter emitter = loadEmitter(aliasTablePick(slot, loadEmitter(slot), uChoose.y));
+  return loadEmitter(aliasTablePick(slot, loadEmitter(slot), uChoose.y));
+}
+
+LightPoint pointOnEmitter(Emitter emitter, vec2 uLight) {
   Triangle light = loadTriangle(emitter.triangle);
   vec2 b = sampleTriangleBarycentrics(uLight);
   vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
+  Material lightMaterial = loadMaterial(light.material);
   return LightPoint((1.0 - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2,
                     normalize(lightCross), 0.5 * length(lightCross),
                     triangleMagnitude(light.v0, light.v1, light.v2), emitter.pmf,
-                    loadMaterial(light.material).emission, emitter.triangle, light.primitive);
+                    lightMaterial.emission, emitter.triangle, light.primitive,
+                    kTwoSidedEmitters && lightMaterial.twoSided != 0u);
+}
+
+// A two-sided light seen from its back (cosLight < 0): the side the receiver sees is the
+// emitting one, its normal turned towards the receiver (for the cosine and the shadow ray's
+// offset).
+void faceTwoSided(inout LightPoint light, inout float cosLight) {
+  if (light.twoSided && cosLight < 0.0) {
+    cosLight = -cosLight;
+    light.normal = -light.normal;
+  }
 }
 
 // Traces the shadow ray of a light sample from `from` (offset) to the light point (offset),
@@ -179,8 +220,7 @@ LightPoint pickLightPoint(vec2 uChoose, vec2 uLight) {
 const uint kShadowOccluded = 0u;
 const uint kShadowClear = 1u;
 const uint kShadowRetrace = 2u;
-uint traceShadowRay(vec3 from, LightPoint light, out vec3 direction) {
-  vec3 to = offsetRayOrigin(light.point, light.normal, light.magnitude);
+uint traceShadowRayTo(vec3 from, vec3 to, out vec3 direction) {
   direction = to - from;
   gRays++;
   HitData blocker;
@@ -189,6 +229,10 @@ uint traceShadowRay(vec3 from, LightPoint light, out vec3 direction) {
       traceRayWith(/*exact=*/false, from, direction, 1.0, /*anyHit=*/true, blocker, inexact);
   if (inexact) return kShadowRetrace;
   return occluded ? kShadowOccluded : kShadowClear;
+}
+uint traceShadowRay(vec3 from, LightPoint light, out vec3 direction) {
+  return traceShadowRayTo(from, offsetRayOrigin(light.point, light.normal, light.magnitude),
+                          direction);
 }
 
 // A clear shadow ray's contribution, or zero with `retrace` set to add it once the ray has been
@@ -208,6 +252,29 @@ void debugLightSample(uint depth, LightPoint light, float lightPdf, float weight
 #endif
 }
 
+#ifndef PT_NO_BSDF_MATERIALS
+// A light sample of one of lights.h's lights (chosen with probability pmf), given the BSDF's
+// f * |cos| towards it (fCos) and its density (bsdfDensity, read only for MIS): traces the
+// shadow ray from `from` and returns the contribution, weighed by the power heuristic unless
+// the light is a delta (which BSDF sampling never finds).
+vec3 analyticLightContribution(AnalyticLightSample ls, float pmf, vec3 from, vec3 beta, vec3 fCos,
+                               float bsdfDensity, bool misOn, uint depth, inout Retrace retrace) {
+  vec3 direction;
+  uint shadow = traceShadowRayTo(from, ls.target, direction);
+  if (shadow == kShadowOccluded) return vec3(0.0);
+  float lightPdf = pmf * ls.pdf;
+  float weight = (misOn && !ls.delta) ? powerHeuristic(lightPdf, bsdfDensity) : 1.0;
+#ifdef PT_DEBUG_PRINTF
+  if (gDebug) {
+    debugPrintfEXT("gpu depth %u: light sample on analytic light pdf=%g weight=%g", depth,
+                   lightPdf, weight);
+  }
+#endif
+  vec3 contribution = beta * fCos * ls.Li * (weight / lightPdf);
+  return addOrDefer(shadow, from, direction, contribution, retrace);
+}
+#endif
+
 // Samples direct illumination at diffuse vertex p with shading normal n (next-event
 // estimation, pbrt's SampleLd): picks an emitter from the alias table with uChoose, a uniform
 // point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
@@ -218,13 +285,28 @@ void debugLightSample(uint depth, LightPoint light, float lightPdf, float weight
 vec3 sampleDirectLight(vec3 p, vec3 n, vec3 ng, bool shadingNormals, float magnitude, vec3 beta,
                        vec3 f, vec2 uChoose, vec2 uLight, bool misOn, uint depth,
                        inout Retrace retrace) {
-  // Pick an emitter from the alias table, then a uniform point on its triangle.
-  LightPoint light = pickLightPoint(uChoose, uLight);
+  // Pick an emitter from the alias table, then a uniform point on its triangle (or a sample of
+  // an analytic light).
+  Emitter emitter = pickEmitter(uChoose);
+#ifndef PT_NO_BSDF_MATERIALS
+  if (kAnalyticLights && (emitter.triangle & kEmitterLight) != 0u) {
+    AnalyticLightSample ls = sampleAnalyticLight(loadLight(emitter.triangle & ~kEmitterLight), p,
+                                                 uLight, params.sceneRadius);
+    float cosWi = dot(n, ls.wi);
+    if (!(cosWi > 0.0) || !(maxComponent(ls.Li) > 0.0)) return vec3(0.0);
+    vec3 from =
+        offsetRayOrigin(p, shadingNormals ? (dot(ng, ls.wi) > 0.0 ? ng : -ng) : n, magnitude);
+    return analyticLightContribution(ls, emitter.pmf, from, beta, f * cosWi, cosWi * kInvPi, misOn,
+                                     depth, retrace);
+  }
+#endif
+  LightPoint light = pointOnEmitter(emitter, uLight);
 
   vec3 toLight = light.point - p;
   float dist2 = dot(toLight, toLight);
   vec3 wl = toLight / sqrt(dist2);
   float cosLight = -dot(light.normal, wl);  // > 0: we see the emitting side
+  if (kTwoSidedEmitters) faceTwoSided(light, cosLight);
   float cosSurface = dot(n, wl);
   if (!(cosLight > 0.0 && cosSurface > 0.0)) return vec3(0.0);
 
@@ -249,11 +331,25 @@ vec3 sampleDirectLightBsdf(vec3 p, vec3 ng, ShadingFrame frame, Material materia
                            float magnitude, vec3 beta, vec2 uChoose, vec2 uLight,
                            RandomStream evalStream, RandomStream pdfStream, bool misOn, uint depth,
                            inout Retrace retrace) {
-  LightPoint light = pickLightPoint(uChoose, uLight);
+  Emitter emitter = pickEmitter(uChoose);
+  if (kAnalyticLights && (emitter.triangle & kEmitterLight) != 0u) {
+    AnalyticLightSample ls = sampleAnalyticLight(loadLight(emitter.triangle & ~kEmitterLight), p,
+                                                 uLight, params.sceneRadius);
+    if (!(maxComponent(ls.Li) > 0.0)) return vec3(0.0);
+    vec3 wiLocal = toLocal(frame, ls.wi);
+    vec3 fCos = bsdfF(material, wo, wiLocal, evalStream) * absCosTheta(wiLocal);
+    if (!(maxComponent(fCos) > 0.0)) return vec3(0.0);
+    float density = (misOn && !ls.delta) ? bsdfPdf(material, wo, wiLocal, pdfStream) : 0.0;
+    vec3 from = offsetRayOrigin(p, dot(ng, ls.wi) > 0.0 ? ng : -ng, magnitude);
+    return analyticLightContribution(ls, emitter.pmf, from, beta, fCos, density, misOn, depth,
+                                     retrace);
+  }
+  LightPoint light = pointOnEmitter(emitter, uLight);
   vec3 toLight = light.point - p;
   float dist2 = dot(toLight, toLight);
   vec3 wl = toLight / sqrt(dist2);
   float cosLight = -dot(light.normal, wl);  // > 0: we see the emitting side
+  if (kTwoSidedEmitters) faceTwoSided(light, cosLight);
   if (!(cosLight > 0.0)) return vec3(0.0);
   vec3 wi = toLocal(frame, wl);
   vec3 f = bsdfF(material, wo, wi, evalStream) * absCosTheta(wi);
@@ -282,6 +378,7 @@ struct Path {
   vec3 L;               // radiance gathered so far
   vec3 beta;            // path throughput
   bool specularBounce;  // the ray leaves a specular bounce (or the camera)
+  float weight;         // the camera sample's weight (filter.h): multiplies L at the end
   float bsdfPdf;        // solid-angle pdf of the BSDF sample that produced the ray
   float etaScale;       // product of the squared relative indices refracted through
   bool hitReady;        // the ray's closest hit is hitFound and hit already (see Retrace)
@@ -305,15 +402,22 @@ bool rouletteOn() {
   return kRussianRoulette && params.russianRoulette != 0u;
 }
 
-// sampleRadiance's start: the primary ray through a uniformly jittered point of the pixel
-// (box filter of width 1), radiance 0, throughput 1.
+// sampleRadiance's start: the camera ray through a point of the pixel's filter (and of the
+// lens), radiance 0, throughput 1. `pixel` is the film's (the image's plus the crop's corner).
 Path startPath(uvec2 pixel, uint sampleIndex) {
   Path path;
   path.sampleIndex = sampleIndex;
   path.depth = 0u;
-  path.origin = params.camera.position;
-  path.direction = cameraDirection(
-      params.camera, vec2(pixel) + random2(PT_SOBOL, pixel, sampleIndex, kDimPixel, params.seed));
+  // The lens's numbers only for a thin lens: a pinhole draws what it drew before lenses.
+  vec2 uLens = params.camera.lensRadius > 0.0
+                   ? random2(PT_SOBOL, pixel, sampleIndex, kDimLens, params.seed)
+                   : vec2(0.0);
+  CameraSample camera =
+      generateCameraRay(params.camera, pixel,
+                        random2(PT_SOBOL, pixel, sampleIndex, kDimPixel, params.seed), uLens);
+  path.origin = camera.origin;
+  path.direction = camera.direction;
+  path.weight = camera.weight;
   path.L = vec3(0.0);
   path.beta = vec3(1.0);
   // The camera ray counts as specular: emission it finds is taken at full weight.
@@ -347,7 +451,24 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
     }
   }
   path.hitReady = false;
-  if (!found) return true;
+  if (!found) {
+#ifndef PT_NO_BSDF_MATERIALS
+    // The ray leaves the scene: the infinite light's radiance, weighed as an emitter's.
+    if (kEnvironment && params.environmentEmitter != kNoEmitter) {
+      if (path.specularBounce) {
+        path.L += path.beta * params.environment;
+      } else if (bsdfEmissionOn()) {
+        float weight = 1.0;
+        if (misOn()) {
+          weight = powerHeuristic(path.bsdfPdf,
+                                  environmentLightPdf(loadEmitter(params.environmentEmitter).pmf));
+        }
+        path.L += path.beta * weight * params.environment;
+      }
+    }
+#endif
+    return true;
+  }
   Triangle tri = loadTriangle(hit.triangle);
   Material material = loadMaterial(tri.material);
   // Hit point from barycentrics (more accurate than origin + t * direction).
@@ -368,8 +489,9 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   }
 #endif
 
-  // Add emitted light found by this ray: one-sided, on the geometric normal's side.
-  if (tri.emitter != kNoEmitter && cosOut > 0.0) {
+  // Add emitted light found by this ray: on the geometric normal's side, or on both.
+  float cosEmit = (kTwoSidedEmitters && material.twoSided != 0u) ? abs(cosOut) : cosOut;
+  if (tri.emitter != kNoEmitter && cosEmit > 0.0) {
     vec3 Le = material.emission;
     if (path.specularBounce) {
       path.L += path.beta * Le;
@@ -378,7 +500,7 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
       float weight = 1.0;
       if (misOn()) {
         float area = 0.5 * length(edgeCross);
-        float lightPdf = loadEmitter(tri.emitter).pmf * hit.t * hit.t / (cosOut * area);
+        float lightPdf = loadEmitter(tri.emitter).pmf * hit.t * hit.t / (cosEmit * area);
         weight = powerHeuristic(path.bsdfPdf, lightPdf);
       }
       path.L += path.beta * weight * Le;
@@ -480,6 +602,9 @@ void main() {
   if (pixel.x >= params.camera.width || pixel.y >= params.camera.height) return;
   uint index = pixel.y * params.camera.width + pixel.x;
   gDebug = index == pass.debugPixel;
+  // The film's pixel, which the random numbers and the camera ray are of: a crop renders its
+  // pixels of the whole film's image.
+  uvec2 filmPixel = pixel + uvec2(params.camera.cropX, params.camera.cropY);
 
   // This dispatch's samples of the pixel, added in float to the batch's sum one by one, in
   // the order of their indices: how a batch's samples are split into dispatches does not
@@ -494,12 +619,12 @@ void main() {
   uint truncated = 0u;
   uint done = 0u;
   bool finished = pass.sampleCount == 0u;
-  Path path = startPath(pixel, pass.sampleIndex);
+  Path path = startPath(filmPixel, pass.sampleIndex);
   gTruncated = false;
   while (!finished) {
     gLoopIterations++;
     Retrace retrace = Retrace(false, false, vec3(0.0), vec3(0.0), vec3(0.0));
-    bool ended = extendPath(path, pixel, retrace);
+    bool ended = extendPath(path, filmPixel, retrace);
     // The rare ray to trace again with the exact test (see Retrace).
     if (retrace.pending) {
       HitData exactHit;
@@ -516,7 +641,8 @@ void main() {
       }
     }
     if (!ended) continue;
-    vec3 L = path.L;
+    // The camera sample's weight: 1 but for the negative lobes of some filters (filter.h).
+    vec3 L = path.L * path.weight;
 #ifdef PT_DEBUG_PRINTF
     if (gDebug) {
       debugPrintfEXT("gpu sample %u: L=(%g, %g, %g)", path.sampleIndex, L.x, L.y, L.z);
@@ -540,7 +666,7 @@ void main() {
     done++;
     finished = done == pass.sampleCount;
     // The next sample's path.
-    path = startPath(pixel, pass.sampleIndex + done);
+    path = startPath(filmPixel, pass.sampleIndex + done);
     gTruncated = false;
   }
   // The loop itself can be cut short by lavapipe's cap: the samples it never finished.

@@ -12,6 +12,7 @@ namespace pt {
 
 PT_CONST float kPi = 3.14159265358979323846f;
 PT_CONST float kInvPi = 0.31830988618379067154f;
+PT_CONST float kInv4Pi = 0.07957747154594766788f;
 
 // ---- Counter-based random numbers ------------------------------------------------------
 
@@ -203,13 +204,19 @@ PT_INLINE float maxComponent(vec3 v) {
   return max(v.x, max(v.y, v.z));
 }
 
-// Unit direction of the primary ray through film point (x, y) in [0, width) x [0, height),
-// row 0 at the top (see struct Camera).
+// The point of the screen window (on the plane at unit distance along forward, relative to
+// the camera's position) that film point (x, y) in [0, filmWidth) x [0, filmHeight), row 0 at
+// the top, maps to (see struct Camera).
+PT_INLINE vec3 cameraFilmVector(Camera cam, vec2 filmPoint) {
+  float u = 2.0f * filmPoint.x / float(cam.filmWidth) - 1.0f;
+  float v = 1.0f - 2.0f * filmPoint.y / float(cam.filmHeight);
+  return cam.windowCenter + (u * cam.tanHalfFovY * cam.aspect) * cam.right +
+         (v * cam.tanHalfFovY) * cam.up;
+}
+
+// Unit direction of the pinhole's ray through film point (x, y) (cameraFilmVector).
 PT_INLINE vec3 cameraDirection(Camera cam, vec2 filmPoint) {
-  float u = 2.0f * filmPoint.x / float(cam.width) - 1.0f;
-  float v = 1.0f - 2.0f * filmPoint.y / float(cam.height);
-  return normalize(cam.forward + (u * cam.tanHalfFovY * cam.aspect) * cam.right +
-                   (v * cam.tanHalfFovY) * cam.up);
+  return normalize(cameraFilmVector(cam, filmPoint));
 }
 
 // Traversal constants of both BVH traversals (host/bvh/traverse.cpp, shaders/bvh.glsl).

@@ -103,7 +103,7 @@ struct Material {
                        //           reflectance, coateddiffuse's base albedo; linear RGB
   uint type;           //  4 bytes: kMaterial*
   vec3 emission;       // 12 bytes: radiance emitted on the front side (geometric normal side)
-  uint reserved;       //  4 bytes: zero (keeps the 16-byte row)
+  uint twoSided;       //  4 bytes: 1: emission leaves both sides (pbrt-v4's "twosided")
   vec3 eta;            // 12 bytes: conductor: real part of the index of refraction per channel;
                        //           dielectric, thindielectric, coateddiffuse: the index in .x
   float alphaX;        //  4 bytes: Trowbridge-Reitz alpha along the tangent (conductor,
@@ -141,21 +141,75 @@ struct Emitter {
   uint alias;            // 4 bytes
 };                       // 16 bytes
 
+// Lights that are not triangles: pbrt-v4's point, spot, distant and (constant) infinite lights.
+// They join the emissive triangles in the alias table: an Emitter whose `triangle` has
+// kEmitterLight set names Light number (triangle & ~kEmitterLight) instead.
+PT_CONST uint kLightPoint = 0u;     // isotropic point: intensity I at position
+PT_CONST uint kLightSpot = 1u;      // point with pbrt-v4's smoothstep falloff about an axis
+PT_CONST uint kLightDistant = 2u;   // parallel light from one direction (radiance L, a delta)
+PT_CONST uint kLightInfinite = 3u;  // constant radiance from every direction (an environment)
+PT_CONST uint kLightTypeCount = 4u;
+PT_CONST uint kEmitterLight = 0x80000000u;
+
+struct Light {
+  vec3 position;          // 12 bytes: point, spot: where it is
+  uint type;              //  4 bytes: kLight*
+  vec3 radiance;          // 12 bytes: point, spot: intensity (W/sr); distant, infinite:
+                          //           radiance; linear RGB, pbrt-v4's scale already applied
+  float cosFalloffStart;  //  4 bytes: spot: full intensity inside this cosine
+  vec3 direction;         // 12 bytes: spot: unit axis it shines along; distant: unit
+                          //           direction towards the light
+  float cosFalloffEnd;    //  4 bytes: spot: dark outside this cosine
+};                        // 48 bytes
+PT_CONST uint kLightTexels = 3u;
+
 // ---- Camera and per-render parameters --------------------------------------------------
 
-// Pinhole camera. Film point (x, y) in [0, width) x [0, height), row 0 at the top, maps to
-// the direction normalize(forward + u * tanHalfFovY * aspect * right + v * tanHalfFovY * up)
-// with u = 2x / width - 1, v = 1 - 2y / height.
+// Pixel filters (pbrt-v4's, its definitions and parameters; shaders/filter.h samples them).
+// Every one is separable, f(x, y) = f1(x) f1(y), and zero beyond its radius on each axis.
+PT_CONST uint kFilterBox = 0u;       // 1 on [-radius, radius]
+PT_CONST uint kFilterTriangle = 1u;  // radius - |x|
+PT_CONST uint kFilterGaussian = 2u;  // exp(-x^2 / (2 sigma^2)) minus its value at the radius
+PT_CONST uint kFilterMitchell = 3u;  // Mitchell and Netravali's cubic of parameters B and C
+
+// Perspective camera, a pinhole or a thin lens (pbrt-v4's PerspectiveCamera), with a pixel
+// filter. The film is filmWidth x filmHeight pixels; the image rendered is the crop of
+// width x height pixels from (cropX, cropY) (the whole film without a crop window). Film point
+// (x, y) in [0, filmWidth) x [0, filmHeight), row 0 at the top, maps to the direction
+// normalize(windowCenter + u * tanHalfFovY * aspect * right + v * tanHalfFovY * up) with
+// u = 2x / filmWidth - 1, v = 1 - 2y / filmHeight: the film spans the screen window, a
+// rectangle on the plane at unit distance along forward. With the default window (centred,
+// tan(vfov / 2) high) windowCenter is forward and aspect filmWidth / filmHeight.
 struct Camera {
-  vec3 position;      // 12 bytes
-  float tanHalfFovY;  //  4 bytes: tan(vertical field of view / 2)
-  vec3 forward;       // 12 bytes: unit view direction
-  float aspect;       //  4 bytes: width / height
-  vec3 right;         // 12 bytes: unit, forward x up
-  uint width;         //  4 bytes
-  vec3 up;            // 12 bytes: unit, right x forward
-  uint height;        //  4 bytes
-};                    // 64 bytes
+  vec3 position;         // 12 bytes: the pinhole; the lens's centre
+  float tanHalfFovY;     //  4 bytes: half the screen window's height (tan(vertical fov / 2))
+  vec3 forward;          // 12 bytes: unit view direction, the lens's axis
+  float aspect;          //  4 bytes: the screen window's width / height
+  vec3 right;            // 12 bytes: unit, forward x up
+  uint width;            //  4 bytes: the image's width (the crop's)
+  vec3 up;               // 12 bytes: unit, right x forward
+  uint height;           //  4 bytes: the image's height
+  vec3 windowCenter;     // 12 bytes: the screen window's centre: forward + cx * right + cy * up
+  float lensRadius;      //  4 bytes: 0: a pinhole
+  uint cropX;            //  4 bytes: the film column of the image's column 0
+  uint cropY;            //  4 bytes: the film row of the image's row 0
+  uint filmWidth;        //  4 bytes: the whole film, which the screen window spans
+  uint filmHeight;       //  4 bytes
+  uint filterType;       //  4 bytes: kFilter*
+  float filterRadiusX;   //  4 bytes: pbrt-v4's xradius, in pixels
+  float filterRadiusY;   //  4 bytes: yradius
+  float focalDistance;   //  4 bytes: thin lens: distance of the plane in focus along forward
+  float filterWeight;    //  4 bytes: |weight| of every sample: 1, or mitchell's integral of
+                         //           |f| over the integral of f (filter.h)
+  float filterScale;     //  4 bytes: gaussian: 1 / (sigma sqrt 2); otherwise unused
+  float filterB;         //  4 bytes: mitchell: B
+  float filterC;         //  4 bytes: mitchell: C
+  vec3 filterRootsNear;  // 12 bytes: mitchell: where its cubic on |t| < 1 changes sign, in
+                         //           increasing order, padded with 1 (t = 2x / radius)
+  float filterExpX;      //  4 bytes: gaussian: its value at the x radius times 2k / sqrt(pi)
+  vec3 filterRootsFar;   // 12 bytes: mitchell: the sign changes on 1 < |t| < 2, padded with 2
+  float filterExpY;      //  4 bytes: gaussian: the same at the y radius
+};                       // 160 bytes
 
 // Sampling strategies for direct light (the MIS knob).
 PT_CONST uint kStrategyMis = 0u;   // light sampling + BSDF sampling, power heuristic
@@ -167,20 +221,24 @@ PT_CONST uint kSamplerIndependent = 0u;  // a hash per (pixel, sample, dimension
 PT_CONST uint kSamplerSobol = 1u;        // Owen-scrambled Sobol points per dimension
 
 struct RenderParams {
-  Camera camera;          // 64 bytes
-  uint maxDepth;          //  4 bytes: maximum number of scattering events on a path
-  uint rrStartDepth;      //  4 bytes: Russian roulette from this many scattering events on
-  uint emitterCount;      //  4 bytes
-  uint seed;              //  4 bytes
-  uint strategy;          //  4 bytes: kStrategyMis, kStrategyNee or kStrategyBsdf
-  uint russianRoulette;   // 4 bytes: 0 or 1
-  uint fastIntersection;  // 4 bytes: 1: Moller-Trumbore (not watertight), 0: watertight
-  uint samplerType;       //  4 bytes: kSamplerIndependent or kSamplerSobol
-  uint normalsPresent;    //  4 bytes: 1 when the vertex-normal buffer holds the scene's normals
-  uint reserved0;         //  4 bytes: zero
-  uint reserved1;         //  4 bytes: zero
-  uint reserved2;         //  4 bytes: zero
-};                        // 112 bytes
+  Camera camera;            // 160 bytes
+  uint maxDepth;            //  4 bytes: maximum number of scattering events on a path
+  uint rrStartDepth;        //  4 bytes: Russian roulette from this many scattering events on
+  uint emitterCount;        //  4 bytes
+  uint seed;                //  4 bytes
+  uint strategy;            //  4 bytes: kStrategyMis, kStrategyNee or kStrategyBsdf
+  uint russianRoulette;     // 4 bytes: 0 or 1
+  uint fastIntersection;    // 4 bytes: 1: Moller-Trumbore (not watertight), 0: watertight
+  uint samplerType;         //  4 bytes: kSamplerIndependent or kSamplerSobol
+  uint normalsPresent;      //  4 bytes: 1 when the vertex-normal buffer holds the scene's normals
+  uint lightCount;          //  4 bytes: Light entries (analytic lights) in the light buffer
+  uint environmentEmitter;  // 4 bytes: the Emitter of the infinite light, or kNoEmitter
+  float sceneRadius;        //  4 bytes: radius of a sphere about sceneCenter holding the scene
+  vec3 environment;         // 12 bytes: radiance of the infinite light (zero when none)
+  uint reserved0;           //  4 bytes: zero
+  vec3 sceneCenter;         // 12 bytes: centre of the scene's bounding box
+  uint reserved1;           //  4 bytes: zero
+};                          // 240 bytes
 
 // ---- Compute pipeline interface (Vulkan backend) ----------------------------------------
 
@@ -198,9 +256,10 @@ struct RenderParams {
 #define PT_BINDING_MATERIALS 3  // Material[], texels
 #define PT_BINDING_EMITTERS 4   // Emitter[], texels (one dummy entry when the scene has none)
 #define PT_BINDING_NORMALS 5    // TriangleNormals[], texels (one dummy entry when none)
-#define PT_BINDING_ACCUM 6      // AccumPixel[width * height]
-#define PT_BINDING_COUNTERS 7   // DeviceCounters
-#define PT_BINDING_COUNT 8
+#define PT_BINDING_LIGHTS 6     // Light[], texels (one dummy entry when the scene has none)
+#define PT_BINDING_ACCUM 7      // AccumPixel[width * height]
+#define PT_BINDING_COUNTERS 8   // DeviceCounters
+#define PT_BINDING_COUNT 9
 
 // Specialization constant ids: the effect set. An effect switched off is compiled out.
 #define PT_SPEC_DIFFUSE 0        // bool: Lambertian surfaces occur
@@ -221,8 +280,11 @@ struct RenderParams {
 #define PT_SPEC_THIN_DIELECTRIC 11
 #define PT_SPEC_DIFFUSE_TRANSMISSION 12
 #define PT_SPEC_COATED_DIFFUSE 13
-#define PT_SPEC_SHADING_NORMALS 14  // bool: some mesh has vertex normals
-#define PT_SPEC_COUNT 15
+#define PT_SPEC_SHADING_NORMALS 14     // bool: some mesh has vertex normals
+#define PT_SPEC_DELTA_LIGHTS 15        // bool: point, spot or distant lights occur
+#define PT_SPEC_ENVIRONMENT 16         // bool: an infinite light occurs
+#define PT_SPEC_TWO_SIDED_EMITTERS 17  // bool: some emissive triangle emits on both sides
+#define PT_SPEC_COUNT 18
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever
@@ -277,8 +339,8 @@ struct RayResult {
 // ---- Random-number dimensions ----------------------------------------------------------
 // Random numbers are a pure function of (pixel, sample index, dimension, seed); see
 // sampling.h. One dimension yields up to two numbers. Each path uses dimension kDimPixel for
-// the pixel jitter, then kDimsPerBounce dimensions per scattering event, starting at
-// kDimFirstBounce + kDimsPerBounce * bounce.
+// the pixel filter's sample (and kDimLens for a thin lens), then kDimsPerBounce dimensions per
+// scattering event, starting at kDimFirstBounce + kDimsPerBounce * bounce.
 PT_CONST uint kDimPixel = 0u;
 PT_CONST uint kDimFirstBounce = 1u;
 PT_CONST uint kDimsPerBounce = 4u;
@@ -286,6 +348,10 @@ PT_CONST uint kDimLightChoose = 0u;  // +0: alias-table slot and coin
 PT_CONST uint kDimLightPoint = 1u;   // +1: point on the emitter triangle
 PT_CONST uint kDimBsdf = 2u;         // +2: BSDF direction
 PT_CONST uint kDimRoulette = 3u;     // +3: Russian roulette
+// The point on a thin lens (Camera::lensRadius > 0 only: a pinhole draws nothing from it). A
+// dimension no path's scattering events reach: bounce dimensions grow by kDimsPerBounce per
+// event from kDimFirstBounce and would come to it at event number 2^30 - 1.
+PT_CONST uint kDimLens = 0xFFFFFFFFu;
 
 #ifdef __cplusplus
 }  // namespace pt

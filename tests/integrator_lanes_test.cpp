@@ -27,8 +27,15 @@ std::vector<Case> cases() {
   const RenderSettings small{.width = 20, .height = 14};
   std::vector<Case> list;
   for (const char* config : {"cornell-box.json", "cornell-mirror.json", "bunny-box.json",
-                             "cornell-materials.json", "veach-mis.json"}) {
+                             "cornell-materials.json", "veach-mis.json", "sun-and-sky.json"}) {
     list.push_back({config, small});
+  }
+  // Point, spot, distant and infinite lights with each strategy (the infinite light weighed by
+  // MIS, taken at full weight, or not at all when rays leave the scene).
+  for (uint strategy : {kStrategyNee, kStrategyBsdf}) {
+    RenderSettings s = small;
+    s.strategy = strategy;
+    list.push_back({"sun-and-sky.json", s});
   }
   auto variant = [&](auto&& change) {
     RenderSettings s = small;

@@ -3,10 +3,12 @@
 // camera and options, warnings and errors, and configs/cornell-box.pbrt against the JSON box.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -15,6 +17,7 @@
 #include "cpu/integrator.h"
 #include "render/prepare.h"
 #include "scene/pbrt/pbrt_scene.h"
+#include "scene/pbrt/spectra.h"
 #include "scene/scene.h"
 #include "test_util.h"
 
@@ -239,8 +242,18 @@ TEST(PbrtShapes, TrianglesWithoutIndicesAndZeroArea) {
   ASSERT_EQ(scene.triangles.size(), 2u);
   ASSERT_EQ(scene.warnings.size(), 1u);
   EXPECT_EQ(scene.warnings[0],
-            "scene.pbrt:7: Shape \"trianglemesh\": dropped 1 zero-area triangle (of 2)");
+            "scene.pbrt:7: Shape \"trianglemesh\": dropped 1 zero-area triangle in 1 shape");
   EXPECT_EQ(scene.triangles[1].primitive, 1u);
+  // Drops in several shapes make one warning, at the first.
+  const Scene more = load(std::string(kUnmirrored) +
+                          "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  0 1 0 ]\n"
+                          "  \"integer indices\" [ 0 1 2  0 1 3 ]\n"
+                          "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  0 1 0 ]\n"
+                          "  \"integer indices\" [ 0 1 2  0 2 1  0 1 3 ]\n");
+  ASSERT_EQ(more.warnings.size(), 1u);
+  EXPECT_EQ(more.warnings[0],
+            "scene.pbrt:6: Shape \"trianglemesh\": dropped 3 zero-area triangles in 2 shapes "
+            "(this is the first)");
 }
 
 TEST(PbrtShapes, PlyMeshRelativeToTheFileThatNamesIt) {
@@ -330,9 +343,10 @@ TEST(PbrtMaterials, EachTypeWithPbrtV4sParameterNames) {
   m = materialOf("Material \"diffuse\" \"rgb reflectance\" [0.1 0.2 0.3]");
   EXPECT_EQ(m.reflectance, vec3(0.1f, 0.2f, 0.3f));
 
-  m = materialOf("Material \"conductor\"");  // copper, as defaultMaterial
+  m = materialOf("Material \"conductor\"");  // pbrt-v4's default: metal-Cu
   EXPECT_EQ(m.type, kMaterialConductor);
-  EXPECT_EQ(m.eta, defaultMaterial(kMaterialConductor).eta);
+  EXPECT_EQ(m.eta, spectra::namedMetal("Cu")->eta);
+  EXPECT_EQ(m.k, spectra::namedMetal("Cu")->k);
   m = materialOf(
       "Material \"conductor\" \"rgb eta\" [0.2 0.3 0.4] \"rgb k\" [3 2 1] \"float roughness\" "
       "0.25 \"float vroughness\" 0.04");
@@ -351,24 +365,20 @@ TEST(PbrtMaterials, EachTypeWithPbrtV4sParameterNames) {
   m = materialOf(
       "Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\"",
       &warnings);
-  EXPECT_EQ(m.eta, vec3(0.1431189557f, 0.3749570432f, 1.4424785571f));
-  EXPECT_EQ(m.k, vec3(3.9831604247f, 2.3857207478f, 1.6032152899f));
-  ASSERT_EQ(warnings.size(), 2u);  // one per named spectrum
-  EXPECT_EQ(warnings[0],
-            "scene.pbrt:6: named spectrum 'metal-Au-eta' taken as RGB from "
-            "Tungsten's ComplexIorData table (the CIE integration of pbrt-v4's own "
-            "data is later work)");
+  EXPECT_EQ(m.eta, spectra::namedMetal("Au")->eta);  // pbrt-v4's spectra fitted per channel
+  EXPECT_EQ(m.k, spectra::namedMetal("Au")->k);
+  EXPECT_TRUE(warnings.empty());
 
   m = materialOf("Material \"dielectric\" \"float eta\" 1.33 \"float roughness\" 0.01");
   EXPECT_EQ(m.type, kMaterialDielectric);
   EXPECT_EQ(m.eta.x, 1.33f);
   EXPECT_EQ(m.alphaX, 0.1f);
   m = materialOf("Material \"dielectric\" \"spectrum eta\" \"glass-BK7\"", &warnings);
-  EXPECT_EQ(m.eta.x, 1.5f);
+  EXPECT_NEAR(m.eta.x, 1.5198f, 1e-4f);  // the mean of BK7's dispersion curve's RGB
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_EQ(warnings[0],
-            "scene.pbrt:6: named glass spectra (here 'glass-BK7') are taken as the "
-            "constant index 1.5 (dispersion is not simulated)");
+            "scene.pbrt:6: named glass spectra (here 'glass-BK7') are taken as one index, the "
+            "mean of their dispersion curve's RGB (1.51978; dispersion is not simulated)");
   m = materialOf("Material \"thindielectric\" \"float eta\" 1.7");
   EXPECT_EQ(m.type, kMaterialThinDielectric);
   EXPECT_EQ(m.eta.x, 1.7f);
@@ -470,15 +480,10 @@ TEST(PbrtLights, AreaLightEmissionIsLTimesScalePerShape) {
   EXPECT_EQ(material(2).emission, vec3(0));  // after AttributeEnd: no light
   // "power" 10 over a triangle of area 1/2, one-sided: L = 10 / (0.5 pi).
   EXPECT_FLOAT_EQ(material(3).emission.x, float(10.0 / (0.5 * 3.14159265358979323846)));
-  EXPECT_EQ(material(4).emission, vec3(1));  // a blackbody: white of luminance 1, warned
-  std::string joined;
-  for (const std::string& w : scene.warnings) joined += w + "\n";
-  EXPECT_NE(joined.find("scene.pbrt:18: blackbody spectra are taken as white of luminance 1"),
-            std::string::npos)
-      << joined;
-  EXPECT_NE(joined.find("scene.pbrt:18: AreaLightSource \"diffuse\": \"twosided\" lights emit "
-                        "on their front side only"),
-            std::string::npos);
+  // A blackbody: luminance 1 of its colour (tests/spectra_test.cpp); two-sided.
+  EXPECT_EQ(material(4).emission, vec3(spectra::blackbodyRgb(3000)));
+  EXPECT_EQ(material(4).twoSided, 1u);
+  EXPECT_EQ(material(3).twoSided, 0u);
 }
 
 TEST(PbrtLights, OtherLightsMediaAndTexturesWarnOncePerKind) {
@@ -487,19 +492,21 @@ TEST(PbrtLights, OtherLightsMediaAndTexturesWarnOncePerKind) {
                            "LightSource \"point\" \"rgb I\" [1 1 1]\n"
                            "LightSource \"infinite\" \"rgb L\" [1 1 1]\n"
                            "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
-                           "MediumInterface \"fog\" \"\"\nMediumInterface \"\"\n" +
+                           "MediumInterface \"fog\" \"\"\nMediumInterface \"\"\n"
+                           "LightSource \"goniometric\" \"string filename\" \"g.exr\"\n"
+                           "LightSource \"goniometric\"\n" +
                            kTriangle);
-  ASSERT_EQ(scene.warnings.size(), 4u);
+  // Point and infinite lights are simulated (tests/lights_test.cpp); goniometric and
+  // projection lights are not, warned once per kind.
+  ASSERT_EQ(scene.lights.size(), 3u);
+  ASSERT_EQ(scene.warnings.size(), 3u);
   EXPECT_EQ(scene.warnings[0],
-            "scene.pbrt:6: LightSource 'point' ignored: only area lights "
-            "(AreaLightSource \"diffuse\") are simulated yet");
-  EXPECT_EQ(scene.warnings[1],
-            "scene.pbrt:8: LightSource 'infinite' ignored: only area lights "
-            "(AreaLightSource \"diffuse\") are simulated yet");
-  EXPECT_EQ(scene.warnings[2],
             "scene.pbrt:9: MakeNamedMedium ignored: participating media are not simulated");
-  EXPECT_EQ(scene.warnings[3],
+  EXPECT_EQ(scene.warnings[1],
             "scene.pbrt:10: MediumInterface ignored: participating media are not simulated");
+  EXPECT_EQ(scene.warnings[2],
+            "scene.pbrt:12: LightSource 'goniometric' ignored: goniometric lights (an image over "
+            "the directions) are not simulated");
 }
 
 // ---- instancing -----------------------------------------------------------------------------
@@ -551,9 +558,12 @@ TEST(PbrtCamera, DefaultsAndOptionsAsPbrtV4) {
   // The default camera at the origin looking down +z is left-handed: the world is mirrored.
   EXPECT_EQ(scene.triangles[0].v0, vec3(0, 0, 0));
   EXPECT_EQ(scene.triangles[0].v2, vec3(-1, 0, 0));
-  EXPECT_EQ(scene.warnings.at(0),
-            "scene.pbrt:1: no PixelFilter: pbrt-v4's default is \"gaussian\"; rendered with a "
-            "box filter of one pixel (other filters are later work)");
+  // No PixelFilter: pbrt-v4's default, a gaussian of radius 1.5 and sigma 0.5.
+  EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+  EXPECT_EQ(scene.camera.filter.type, kFilterGaussian);
+  EXPECT_EQ(scene.camera.filter.radiusX, 1.5f);
+  EXPECT_EQ(scene.camera.filter.radiusY, 1.5f);
+  EXPECT_EQ(scene.camera.filter.sigma, 0.5f);
   scene = load(
       "Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 24 \"float iso\" 100\n"
       "Sampler \"halton\" \"integer pixelsamples\" 64 \"integer seed\" 7\n"
@@ -566,15 +576,14 @@ TEST(PbrtCamera, DefaultsAndOptionsAsPbrtV4) {
   EXPECT_EQ(scene.integrator.spp, 64);
   EXPECT_EQ(scene.integrator.seed, 7u);
   EXPECT_EQ(scene.integrator.maxDepth, 12);
+  EXPECT_EQ(scene.camera.filter.type, kFilterGaussian);
+  EXPECT_EQ(scene.camera.lensRadius, 0.1f);
+  EXPECT_EQ(scene.camera.focalDistance, 5.0f);
   std::string joined;
   for (const std::string& w : scene.warnings) joined += w + "\n";
   EXPECT_EQ(joined,
             "scene.pbrt:3: Integrator 'bdpt' is rendered with the path tracer (\"path\": light "
-            "and BSDF sampling with MIS)\n"
-            "scene.pbrt:4: PixelFilter 'gaussian' is rendered as a box filter of one pixel "
-            "(other filters are later work)\n"
-            "scene.pbrt:5: Camera \"perspective\": \"lensradius\" ignored: the camera is a "
-            "pinhole (thin lens is later work)\n");
+            "and BSDF sampling with MIS)\n");
   scene = load(std::string(kUnmirrored) + kTriangle + "Shape \"sphere\" \"float radiuss\" 1\n");
   EXPECT_EQ(scene.warnings.at(1),
             "scene.pbrt:7: Shape \"sphere\": parameter 'float radiuss' "
@@ -731,6 +740,203 @@ TEST(PbrtSceneErrors, CommandLineExitsWithStatus2AndOneLine) {
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err, bad.string() + ":2:31: unterminated '[' (the file ends before its ']')\n");
   EXPECT_FALSE(fs::exists(dir / "x.png"));
+}
+
+// ---- camera and film: filters, thin lens, screen window, crop, --strict ----------------------
+
+TEST(PbrtCameraFilm, PixelFiltersWithPbrtV4sParametersAndDefaults) {
+  auto filter = [](const std::string& directive) {
+    return load(directive + "\nWorldBegin\n" + kTriangle).camera.filter;
+  };
+  PixelFilterDesc f = filter("PixelFilter \"box\"");
+  EXPECT_EQ(f.type, kFilterBox);
+  EXPECT_EQ(f.radiusX, 0.5f);
+  EXPECT_EQ(f.radiusY, 0.5f);
+  f = filter("PixelFilter \"triangle\" \"float xradius\" 1.25");
+  EXPECT_EQ(f.type, kFilterTriangle);
+  EXPECT_EQ(f.radiusX, 1.25f);
+  EXPECT_EQ(f.radiusY, 2.0f);
+  f = filter("PixelFilter \"gaussian\" \"float sigma\" 0.75 \"float yradius\" 2");
+  EXPECT_EQ(f.type, kFilterGaussian);
+  EXPECT_EQ(f.radiusX, 1.5f);
+  EXPECT_EQ(f.radiusY, 2.0f);
+  EXPECT_EQ(f.sigma, 0.75f);
+  f = filter("PixelFilter \"mitchell\" \"float B\" 0 \"float C\" 0.5");
+  EXPECT_EQ(f.type, kFilterMitchell);
+  EXPECT_EQ(f.radiusX, 2.0f);
+  EXPECT_EQ(f.b, 0.0f);
+  EXPECT_EQ(f.c, 0.5f);
+  f = filter("");  // none: pbrt-v4's default
+  EXPECT_EQ(f.type, kFilterGaussian);
+  EXPECT_EQ(f.radiusX, 1.5f);
+  EXPECT_EQ(f.sigma, 0.5f);
+  // "sinc" is not simulated: pbrt-v4's default filter instead, warned.
+  const Scene sinc =
+      load("PixelFilter \"sinc\" \"float tau\" 2\nWorldBegin\n" + std::string(kTriangle));
+  EXPECT_EQ(sinc.camera.filter.type, kFilterGaussian);
+  ASSERT_EQ(sinc.warnings.size(), 1u);
+  EXPECT_EQ(sinc.warnings[0],
+            "scene.pbrt:1: PixelFilter \"sinc\" is rendered with pbrt-v4's default filter, "
+            "\"gaussian\" (the windowed sinc is not simulated)");
+  // A parameter of another filter is unused, as pbrt-v4 reports it.
+  const Scene unused =
+      load("PixelFilter \"box\" \"float sigma\" 2\nWorldBegin\n" + std::string(kTriangle));
+  ASSERT_EQ(unused.warnings.size(), 1u);
+  EXPECT_EQ(unused.warnings[0],
+            "scene.pbrt:1: PixelFilter \"box\": parameter 'float sigma' ignored (not used by "
+            "this renderer)");
+}
+
+TEST(PbrtCameraFilm, ThinLensScreenWindowAndFrame) {
+  const std::string film = "Film \"rgb\" \"integer xresolution\" 40 \"integer yresolution\" 20\n";
+  Scene scene = load(film +
+                     "Camera \"perspective\" \"float fov\" 30 \"float lensradius\" 0.2 "
+                     "\"float focaldistance\" 8 \"float screenwindow\" [-1 3 -0.5 1.5]\n"
+                     "WorldBegin\n" +
+                     kTriangle);
+  EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+  EXPECT_EQ(scene.camera.lensRadius, 0.2f);
+  EXPECT_EQ(scene.camera.focalDistance, 8.0f);
+  // With a screen window, fov is its unit: tan(fov / 2) times the window, whatever the film.
+  EXPECT_EQ(scene.camera.vfovDegrees, 30.0f);
+  EXPECT_EQ(scene.camera.screenWindow, (std::array<float, 4>{-1, 3, -0.5f, 1.5f}));
+  // pbrt-v4's ray through raster point (px, py): camera-space (sx t, sy t, 1), t = tan(fov / 2),
+  // sx = x0 + (x1 - x0) px / W, sy = y1 - (y1 - y0) py / H; camera +x is the image's right.
+  const Camera cam = makeCamera(scene.camera, 40, 20);
+  const double t = std::tan(15.0 * 3.14159265358979323846 / 180.0);
+  for (const glm::dvec2 raster : {glm::dvec2(0, 0), glm::dvec2(40, 20), glm::dvec2(10, 15)}) {
+    const double sx = -1.0 + 4.0 * raster.x / 40.0, sy = 1.5 - 2.0 * raster.y / 20.0;
+    const glm::dvec3 d(cameraDirection(cam, vec2(raster)));
+    const double z = glm::dot(d, glm::dvec3(cam.forward));
+    EXPECT_NEAR(glm::dot(d, glm::dvec3(cam.right)) / z, sx * t, 1e-6);
+    EXPECT_NEAR(glm::dot(d, glm::dvec3(cam.up)) / z, sy * t, 1e-6);
+  }
+  // frameaspectratio: pbrt-v4's window [-frame, frame] x [-1, 1] (landscape) or [-1, 1] x
+  // [-1/frame, 1/frame] (portrait) on the film, whatever its shape: both are [-frame, frame,
+  // -1, 1] in units of the vertical half-angle.
+  scene = load(film +
+               "Camera \"perspective\" \"float fov\" 60 \"float frameaspectratio\" 1\n"
+               "WorldBegin\n" +
+               kTriangle);
+  EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+  EXPECT_EQ(scene.camera.vfovDegrees, 60.0f);
+  EXPECT_EQ(scene.camera.screenWindow, (std::array<float, 4>{-1, 1, -1, 1}));
+  scene = load(film +
+               "Camera \"perspective\" \"float fov\" 60 \"float frameaspectratio\" 0.5\n"
+               "WorldBegin\n" +
+               kTriangle);
+  EXPECT_EQ(scene.camera.screenWindow, (std::array<float, 4>{-0.5f, 0.5f, -1, 1}));
+  // The horizontal half-angle is the fov's: tan(30 degrees) at the film's left edge.
+  const Camera portrait = makeCamera(scene.camera, 40, 20);
+  const glm::dvec3 left(cameraDirection(portrait, vec2(0.0f, 10.0f)));
+  EXPECT_NEAR(
+      -glm::dot(left, glm::dvec3(portrait.right)) / glm::dot(left, glm::dvec3(portrait.forward)),
+      std::tan(30.0 * 3.14159265358979323846 / 180.0), 1e-6);
+  // Without either, the window is CameraDesc's default, which follows --width and --height.
+  scene = load(film + "Camera \"perspective\" \"float lensradius\" -1\nWorldBegin\n" + kTriangle);
+  EXPECT_FALSE(scene.camera.screenWindow.has_value());
+  EXPECT_EQ(scene.camera.lensRadius, 0.0f);  // pbrt-v4: a radius of 0 or less is a pinhole
+}
+
+TEST(PbrtCameraFilm, LensUnitsFollowTheCameraTransformsScale) {
+  // A uniform scale in the camera transform scales camera space: the lens and the focal
+  // distance are camera-space lengths.
+  const Scene scene = load(
+      "Scale 2 2 2\nLookAt 0 0 -10  0 0 0  0 1 0\nCamera \"perspective\" \"float lensradius\" 0.5 "
+      "\"float focaldistance\" 4\nWorldBegin\n" +
+      std::string(kTriangle));
+  EXPECT_FLOAT_EQ(scene.camera.lensRadius, 0.25f);
+  EXPECT_FLOAT_EQ(scene.camera.focalDistance, 2.0f);
+}
+
+TEST(PbrtCameraFilm, CropWindowAndPixelBoundsAsPbrtV4) {
+  const std::string res = "Film \"rgb\" \"integer xresolution\" 10 \"integer yresolution\" 8 ";
+  Scene scene = load(res + "\"float cropwindow\" [0.75 0.25 0.1 0.5]\nWorldBegin\n" + kTriangle);
+  EXPECT_EQ(scene.camera.cropWindow, (std::array<float, 4>{0.75f, 0.25f, 0.1f, 0.5f}));
+  EXPECT_EQ(cropPixels(scene.camera, 10, 8), (std::array<int, 4>{3, 8, 1, 4}));
+  const Camera cam = makeCamera(scene.camera, 10, 8);
+  EXPECT_EQ(cam.width, 5u);
+  EXPECT_EQ(cam.height, 3u);
+  scene = load(res + "\"integer pixelbounds\" [2 5 1 7]\nWorldBegin\n" + kTriangle);
+  EXPECT_TRUE(scene.warnings.empty());
+  EXPECT_EQ(cropPixels(scene.camera, 10, 8), (std::array<int, 4>{2, 5, 1, 7}));
+  // Beyond the film: clipped, warned (as pbrt-v4).
+  scene = load(res + "\"integer pixelbounds\" [2 50 1 7]\nWorldBegin\n" + kTriangle);
+  EXPECT_EQ(cropPixels(scene.camera, 10, 8), (std::array<int, 4>{2, 10, 1, 7}));
+  ASSERT_EQ(scene.warnings.size(), 1u);
+  EXPECT_EQ(scene.warnings[0],
+            "scene.pbrt:1: Film: \"pixelbounds\" reach beyond the 10x8 film: clipped to it (as "
+            "pbrt-v4 does)");
+  // Both: the crop window, warned.
+  scene = load(res +
+               "\"integer pixelbounds\" [2 5 1 7] \"float cropwindow\" [0 0.5 0 0.5]\n"
+               "WorldBegin\n" +
+               kTriangle);
+  EXPECT_EQ(cropPixels(scene.camera, 10, 8), (std::array<int, 4>{0, 5, 0, 4}));
+  ASSERT_EQ(scene.warnings.size(), 1u);
+  EXPECT_EQ(scene.warnings[0],
+            "scene.pbrt:1: Film: both \"pixelbounds\" and \"cropwindow\" given: the crop window is "
+            "used (as pbrt-v4 does)");
+}
+
+TEST(PbrtCameraFilm, BadCameraAndFilmParametersAreErrors) {
+  const std::string w = "WorldBegin\n" + std::string(kTriangle);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"PixelFilter \"lanczos\"\n" + w,
+       "scene.pbrt:1:13: unknown PixelFilter type 'lanczos' (pbrt-v4 has \"box\", \"gaussian\", "
+       "\"mitchell\", \"sinc\" and \"triangle\")"},
+      {"PixelFilter \"gaussian\" \"float xradius\" 0\n" + w,
+       "scene.pbrt:1:1: PixelFilter 'gaussian': filter radius must be in (0, 4096] pixels, got 0"},
+      {"PixelFilter \"gaussian\" \"float sigma\" 0\n" + w,
+       "scene.pbrt:1:1: PixelFilter 'gaussian': gaussian filter: sigma must be a positive number, "
+       "got 0"},
+      {"Camera \"perspective\" \"float focaldistance\" -2\n" + w,
+       "scene.pbrt:1:22: focaldistance must be a positive distance, got -2"},
+      {"Camera \"perspective\" \"float screenwindow\" [0 1 2]\n" + w,
+       "scene.pbrt:1:22: 'screenwindow' of Camera \"perspective\" takes 4 values, got 3"},
+      {"Camera \"perspective\" \"float screenwindow\" [1 1 0 2]\n" + w,
+       "scene.pbrt:1:22: screenwindow [x0 x1 y0 y1] must have some width and height"},
+      {"Film \"rgb\" \"integer xresolution\" 10 \"float cropwindow\" [0.11 0.15 0 1]\n" + w,
+       "scene.pbrt:1:37: cropwindow selects no pixel of the 10x720 film"},
+      {"Film \"rgb\" \"integer pixelbounds\" [4 4 0 1]\n" + w,
+       "scene.pbrt:1:12: pixelbounds selects no pixel of the 1280x720 film"},
+      {"Film \"rgb\" \"float cropwindow\" [0 1]\n" + w,
+       "scene.pbrt:1:12: 'cropwindow' of Film \"rgb\" takes 4 values, got 2"},
+  };
+  for (const auto& [text, message] : cases) EXPECT_EQ(errorOf(text), message) << text;
+}
+
+TEST(PbrtCameraFilm, StrictMakesEveryWarningAnError) {
+  const std::string text = std::string(kUnmirrored) +
+                           "MakeNamedMedium \"fog\" \"string type\" "
+                           "\"homogeneous\"\n" +
+                           kTriangle;
+  EXPECT_EQ(load(text).warnings.size(), 1u);
+  try {
+    loadPbrtSceneText(text, "scene.pbrt", SceneLoadOptions{.strict = true});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "scene.pbrt:6:1: MakeNamedMedium ignored: participating media are not simulated (an "
+              "error with --strict)");
+  }
+  // Through loadScene, with a parameter nothing reads.
+  test::TempDir dir;
+  const fs::path path = dir.write("s.pbrt", std::string(kUnmirrored) +
+                                                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 "
+                                                "1 0 0 0 1 0] \"float bogus\" 1\n");
+  EXPECT_NO_THROW(loadScene(path));
+  try {
+    loadScene(path, SceneLoadOptions{.strict = true});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path.string() +
+                  ":6:53: Shape \"trianglemesh\": parameter 'float bogus' ignored (not "
+                  "used by this renderer) (an error with --strict)");
+  }
+  // Configs/cornell-box.pbrt has nothing to warn about.
+  EXPECT_NO_THROW(loadScene(test::kConfigs / "cornell-box.pbrt", SceneLoadOptions{.strict = true}));
 }
 
 }  // namespace

@@ -95,7 +95,7 @@ TEST(SceneLoad, ValidSceneGivesExpectedTriangles) {
   EXPECT_EQ(scene.materials[1].reflectance, glm::vec3(0.0f));
   EXPECT_EQ(scene.materials[2].type, kMaterialMirror);
   EXPECT_EQ(scene.materials[2].reflectance, glm::vec3(1.0f));  // mirror default
-  for (const Material& m : scene.materials) EXPECT_EQ(m.reserved, 0u);
+  for (const Material& m : scene.materials) EXPECT_EQ(m.twoSided, 0u);
 
   const std::vector<Triangle>& t = scene.triangles;
   ASSERT_EQ(t.size(), 11u);
@@ -427,7 +427,7 @@ void expectMaterial(const Material& got, const Material& want, const std::string
   EXPECT_EQ(got.g, want.g);
   EXPECT_EQ(got.maxDepth, want.maxDepth);
   EXPECT_EQ(got.nSamples, want.nSamples);
-  EXPECT_EQ(got.reserved, 0u);
+  EXPECT_EQ(got.twoSided, 0u);
   EXPECT_EQ(got.reserved1, 0u);
 }
 
@@ -608,17 +608,17 @@ TEST(SceneMaterials, BadParametersOfTheNewTypes) {
   EXPECT_EQ(withMaterial(R"({"name": "white", "type": "dielectric", "k": 1})"),
             file +
                 ": materials[0].k: not a parameter of 'dielectric' (a 'dielectric' material "
-                "takes 'eta', 'roughness', 'uroughness', 'vroughness', 'remaproughness' and "
-                "'emission')");
+                "takes 'eta', 'roughness', 'uroughness', 'vroughness', 'remaproughness', "
+                "'emission' and 'twoSided')");
   EXPECT_EQ(withMaterial(R"({"name": "white", "roughness": 0.1})"),
             file +
                 ": materials[0].roughness: not a parameter of 'diffuse' (a 'diffuse' material "
-                "takes 'reflectance' and 'emission')");
+                "takes 'reflectance', 'emission' and 'twoSided')");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "mirror", "eta": 1.5})"),
                   "materials[0].eta: not a parameter of 'mirror'");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "thindielectric", "roughness": 0})"),
                   "materials[0].roughness: not a parameter of 'thindielectric' (a "
-                  "'thindielectric' material takes 'eta' and 'emission')");
+                  "'thindielectric' material takes 'eta', 'emission' and 'twoSided')");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "conductor", "albedo": [0, 0, 0]})"),
                   "materials[0].albedo: not a parameter of 'conductor'");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "diffusetransmission", "g": 0})"),
@@ -632,8 +632,8 @@ TEST(SceneMaterials, BadParametersOfTheNewTypes) {
                   "materials[0].rougness: unknown key (did you mean 'roughness'?)");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "conductor", "displacement": 1})"),
                   "materials[0].displacement: unknown key (expected 'name', 'type', 'eta', 'k', "
-                  "'reflectance', 'roughness', 'uroughness', 'vroughness', 'remaproughness' or "
-                  "'emission')");
+                  "'reflectance', 'roughness', 'uroughness', 'vroughness', 'remaproughness', "
+                  "'emission' or 'twoSided')");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "metal"})"),
                   "materials[0].type: unknown material type 'metal' (expected 'diffuse', "
                   "'mirror', 'conductor', 'dielectric', 'thindielectric', 'diffusetransmission' "
@@ -854,9 +854,10 @@ TEST(SceneDocument, TopLevelErrors) {
   EXPECT_CONTAINS(errorFor(dir, "[1, 2]"), ": top level: expected an object, got an array");
   EXPECT_CONTAINS(errorFor(dir, sceneJson(kWhite, kUnitQuad, R"("material": 1)")),
                   ": material: unknown key (did you mean 'materials'?)");
+  EXPECT_CONTAINS(errorFor(dir, sceneJson(kWhite, kUnitQuad, R"("light": 1)")),
+                  ": light: unknown key (did you mean 'lights'?)");
   EXPECT_CONTAINS(errorFor(dir, sceneJson(kWhite, kUnitQuad, R"("lights": 1)")),
-                  ": lights: unknown key (expected 'description', 'camera', 'integrator', "
-                  "'materials' or 'shapes')");
+                  ": lights: expected an array, got a number");
   EXPECT_CONTAINS(errorFor(dir, R"({"shapes": [1]})"), ": materials: required key is missing");
   EXPECT_CONTAINS(errorFor(dir, R"({"materials": [{"name": "a"}]})"),
                   ": shapes: required key is missing");

@@ -37,6 +37,7 @@ struct RenderArgs {
   std::string device;
   bool validation = false;
   bool noSpecialize = false;
+  bool strict = false;     // pbrt-v4 files: warnings are errors
   std::string debugPixel;  // "X,Y"
   SceneOverrides overrides;
   std::optional<int> spp;
@@ -132,7 +133,7 @@ int runRender(const RenderArgs& args) {
   if (!args.resume.empty()) resumed = readFilmState(args.resume);
 
   const auto loadStart = std::chrono::steady_clock::now();
-  Scene scene = loadScene(args.scene);
+  Scene scene = loadScene(args.scene, SceneLoadOptions{.strict = args.strict});
   const double loadSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
@@ -450,6 +451,9 @@ int main(int argc, char** argv) {
   render->add_flag("--validation", r.validation, "Enable the Vulkan validation layers");
   render->add_flag("--no-specialize", r.noSpecialize,
                    "Compile every effect into the shader (to measure what specialization saves)");
+  render->add_flag("--strict", r.strict,
+                   "pbrt-v4 files: what the reader would warn about (ignored or rendered "
+                   "otherwise than pbrt-v4) is an error, exit status 2");
   render->add_option("--spp", r.spp, "Samples per pixel (default: the scene's)")->check(kPositive);
   render->add_option("--threads", r.threads, "CPU threads (default: all)")->check(kPositive);
   render

@@ -28,7 +28,7 @@ static_assert(offsetof(Triangle, v2) == 32 && offsetof(Triangle, primitive) == 4
 
 static_assert(sizeof(Material) == 96 && sizeof(Material) == 16 * kMaterialTexels);
 static_assert(offsetof(Material, reflectance) == 0 && offsetof(Material, type) == 12);
-static_assert(offsetof(Material, emission) == 16 && offsetof(Material, reserved) == 28);
+static_assert(offsetof(Material, emission) == 16 && offsetof(Material, twoSided) == 28);
 static_assert(offsetof(Material, eta) == 32 && offsetof(Material, alphaX) == 44);
 static_assert(offsetof(Material, k) == 48 && offsetof(Material, alphaY) == 60);
 static_assert(offsetof(Material, transmittance) == 64 && offsetof(Material, thickness) == 76);
@@ -42,14 +42,32 @@ static_assert(sizeof(Emitter) == 16);
 static_assert(offsetof(Emitter, pmf) == 4 && offsetof(Emitter, aliasThreshold) == 8);
 static_assert(offsetof(Emitter, alias) == 12);
 
-static_assert(sizeof(Camera) == 64);
+static_assert(sizeof(Camera) == 160);
 static_assert(offsetof(Camera, forward) == 16 && offsetof(Camera, right) == 32);
 static_assert(offsetof(Camera, up) == 48 && offsetof(Camera, height) == 60);
+static_assert(offsetof(Camera, windowCenter) == 64 && offsetof(Camera, lensRadius) == 76);
+static_assert(offsetof(Camera, cropX) == 80 && offsetof(Camera, filmHeight) == 92);
+static_assert(offsetof(Camera, filterType) == 96 && offsetof(Camera, focalDistance) == 108);
+static_assert(offsetof(Camera, filterWeight) == 112 && offsetof(Camera, filterC) == 124);
+static_assert(offsetof(Camera, filterRootsNear) == 128 && offsetof(Camera, filterExpX) == 140);
+static_assert(offsetof(Camera, filterRootsFar) == 144 && offsetof(Camera, filterExpY) == 156);
 
-static_assert(sizeof(RenderParams) == 112);
-static_assert(offsetof(RenderParams, normalsPresent) == 96);
-static_assert(offsetof(RenderParams, maxDepth) == 64 && offsetof(RenderParams, seed) == 76);
-static_assert(offsetof(RenderParams, russianRoulette) == 84);
+// RenderParams after its Camera, whatever the Camera's size (a multiple of 16 bytes).
+inline constexpr std::size_t kParamsBase = sizeof(Camera);
+static_assert(kParamsBase % 16 == 0);
+static_assert(sizeof(RenderParams) == kParamsBase + 80);
+static_assert(offsetof(RenderParams, maxDepth) == kParamsBase);
+static_assert(offsetof(RenderParams, seed) == kParamsBase + 12);
+static_assert(offsetof(RenderParams, russianRoulette) == kParamsBase + 20);
+static_assert(offsetof(RenderParams, normalsPresent) == kParamsBase + 32);
+static_assert(offsetof(RenderParams, sceneRadius) == kParamsBase + 44);
+static_assert(offsetof(RenderParams, environment) == kParamsBase + 48);
+static_assert(offsetof(RenderParams, sceneCenter) == kParamsBase + 64);
+
+static_assert(sizeof(Light) == 48 && sizeof(Light) == 16 * kLightTexels);
+static_assert(offsetof(Light, type) == 12 && offsetof(Light, radiance) == 16);
+static_assert(offsetof(Light, cosFalloffStart) == 28 && offsetof(Light, direction) == 32);
+static_assert(offsetof(Light, cosFalloffEnd) == 44);
 
 static_assert(sizeof(PassConstants) == 16 && offsetof(PassConstants, sampleCount) == 4 &&
               offsetof(PassConstants, debugPixel) == 8);

@@ -20,6 +20,8 @@
 #include "common/check.h"
 #include "cpu/bounce_random.h"
 #include "cpu/integrator_lanes.h"
+#include "filter.h"
+#include "lights.h"
 
 namespace pt {
 namespace {
@@ -42,12 +44,17 @@ struct LightPoint {
   float pmf;        // probability of choosing this emitter
   vec3 Le;
   uint triangle;
+  bool twoSided;  // emits on both sides
 };
 
-LightPoint pickLightPoint(const SceneData& scene, const CpuSceneCopies& copies, vec2 uChoose,
-                          vec2 uLight) {
+// The emitter the alias table gives for uChoose.
+const Emitter& pickEmitter(const SceneData& scene, vec2 uChoose) {
   const uint slot = aliasTableSlot(uChoose.x, scene.params.emitterCount);
-  const Emitter& emitter = scene.emitters[aliasTablePick(slot, scene.emitters[slot], uChoose.y)];
+  return scene.emitters[aliasTablePick(slot, scene.emitters[slot], uChoose.y)];
+}
+
+LightPoint pointOnEmitter(const SceneData& scene, const CpuSceneCopies& copies,
+                          const Emitter& emitter, vec2 uLight) {
   const Triangle& light = scene.bvh.triangles[emitter.triangle];
   const TriangleShading& lightShading = copies.shading[emitter.triangle];
   const vec2 b = sampleTriangleBarycentrics(uLight);
@@ -57,7 +64,8 @@ LightPoint pickLightPoint(const SceneData& scene, const CpuSceneCopies& copies, 
                     lightShading.magnitude,
                     emitter.pmf,
                     scene.materials[light.material].emission,
-                    emitter.triangle};
+                    emitter.triangle,
+                    scene.materials[light.material].twoSided != 0u};
 }
 
 // The unit direction from p towards a light point, the squared distance, and the cosine at the
@@ -75,6 +83,15 @@ ToLight towardsLight(const LightPoint& light, vec3 p) {
   return ToLight{wl, dist2, -dot(light.normal, wl)};
 }
 
+// A two-sided light seen from its back: the side p sees is the emitting one, its normal turned
+// towards p (for the cosine and the shadow ray's offset).
+void faceTwoSided(LightPoint& light, ToLight& toward) {
+  if (light.twoSided && toward.cosLight < 0.0f) {
+    toward.cosLight = -toward.cosLight;
+    light.normal = -light.normal;
+  }
+}
+
 // --debug-pixel's line about a light sample.
 void printLightSample(const SceneData& scene, const LightPoint& light, float lightPdf, float weight,
                       bool debugPrint, uint depth) {
@@ -83,6 +100,31 @@ void printLightSample(const SceneData& scene, const LightPoint& light, float lig
         stderr, "cpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g\n",
         depth, light.triangle, scene.bvh.triangles[light.triangle].primitive, lightPdf, weight);
   }
+}
+
+// The analytic light (lights.h) an emitter names, or null for an emissive triangle.
+const Light* analyticLight(const SceneData& scene, const Emitter& emitter) {
+  if ((emitter.triangle & kEmitterLight) == 0u) return nullptr;
+  return &scene.lights[emitter.triangle & ~kEmitterLight];
+}
+
+// A light sample of an analytic light (chosen with probability pmf), given the BSDF's
+// f * |cos| towards it (fCos) and its density (bsdfDensity, read only for MIS): traces the
+// shadow ray from `from` and returns the contribution, weighed by the power heuristic unless
+// the light is a delta (which BSDF sampling never finds).
+vec3 analyticLightContribution(const CpuSceneCopies& copies, const AnalyticLightSample& ls,
+                               float pmf, vec3 from, vec3 beta, vec3 fCos, float bsdfDensity,
+                               bool misOn, Intersection test, uint64_t& rays, bool debugPrint,
+                               uint depth) {
+  ++rays;
+  if (anyHit(copies.wide, Ray{from, ls.target - from}, 1.0f, test)) return vec3(0.0f);
+  const float lightPdf = pmf * ls.pdf;
+  const float weight = (misOn && !ls.delta) ? powerHeuristic(lightPdf, bsdfDensity) : 1.0f;
+  if (debugPrint) {
+    std::fprintf(stderr, "cpu depth %u: light sample on analytic light pdf=%g weight=%g\n", depth,
+                 lightPdf, weight);
+  }
+  return beta * fCos * ls.Li * (weight / lightPdf);
 }
 
 // Samples direct illumination at diffuse vertex p with shading normal n (next-event
@@ -96,10 +138,17 @@ vec3 sampleDirectLight(const SceneData& scene, const CpuSceneCopies& copies, vec
                        vec3 ng, bool shadingNormals, float magnitude, vec3 beta, vec3 f,
                        vec2 uChoose, vec2 uLight, bool misOn, Intersection test, uint64_t& rays,
                        bool debugPrint, uint depth) {
-  // Pick an emitter from the alias table, then a uniform point on its triangle.
-  const LightPoint light = pickLightPoint(scene, copies, uChoose, uLight);
+  // Pick an emitter from the alias table, then a uniform point on its triangle (or a sample
+  // of an analytic light).
+  const Emitter& emitter = pickEmitter(scene, uChoose);
+  if ((emitter.triangle & kEmitterLight) != 0u) {
+    return sampleAnalyticLightDiffuse(scene, emitter, p, n, ng, shadingNormals, magnitude, beta, f,
+                                      uLight, misOn, test, rays, debugPrint, depth);
+  }
+  LightPoint light = pointOnEmitter(scene, copies, emitter, uLight);
 
-  const ToLight toward = towardsLight(light, p);
+  ToLight toward = towardsLight(light, p);
+  faceTwoSided(light, toward);
   const float cosSurface = dot(n, toward.wl);
   if (!(toward.cosLight > 0.0f && cosSurface > 0.0f)) return vec3(0.0f);
 
@@ -125,8 +174,22 @@ vec3 sampleDirectLightBsdf(const SceneData& scene, const CpuSceneCopies& copies,
                            float magnitude, vec3 beta, vec2 uChoose, vec2 uLight,
                            RandomStream evalStream, RandomStream pdfStream, bool misOn,
                            Intersection test, uint64_t& rays, bool debugPrint, uint depth) {
-  const LightPoint light = pickLightPoint(scene, copies, uChoose, uLight);
-  const ToLight toward = towardsLight(light, p);
+  const Emitter& emitter = pickEmitter(scene, uChoose);
+  if (const Light* analytic = analyticLight(scene, emitter)) {
+    const AnalyticLightSample ls =
+        sampleAnalyticLight(*analytic, p, uLight, scene.params.sceneRadius);
+    if (!(maxComponent(ls.Li) > 0.0f)) return vec3(0.0f);
+    const vec3 wi = toLocal(frame, ls.wi);
+    const vec3 fCos = bsdfF(material, wo, wi, evalStream) * absCosTheta(wi);
+    if (!(maxComponent(fCos) > 0.0f)) return vec3(0.0f);
+    const float density = (misOn && !ls.delta) ? bsdfPdf(material, wo, wi, pdfStream) : 0.0f;
+    const vec3 from = offsetRayOrigin(p, dot(ng, ls.wi) > 0.0f ? ng : -ng, magnitude);
+    return analyticLightContribution(copies, ls, emitter.pmf, from, beta, fCos, density, misOn,
+                                     test, rays, debugPrint, depth);
+  }
+  LightPoint light = pointOnEmitter(scene, copies, emitter, uLight);
+  ToLight toward = towardsLight(light, p);
+  faceTwoSided(light, toward);
   if (!(toward.cosLight > 0.0f)) return vec3(0.0f);
   const vec3 wi = toLocal(frame, toward.wl);
   const vec3 f = bsdfF(material, wo, wi, evalStream) * absCosTheta(wi);
@@ -145,6 +208,33 @@ vec3 sampleDirectLightBsdf(const SceneData& scene, const CpuSceneCopies& copies,
 }
 
 }  // namespace
+
+vec3 sampleAnalyticLightDiffuse(const SceneData& scene, const Emitter& emitter, vec3 p, vec3 n,
+                                vec3 ng, bool shadingNormals, float magnitude, vec3 beta, vec3 f,
+                                vec2 uLight, bool misOn, Intersection test, uint64_t& rays,
+                                bool debugPrint, uint depth) {
+  const AnalyticLightSample ls =
+      sampleAnalyticLight(*analyticLight(scene, emitter), p, uLight, scene.params.sceneRadius);
+  const float cosWi = dot(n, ls.wi);
+  if (!(cosWi > 0.0f) || !(maxComponent(ls.Li) > 0.0f)) return vec3(0.0f);
+  const vec3 side = shadingNormals ? (dot(ng, ls.wi) > 0.0f ? ng : -ng) : n;
+  return analyticLightContribution(scene.cpuCopies(), ls, emitter.pmf,
+                                   offsetRayOrigin(p, side, magnitude), beta, f * cosWi,
+                                   cosWi * kInvPi, misOn, test, rays, debugPrint, depth);
+}
+
+vec3 environmentSeen(const SceneData& scene, vec3 beta, bool specularBounce, float bsdfPdf) {
+  const RenderParams& params = scene.params;
+  if (params.environmentEmitter == kNoEmitter) return vec3(0.0f);
+  if (specularBounce) return beta * params.environment;
+  if (params.strategy == kStrategyNee) return vec3(0.0f);
+  const float weight =
+      params.strategy == kStrategyMis
+          ? powerHeuristic(bsdfPdf,
+                           environmentLightPdf(scene.emitters[params.environmentEmitter].pmf))
+          : 1.0f;
+  return beta * weight * params.environment;
+}
 
 bool scatterAtBsdfVertex(const SceneData& scene, const BsdfVertex& v, PathState& state, vec3& wi,
                          vec3& side, uint64_t& rays, bool debugPrint) {
@@ -187,9 +277,12 @@ Ray cameraRay(const Camera& cam, vec2 filmPoint) {
   return Ray{cam.position, cameraDirection(cam, filmPoint)};
 }
 
-vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
+vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex, uint64_t& rays,
                     bool debugPrint) {
   const RenderParams& params = scene.params;
+  // The film's pixel, which the random numbers and the camera ray are of: a crop renders its
+  // pixels of the whole film's image.
+  const uvec2 pixel = imagePixel + uvec2(params.camera.cropX, params.camera.cropY);
   const Bvh& bvh = scene.bvh;
   const CpuSceneCopies& copies = scene.cpuCopies();  // the wide BVH, TriangleShading
   const uint seed = params.seed;
@@ -200,9 +293,14 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
   const Intersection test =
       params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
 
-  // Primary ray through a uniformly jittered point of the pixel (box filter of width 1).
-  Ray ray =
-      cameraRay(params.camera, vec2(pixel) + random2(sobol, pixel, sampleIndex, kDimPixel, seed));
+  // The camera ray through a point of the pixel's filter (and of the lens: a pinhole draws no
+  // numbers for it, so that its paths are those of the renderer before lenses).
+  const vec2 uLens = params.camera.lensRadius > 0.0f
+                         ? random2(sobol, pixel, sampleIndex, kDimLens, seed)
+                         : vec2(0.0f);
+  const CameraSample camera = generateCameraRay(
+      params.camera, pixel, random2(sobol, pixel, sampleIndex, kDimPixel, seed), uLens);
+  Ray ray{camera.origin, camera.direction};
   vec3 L(0.0f);     // radiance gathered so far
   vec3 beta(1.0f);  // path throughput
   // The camera ray counts as specular: emission it finds is taken at full weight.
@@ -216,7 +314,11 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     // Find the closest surface along the ray; the background is black.
     ++rays;
     const std::optional<Hit> hit = closestHit(copies.wide, ray, INFINITY, test);
-    if (!hit) break;
+    if (!hit) {
+      // The ray leaves the scene: the infinite light's radiance, weighed as an emitter's.
+      L += environmentSeen(scene, beta, specularBounce, bsdfPdf);
+      break;
+    }
     const Triangle& tri = bvh.triangles[hit->triangle];
     const Material& material = scene.materials[tri.material];
     // Hit point from barycentrics (more accurate than origin + t * direction).
@@ -237,8 +339,9 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
                    beta.z);
     }
 
-    // Add emitted light found by this ray: one-sided, on the geometric normal's side.
-    if (tri.emitter != kNoEmitter && cosOut > 0.0f) {
+    // Add emitted light found by this ray: on the geometric normal's side, or on both.
+    const float cosEmit = material.twoSided != 0u ? std::fabs(cosOut) : cosOut;
+    if (tri.emitter != kNoEmitter && cosEmit > 0.0f) {
       const vec3 Le = material.emission;
       if (specularBounce) {
         L += beta * Le;
@@ -247,7 +350,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
         float weight = 1.0f;
         if (misOn) {
           const float lightPdf = scene.emitters[tri.emitter].pmf * hit->t * hit->t /
-                                 (cosOut * shading.area);  // |direction| = 1: t is the distance
+                                 (cosEmit * shading.area);  // |direction| = 1: t is the distance
           weight = powerHeuristic(bsdfPdf, lightPdf);
         }
         L += beta * weight * Le;
@@ -318,6 +421,8 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
     if (shadingNormals) n = dot(ng, wi) > 0.0f ? ng : -ng;
     ray = Ray{offsetRayOrigin(p, n, magnitude), wi};
   }
+  // The camera sample's weight: 1 but for the negative lobes of some filters (filter.h).
+  L *= camera.weight;
   if (debugPrint) {
     std::fprintf(stderr, "cpu sample %u: L=(%g, %g, %g)\n", sampleIndex, L.x, L.y, L.z);
   }

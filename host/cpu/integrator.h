@@ -25,10 +25,12 @@ struct CpuRenderStats : RenderStats {
   int threads = 0;  // threads used
 };
 
-// Camera ray through film point (x, y) in [0, width) x [0, height), row 0 at the top.
+// The pinhole's ray through film point (x, y) in [0, filmWidth) x [0, filmHeight), row 0 at
+// the top (the whole film's coordinates; no filter, no lens).
 Ray cameraRay(const Camera& camera, vec2 filmPoint);
 
-// Radiance arriving at the camera along one path sample of pixel (x, y). Exposed for
+// Radiance arriving at the camera along one path sample of image pixel (x, y) (of the crop,
+// when there is one), times the camera sample's weight (filter.h). Exposed for
 // `--debug-pixel` and for tests that evaluate single paths; `rays` is incremented by the rays
 // traced. With debugPrint, the path's vertices and light samples go to stderr in the shader's
 // --debug-pixel format.
@@ -69,6 +71,21 @@ struct BsdfVertex {
 // both give the same bits.
 bool scatterAtBsdfVertex(const SceneData& scene, const BsdfVertex& v, PathState& state, vec3& wi,
                          vec3& side, uint64_t& rays, bool debugPrint);
+
+// Light sampling at a diffuse vertex (reflectance / pi = f) towards the analytic light (lights.h)
+// that `emitter` names: sampleRadiance's next-event estimation for such a light, exposed for
+// the lanes (integrator_lanes.h), which call it lane by lane. p, n (the shading normal facing
+// the viewer), ng (geometric), the ray offset's scale, the path throughput; returns the
+// contribution to L, weighed by MIS (misOn) unless the light is a delta.
+vec3 sampleAnalyticLightDiffuse(const SceneData& scene, const Emitter& emitter, vec3 p, vec3 n,
+                                vec3 ng, bool shadingNormals, float magnitude, vec3 beta, vec3 f,
+                                vec2 uLight, bool misOn, Intersection test, uint64_t& rays,
+                                bool debugPrint = false, uint depth = 0);
+
+// The radiance a path gathers when its ray leaves the scene: the infinite light's (none without
+// one), at full weight after a specular bounce (or from the camera), else weighed as
+// BSDF-sampled emission is (MIS, or nothing with light sampling alone).
+vec3 environmentSeen(const SceneData& scene, vec3 beta, bool specularBounce, float bsdfPdf);
 
 // Renders into film (which must have the camera's resolution), adding spp samples per pixel
 // in passes of one sample index each; stopped early (options.stop), it adds whole passes

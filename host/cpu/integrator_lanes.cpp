@@ -32,6 +32,7 @@
 #include "cpu/integrator.h"
 #include "cpu/integrator_lanes.h"
 #include "cpu/random_lanes-inl.h"
+#include "filter.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace pt {
@@ -205,11 +206,13 @@ HWY_INLINE V3 sampleCosineHemisphere(V ux, V uy) {
 
 // cameraDirection: normalize(v) is v * (1 / sqrt(dot(v, v))) in glm.
 HWY_INLINE V3 cameraDirection(const Camera& cam, V filmX, V filmY) {
-  const V u = hn::Sub(hn::Div(hn::Mul(splat(2.0f), filmX), splat(float(cam.width))), splat(1.0f));
-  const V v = hn::Sub(splat(1.0f), hn::Div(hn::Mul(splat(2.0f), filmY), splat(float(cam.height))));
+  const V u =
+      hn::Sub(hn::Div(hn::Mul(splat(2.0f), filmX), splat(float(cam.filmWidth))), splat(1.0f));
+  const V v =
+      hn::Sub(splat(1.0f), hn::Div(hn::Mul(splat(2.0f), filmY), splat(float(cam.filmHeight))));
   auto broadcast = [](vec3 a) { return V3{splat(a.x), splat(a.y), splat(a.z)}; };
   const V3 w =
-      (broadcast(cam.forward) +
+      (broadcast(cam.windowCenter) +
        hn::Mul(hn::Mul(u, splat(cam.tanHalfFovY)), splat(cam.aspect)) * broadcast(cam.right)) +
       hn::Mul(v, splat(cam.tanHalfFovY)) * broadcast(cam.up);
   return hn::Div(splat(1.0f), hn::Sqrt(dot(w, w))) * w;
@@ -313,6 +316,7 @@ struct Paths {
   Lanes3 L, beta;
   Lanes bsdfPdf;
   Lanes etaScale;         // squared relative indices refracted through (bsdf.h's materials)
+  Lanes weight;           // the camera sample's weight (filter.h): multiplies L at the end
   uint32_t specular = 0;  // bits: specularBounce
 };
 
@@ -354,6 +358,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   const bool misOn = params.strategy == kStrategyMis;
   const bool neeOn = params.strategy != kStrategyBsdf && params.emitterCount > 0;
   const bool bsdfEmissionOn = params.strategy != kStrategyNee;
+  const bool environment = params.environmentEmitter != kNoEmitter;  // an infinite light
   const Intersection intersection =
       params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
   const V zero = hn::Zero(d);
@@ -369,23 +374,30 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   TriangleLanes hitTriangle, lightTriangle;
   Lanes uLightChooseX, uLightChooseY, uLightX, uLightY, uBsdfX, uBsdfY, uRoulette, uRouletteY;
   uint32_t hitIndex[kMaxLanes] = {};  // the hit triangle (Bvh::triangles)
-  Lanes3 shadingPoint, wiOther, sideOther;
+  Lanes3 shadingPoint, shadingNormal, wiOther, sideOther;
   Lanes3 lightEmission, shadowFrom, shadowDir;
+  const Emitter* analyticEmitter[kMaxLanes] = {};  // a lane's light of lights.h, if it chose one
   Lanes lightPmf;
   RayPrecomputed prepared[kMaxLanes];
   Lanes filmX, filmY;
   const Camera& camera = params.camera;
+  // The box filter of one pixel and a pinhole: the uniform jitter in the pixel, in lanes. Other
+  // filters and the thin lens take filter.h's generateCameraRay lane by lane (the same bits
+  // as the reference, by definition; a camera ray is a small part of a path).
+  const bool jitterInLanes = camera.filterType == kFilterBox && camera.filterRadiusX == 0.5f &&
+                             camera.filterRadiusY == 0.5f && !(camera.lensRadius > 0.0f);
 
   for (;;) {
-    // Free lanes start the next pixels' paths: the primary ray through a jittered point of
-    // the pixel, radiance 0, throughput 1, the camera ray counting as specular.
+    // Free lanes start the next pixels' paths: the camera ray through a point of the pixel's
+    // filter, radiance 0, throughput 1, the camera ray counting as specular.
     uint32_t starting = 0;
     for (size_t i = 0; i < lanes && nextPixel < count; ++i) {
       if (active >> i & 1u) continue;
       const uvec2 pixel = pixels[nextPixel];
       path.slot[i] = int32_t(nextPixel++);
-      path.pixelX[i] = pixel.x;
-      path.pixelY[i] = pixel.y;
+      // The film's pixel (the crop's corner added), which the random numbers are of.
+      path.pixelX[i] = pixel.x + camera.cropX;
+      path.pixelY[i] = pixel.y + camera.cropY;
       path.depth[i] = 0;
       path.dim[i] = 0;
       path.origin.set(i, camera.position);
@@ -393,10 +405,24 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       path.beta.set(i, vec3(1.0f));
       path.bsdfPdf.v[i] = 0.0f;
       path.etaScale.v[i] = 1.0f;
+      path.weight.v[i] = 1.0f;
       path.specular |= 1u << i;
       starting |= 1u << i;
     }
-    if (starting != 0) {
+    if (starting != 0 && !jitterInLanes) {
+      forEachLane(starting, [&](size_t i) {
+        const uvec2 filmPixel(path.pixelX[i], path.pixelY[i]);
+        const vec2 uLens = camera.lensRadius > 0.0f
+                               ? random2(sobol, filmPixel, sampleIndex, kDimLens, seed)
+                               : vec2(0.0f);
+        const CameraSample ray = generateCameraRay(
+            camera, filmPixel, random2(sobol, filmPixel, sampleIndex, kDimPixel, seed), uLens);
+        path.origin.set(i, ray.origin);
+        path.direction.set(i, ray.direction);
+        path.weight.v[i] = ray.weight;
+      });
+      active |= starting;
+    } else if (starting != 0) {
       // Through a uniformly jittered point of the pixel: vec2(pixel) + random2(.., kDimPixel).
       drawRandom2(sobol, path, sampleIndex, kDimPixel, seed, starting, filmX, &filmY);
       const hn::RebindToSigned<D> di;
@@ -432,7 +458,16 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
           hit = found;
         }
       }
-      if (!hit) return;
+      if (!hit) {
+        // The ray leaves the scene: the infinite light's radiance (environmentSeen, the
+        // reference's own function).
+        if (environment) {
+          path.L.set(i, path.L.get(i) + environmentSeen(scene, path.beta.get(i),
+                                                        (path.specular >> i & 1u) != 0u,
+                                                        path.bsdfPdf.v[i]));
+        }
+        return;
+      }
       live |= 1u << i;
       const Triangle& tri = bvh.triangles[hit->triangle];
       const Material& material = scene.materials[tri.material];
@@ -514,10 +549,19 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
     const uint32_t nee = neeOn ? diffuse & nonBlack : 0u;
     if (nee != 0) {
       // Pick an emitter from the alias table, then a uniform point on its triangle.
+      uint32_t analytic = 0;  // lanes that chose a light of lights.h (taken lane by lane below)
       forEachLane(nee, [&](size_t i) {
         const uint slot = aliasTableSlot(uLightChooseX.v[i], params.emitterCount);
         const Emitter& emitter =
             scene.emitters[aliasTablePick(slot, scene.emitters[slot], uLightChooseY.v[i])];
+        if ((emitter.triangle & kEmitterLight) != 0u) {
+          analytic |= 1u << i;
+          analyticEmitter[i] = &emitter;
+          lightTriangle.set(i, bvh.triangles[0], copies.shading[0]);  // unused, but finite
+          lightPmf.v[i] = 1.0f;
+          lightEmission.set(i, vec3(0.0f));
+          return;
+        }
         const Triangle& light = bvh.triangles[emitter.triangle];
         const TriangleShading& lightShading = copies.shading[emitter.triangle];
         lightTriangle.set(i, light, lightShading);
@@ -538,7 +582,8 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       const V3 wl = toLight / hn::Sqrt(dist2);
       const V cosLight = hn::Neg(dot(lightN, wl));
       const V cosSurface = dot(n, wl);
-      const uint32_t facing = nee & bits(hn::And(hn::Gt(cosLight, zero), hn::Gt(cosSurface, zero)));
+      const uint32_t facing =
+          nee & ~analytic & bits(hn::And(hn::Gt(cosLight, zero), hn::Gt(cosSurface, zero)));
       // Shadow ray between the two offset points; t in [0, 1) spans the segment.
       const V3 from = offsetRayOrigin(p, n, mag);
       const V3 to = offsetRayOrigin(lightPoint, lightN, lightTriangle.magnitude.load());
@@ -566,6 +611,23 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
         const V3 contribution =
             hn::Div(hn::Mul(cosSurface, weight), lightPdf) * ((beta * f) * load(lightEmission));
         L = select(mask(unoccluded), L + contribution, L);
+      }
+      // Analytic lights: the reference's function, lane by lane (the same bits).
+      if (analytic != 0) {
+        store(path.L, L);
+        store(shadingPoint, p);
+        store(shadingNormal, n);
+        store(path.beta, beta);
+        forEachLane(analytic, [&](size_t i) {
+          const vec3 ns = shadingNormal.get(i);
+          path.L.set(
+              i, path.L.get(i) + sampleAnalyticLightDiffuse(
+                                     scene, *analyticEmitter[i], shadingPoint.get(i), ns, ns,
+                                     /*shadingNormals=*/false, hitTriangle.magnitude.v[i],
+                                     path.beta.get(i), kInvPi * reflectance.get(i),
+                                     vec2(uLightX.v[i], uLightY.v[i]), misOn, intersection, rays));
+        });
+        L = load(path.L);
       }
     }
 
@@ -645,7 +707,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
 
     // Paths that ended: their radiance goes out, their lanes are free.
     forEachLane(active & ~live, [&](size_t i) {
-      out[path.slot[i]] = path.L.get(i);
+      out[path.slot[i]] = path.L.get(i) * path.weight.v[i];
       path.slot[i] = -1;
     });
     active = live;
@@ -664,9 +726,10 @@ HWY_EXPORT(sampleRadianceLanesImpl);
 
 void sampleRadianceLanes(const SceneData& scene, const uvec2* pixels, size_t count,
                          uint32_t sampleIndex, vec3* out, uint64_t& rays) {
-  // The lanes shade about the geometric normal only; a scene with shading normals takes the
+  // The lanes shade about the geometric normal only and sample one-sided emissive triangles
+  // (and lights.h's lights) only; a scene with shading normals or two-sided lights takes the
   // reference path by path (the same results by definition).
-  if (scene.effects.shadingNormals) {
+  if (scene.effects.shadingNormals || scene.effects.twoSidedEmitters) {
     for (size_t i = 0; i < count; ++i) out[i] = sampleRadiance(scene, pixels[i], sampleIndex, rays);
     return;
   }

@@ -1,6 +1,7 @@
 // Scene preparation; see prepare.h.
 #include "render/prepare.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "bsdf.h"
@@ -42,6 +43,9 @@ std::string EffectSet::toString() const {
   add(diffuseTransmission, "diffusetransmission");
   add(coatedDiffuse, "coateddiffuse");
   add(shadingNormals, "shading-normals");
+  add(deltaLights, "delta-lights");
+  add(environment, "environment");
+  add(twoSidedEmitters, "two-sided-emitters");
   add(lightSampling, "nee");
   add(mis, "mis");
   add(russianRoulette, "rr");
@@ -50,8 +54,39 @@ std::string EffectSet::toString() const {
   return s.empty() ? "none" : s;
 }
 
+namespace {
+
+double luminance(vec3 c) {
+  return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+}
+
+// A light's power divided by pi (pbrt-v4's Light::Phi, from luminance): point 4 pi I, spot
+// 2 pi I (1 - (cosStart + cosEnd) / 2), distant pi r^2 L, infinite 4 pi^2 r^2 L.
+double lightPowerOverPi(const Light& light, double sceneRadius) {
+  const double y = luminance(light.radiance);
+  const double pi = 3.14159265358979323846;
+  switch (light.type) {
+    case kLightPoint:
+      return 4.0 * y;
+    case kLightSpot:
+      return 2.0 * y * (1.0 - 0.5 * (double(light.cosFalloffStart) + double(light.cosFalloffEnd)));
+    case kLightDistant:
+      return y * sceneRadius * sceneRadius;
+    default:
+      return 4.0 * pi * y * sceneRadius * sceneRadius;
+  }
+}
+
+}  // namespace
+
 std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
                                    const std::vector<Material>& materials) {
+  return buildEmitters(triangles, materials, {}, 0.0f);
+}
+
+std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
+                                   const std::vector<Material>& materials,
+                                   const std::vector<Light>& lights, float sceneRadius) {
   // Power of each emissive triangle: one-sided, so flux = pi * area * radiance; the pmf only
   // needs proportions, and luminance weights the channels.
   std::vector<Emitter> emitters;
@@ -65,9 +100,33 @@ std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
     if (!(luminance > 0.0) || !(area > 0.0)) continue;
     tri.emitter = uint32_t(emitters.size());
     emitters.push_back(Emitter{i, 0.0f, 1.0f, uint32_t(emitters.size())});
-    power.push_back(luminance * area);
+    power.push_back(materials[tri.material].twoSided != 0u ? 2.0 * luminance * area
+                                                           : luminance * area);
+  }
+  // Lights without a position (distant, infinite) are chosen as pbrt-v4's default light
+  // sampler (its BVHLightSampler) chooses them: each with probability 1 / (U + 1), U their
+  // number, and the lights with a position (triangles, point, spot) share the rest by power.
+  // Weighed by power too, they would take nearly every sample (their power grows with the
+  // scene's radius squared) and leave each local light rare samples of huge weight.
+  std::vector<bool> unbounded(power.size(), false);
+  for (uint32_t i = 0; i < lights.size(); ++i) {
+    const double phi = lightPowerOverPi(lights[i], sceneRadius);
+    if (!(phi > 0.0)) continue;  // a black light, or a distant one in an empty scene
+    emitters.push_back(Emitter{kEmitterLight | i, 0.0f, 1.0f, uint32_t(emitters.size())});
+    power.push_back(phi);
+    unbounded.push_back(lights[i].type == kLightDistant || lights[i].type == kLightInfinite);
   }
   if (emitters.empty()) return emitters;
+  const size_t unboundedCount = size_t(std::count(unbounded.begin(), unbounded.end(), true));
+  if (unboundedCount > 0) {
+    double boundedPower = 0.0;
+    for (size_t i = 0; i < power.size(); ++i) boundedPower += unbounded[i] ? 0.0 : power[i];
+    const double share =
+        boundedPower > 0.0 ? 1.0 / double(unboundedCount + 1) : 1.0 / double(unboundedCount);
+    for (size_t i = 0; i < power.size(); ++i) {
+      power[i] = unbounded[i] ? share : power[i] / boundedPower * share;
+    }
+  }
 
   // Vose's alias method: scale probabilities by n, then pair each under-full slot with an
   // over-full one that tops it up. Slots left at the end are full (threshold 1).
@@ -100,13 +159,29 @@ std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
 
 namespace {
 
+// pbrt-v4 sums the infinite lights' radiance where rays leave the scene; constant ones are one
+// light of the summed radiance (the first keeps its place in the list).
+std::vector<Light> mergeInfiniteLights(std::vector<Light> lights) {
+  std::vector<Light> merged;
+  int infinite = -1;
+  for (const Light& light : lights) {
+    if (light.type == kLightInfinite && infinite >= 0) {
+      merged[size_t(infinite)].radiance += light.radiance;
+      continue;
+    }
+    if (light.type == kLightInfinite) infinite = int(merged.size());
+    merged.push_back(light);
+  }
+  return merged;
+}
+
 // A scene far from the origin (coordinates much larger than its extent) wastes float bits on
 // the offset: at 1e5 the spacing of floats is 0.008, and ray offsets, which scale with the
 // coordinates, grow with it. The image does not depend on where the scene is, so move it,
 // with its camera, next to the origin. Per axis, only when the centre is farther out than
 // the extent; then every coordinate is within a factor of two of the centre and the
 // subtraction is exact (Sterbenz), so nothing is rounded. Returns the shift applied.
-vec3 recentre(std::vector<Triangle>& triangles, CameraDesc& camera) {
+vec3 recentre(std::vector<Triangle>& triangles, CameraDesc& camera, std::vector<Light>& lights) {
   vec3 lo(INFINITY), hi(-INFINITY);
   for (const Triangle& t : triangles) {
     lo = min(lo, min(t.v0, min(t.v1, t.v2)));
@@ -125,6 +200,7 @@ vec3 recentre(std::vector<Triangle>& triangles, CameraDesc& camera) {
   }
   camera.position -= shift;
   camera.target -= shift;
+  for (Light& light : lights) light.position -= shift;
   return shift;
 }
 
@@ -142,17 +218,44 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
 
   std::vector<Triangle> triangles = std::move(scene.triangles);
   CameraDesc camera = scene.camera;
-  data.shift = recentre(triangles, camera);
+  std::vector<Light> lights = mergeInfiniteLights(std::move(scene.lights));
+  data.shift = recentre(triangles, camera, lights);
   data.bvh =
       buildBvh(std::move(triangles), BvhBuildOptions{settings.maxLeafSize, settings.builder});
+  // The sphere about the scene's box, for distant and infinite lights (pbrt-v4's
+  // scene radius).
+  vec3 centre(0.0f);
+  float radius = 0.0f;
+  if (!data.bvh.nodes.empty()) {
+    const BvhNode& root = data.bvh.nodes[0];
+    centre = 0.5f * (root.boundsMin + root.boundsMax);
+    radius = 0.5f * length(root.boundsMax - root.boundsMin);
+  }
   // Emitters index triangles in leaf order, so they are built after the reorder.
-  data.emitters = buildEmitters(data.bvh.triangles, data.materials);
+  data.emitters = buildEmitters(data.bvh.triangles, data.materials, lights, radius);
+  data.lights = std::move(lights);
 
   RenderParams& p = data.params;
   p.camera = makeCamera(camera, width, height);
   p.maxDepth = uint32_t(settings.maxDepth.value_or(integ.maxDepth));
   p.rrStartDepth = uint32_t(integ.rrStartDepth);
   p.emitterCount = uint32_t(data.emitters.size());
+  p.lightCount = uint32_t(data.lights.size());
+  p.sceneCenter = centre;
+  p.sceneRadius = radius;
+  p.environmentEmitter = kNoEmitter;
+  for (uint32_t i = 0; i < data.emitters.size(); ++i) {
+    const uint32_t ref = data.emitters[i].triangle;
+    if ((ref & kEmitterLight) == 0u) continue;
+    const Light& light = data.lights[ref & ~kEmitterLight];
+    if (light.type == kLightInfinite) {
+      p.environmentEmitter = i;
+      p.environment = light.radiance;
+    } else {
+      data.effects.deltaLights = true;
+    }
+  }
+  data.effects.environment = p.environmentEmitter != kNoEmitter;
   p.seed = settings.seed.value_or(integ.seed);
   p.strategy = settings.strategy.value_or(integ.strategy);
   p.fastIntersection = settings.fastIntersection ? 1u : 0u;
@@ -180,7 +283,16 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   const bool scatters = p.maxDepth > 0;
   fx.lightSampling = (fx.diffuse || lightSampled) && scatters && !data.emitters.empty() &&
                      p.strategy != kStrategyBsdf;
-  fx.bsdfEmission = !data.emitters.empty() && p.strategy != kStrategyNee;
+  // Emission found by BSDF-sampled rays: some triangle or the environment emits.
+  bool hittable = fx.environment;
+  for (const Emitter& e : data.emitters) {
+    if ((e.triangle & kEmitterLight) != 0u) continue;
+    hittable = true;
+    if (data.materials[data.bvh.triangles[e.triangle].material].twoSided != 0u) {
+      fx.twoSidedEmitters = true;
+    }
+  }
+  fx.bsdfEmission = hittable && p.strategy != kStrategyNee;
   fx.shadingNormals = !data.normals.empty();
   p.normalsPresent = fx.shadingNormals ? 1u : 0u;
   fx.watertight = !settings.fastIntersection;

@@ -59,10 +59,13 @@ struct EffectSet {
   bool thinDielectric = false;
   bool diffuseTransmission = false;
   bool coatedDiffuse = false;
-  bool shadingNormals = false;  // some mesh has vertex normals: shading normals interpolated
-  bool lightSampling = false;   // next-event estimation (needs emitters, a diffuse surface)
-  bool bsdfEmission = false;    // emission found by BSDF-sampled rays is counted (MIS/BSDF)
-  bool mis = false;             // both of the above, weighed by the power heuristic
+  bool shadingNormals = false;    // some mesh has vertex normals: shading normals interpolated
+  bool deltaLights = false;       // point, spot or distant lights (sampled, never hit)
+  bool environment = false;       // an infinite light: rays that leave the scene see it
+  bool twoSidedEmitters = false;  // some emissive triangle emits on both sides
+  bool lightSampling = false;     // next-event estimation (needs emitters, a diffuse surface)
+  bool bsdfEmission = false;      // emission found by BSDF-sampled rays is counted (MIS/BSDF)
+  bool mis = false;               // both of the above, weighed by the power heuristic
   bool russianRoulette = false;
   bool watertight = true;  // false: the faster, leaky Moller-Trumbore test
   bool sobol = false;      // Owen-scrambled Sobol numbers instead of independent ones
@@ -126,6 +129,7 @@ struct SceneData {
   Bvh bvh;
   std::vector<Material> materials;
   std::vector<Emitter> emitters;  // alias table; empty when nothing emits
+  std::vector<Light> lights;      // the analytic lights the emitters beyond the triangles name
   // Vertex normals by Triangle::primitive (load order), or empty when no mesh has any.
   std::vector<TriangleNormals> normals;
   RenderParams params{};
@@ -150,5 +154,14 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings);
 // triangle's emitter index in Triangle::emitter. Exposed for tests.
 std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
                                    const std::vector<Material>& materials);
+
+// The same with analytic lights (struct Light) after the triangles. Distant and infinite lights
+// take 1 / (U + 1) each (U of them; 1 / U when nothing else emits), as pbrt-v4's default
+// light sampler gives them; point and spot lights join the triangles, which share the rest
+// by power, a light's as pbrt-v4's Light::Phi gives it (divided by pi, as the triangles'
+// area x luminance is).
+std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
+                                   const std::vector<Material>& materials,
+                                   const std::vector<Light>& lights, float sceneRadius);
 
 }  // namespace pt

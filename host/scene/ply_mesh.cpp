@@ -276,6 +276,7 @@ class PlyReader {
     for (const IndexTri& t : tris_) {
       mesh.triangles.push_back({vertices_[t[0]], vertices_[t[1]], vertices_[t[2]]});
     }
+    mesh.nonFiniteNormals = nonFiniteNormals_;
     if (!normals_.empty()) {
       mesh.normals.reserve(tris_.size());
       for (const IndexTri& t : tris_) {
@@ -687,6 +688,11 @@ class PlyReader {
     checkVector(e, entry, point, kCoordinate, line);
     vertices_.push_back(point);
     if (!e.hasNormals) return;
+    if (!std::isfinite(normal.x) || !std::isfinite(normal.y) || !std::isfinite(normal.z)) {
+      ++nonFiniteNormals_;
+      normals_.push_back(glm::dvec3(0.0));
+      return;
+    }
     checkVector(e, entry, normal, kNormal, line);
     normals_.push_back(normal);
   }
@@ -973,6 +979,8 @@ class PlyReader {
     // overflow has already become an infinity).
     double asDouble = value;
     parseReal(token, &asDouble);
+    // A normal that is not finite is kept as such, for addVertex to count and replace.
+    if (&kind == &kNormal && !std::isfinite(asDouble)) return asDouble;
     failEntry(
         e, entry,
         std::string(kind.what) +
@@ -996,7 +1004,8 @@ class PlyReader {
   std::size_t line_ = 0;  // ascii: number of the line last read
 
   std::vector<glm::dvec3> vertices_;
-  std::vector<glm::dvec3> normals_;  // parallel to vertices_, or empty: the file has none
+  std::vector<glm::dvec3> normals_;   // parallel to vertices_, or empty: the file has none
+  std::size_t nonFiniteNormals_ = 0;  // normals read as 0 0 0 because they were not finite
   std::vector<IndexTri> tris_;
 };
 

@@ -18,6 +18,10 @@ struct PlyMesh {
   // read: not normalized (the scene loader normalizes after transforming), and a file's
   // own 0 0 0 stays a zero vector, which the scene loader replaces by the geometric normal.
   std::vector<std::array<glm::dvec3, 3>> normals;
+  // Vertex normals with a NaN or infinite component (scanned meshes and exporters write them:
+  // Bitterli's lamp has 32): kept as 0 0 0, so that their triangles take the geometric normal
+  // there, and counted, so that the scene loader can say so.
+  std::size_t nonFiniteNormals = 0;
 };
 
 // Triangles of a PLY file in file order, each polygon fanned as (0, i, i + 1). `bytes` is

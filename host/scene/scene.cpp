@@ -51,8 +51,81 @@ T readChoice(const JsonNode& node, const NameTable<T, N>& table, const char* wha
 
 // ---- camera and integrator --------------------------------------------------------------
 
+constexpr NameTable<uint, 4> kFilterTypes{{
+    {"box", kFilterBox, "constant"},
+    {"triangle", kFilterTriangle, "a tent"},
+    {"gaussian", kFilterGaussian, "a truncated Gaussian"},
+    {"mitchell", kFilterMitchell, "Mitchell and Netravali's cubic"},
+}};
+
+// A float field that must satisfy `ok` (after rounding to float too: 1e-50 rounds to 0).
+template <typename Ok>
+float readFloat(const JsonNode& n, Ok ok, const std::string& expected) {
+  const double v = n.number();
+  const float rounded = static_cast<float>(v);
+  if (!(ok(v) && ok(double(rounded)) && std::isfinite(rounded))) {
+    n.fail("expected " + expected + ", got " + n.describe());
+  }
+  return rounded;
+}
+
+// Four numbers [x0, x1, y0, y1].
+std::array<double, 4> readRectangle(const JsonNode& n) {
+  n.expectArray();
+  if (n.size() != 4) n.fail("expected [x0, x1, y0, y1], got " + n.describe());
+  std::array<double, 4> r{};
+  for (std::size_t i = 0; i < 4; ++i) {
+    r[i] = n[i].number();
+    if (!std::isfinite(static_cast<float>(r[i]))) {
+      n[i].fail("expected a number that fits a 32-bit float, got " + n[i].describe());
+    }
+  }
+  return r;
+}
+
+// "filter": {"type": ..., "radius": r or [rx, ry], "sigma": s, "B": b, "C": c}, pbrt-v4's
+// filters with its defaults.
+PixelFilterDesc readFilter(const JsonNode& node) {
+  node.expectObject();
+  const uint type = readChoice(node.require("type"), kFilterTypes, "filter type");
+  std::vector<std::string_view> keys{"type", "radius"};
+  if (type == kFilterGaussian) keys.push_back("sigma");
+  if (type == kFilterMitchell) keys.insert(keys.end(), {"B", "C"});
+  node.checkKeys(keys);
+  PixelFilterDesc filter = defaultFilter(type);
+  const auto positive = [](double v) { return v > 0.0 && v <= 4096.0; };
+  const std::string radius = "a radius in (0, 4096] pixels";
+  if (auto n = node.find("radius")) {
+    if (n->json().is_array()) {
+      if (n->size() != 2) {
+        n->fail("expected a radius or [x radius, y radius], got " + n->describe());
+      }
+      filter.radiusX = readFloat((*n)[0], positive, radius);
+      filter.radiusY = readFloat((*n)[1], positive, radius);
+    } else {
+      filter.radiusX = filter.radiusY = readFloat(*n, positive, radius);
+    }
+  }
+  if (auto n = node.find("sigma")) {
+    filter.sigma = readFloat(
+        *n, [](double v) { return v > 0.0; }, "a positive number");
+  }
+  const auto bounded = [](double v) { return v >= -100.0 && v <= 100.0; };
+  if (auto n = node.find("B")) filter.b = readFloat(*n, bounded, "a number in [-100, 100]");
+  if (auto n = node.find("C")) filter.c = readFloat(*n, bounded, "a number in [-100, 100]");
+  // What only the combination can violate (gaussian's sigma against its radius).
+  Camera check{};
+  try {
+    setFilterConstants(check, filter, "");
+  } catch (const InputError& e) {
+    node.fail(e.what());
+  }
+  return filter;
+}
+
 CameraDesc readCamera(const JsonNode& node) {
-  node.checkKeys({"position", "target", "up", "vfov", "width", "height"});
+  node.checkKeys({"position", "target", "up", "vfov", "width", "height", "filter", "lensRadius",
+                  "focalDistance", "screenWindow", "cropWindow", "pixelBounds"});
   CameraDesc desc;
   glm::dvec3 position(desc.position), target(desc.target), up(desc.up);
   if (auto n = node.find("position")) position = n->vec3();
@@ -70,6 +143,55 @@ CameraDesc readCamera(const JsonNode& node) {
   }
   if (auto n = node.find("width")) desc.width = static_cast<int>(n->integer(1, kMaxResolution));
   if (auto n = node.find("height")) desc.height = static_cast<int>(n->integer(1, kMaxResolution));
+  if (auto n = node.find("filter")) desc.filter = readFilter(*n);
+  if (auto n = node.find("lensRadius")) {
+    desc.lensRadius = readFloat(
+        *n, [](double v) { return v >= 0.0; }, "a lens radius >= 0 (0: a pinhole)");
+  }
+  if (auto n = node.find("focalDistance")) {
+    desc.focalDistance = readFloat(
+        *n, [](double v) { return v > 0.0; }, "a positive distance");
+  }
+  if (auto n = node.find("screenWindow")) {
+    const std::array<double, 4> w = readRectangle(*n);
+    std::array<float, 4> f{};
+    for (std::size_t i = 0; i < 4; ++i) f[i] = static_cast<float>(w[i]);
+    if (!(f[0] != f[1] && f[2] != f[3])) {
+      n->fail("expected a window of some width and height [x0, x1, y0, y1], got " + n->describe());
+    }
+    desc.screenWindow = f;
+  }
+  if (node.find("cropWindow") && node.find("pixelBounds")) {
+    node.fail("give cropWindow or pixelBounds, not both");
+  }
+  if (auto n = node.find("cropWindow")) {
+    const std::array<double, 4> c = readRectangle(*n);
+    if (!(c[0] >= 0.0 && c[0] < c[1] && c[1] <= 1.0 && c[2] >= 0.0 && c[2] < c[3] && c[3] <= 1.0)) {
+      n->fail(
+          "expected fractions of the film [x0, x1, y0, y1] with 0 <= x0 < x1 <= 1 and "
+          "0 <= y0 < y1 <= 1");
+    }
+    desc.cropWindow = std::array<float, 4>{static_cast<float>(c[0]), static_cast<float>(c[1]),
+                                           static_cast<float>(c[2]), static_cast<float>(c[3])};
+  }
+  if (auto n = node.find("pixelBounds")) {
+    n->expectArray();
+    if (n->size() != 4) n->fail("expected [x0, x1, y0, y1], got " + n->describe());
+    std::array<int, 4> b{};
+    for (std::size_t i = 0; i < 4; ++i) b[i] = static_cast<int>((*n)[i].integer(0, kMaxResolution));
+    if (!(b[0] < b[1] && b[1] <= desc.width && b[2] < b[3] && b[3] <= desc.height)) {
+      n->fail("expected pixels [x0, x1) x [y0, y1) of the " + std::to_string(desc.width) + "x" +
+              std::to_string(desc.height) + " film, x0 < x1 and y0 < y1");
+    }
+    desc.pixelBounds = b;
+  }
+  if (auto n = node.find("cropWindow")) {
+    const std::array<int, 4> crop = cropPixels(desc, desc.width, desc.height);
+    if (!(crop[1] > crop[0] && crop[3] > crop[2])) {
+      n->fail("selects no pixel of the " + std::to_string(desc.width) + "x" +
+              std::to_string(desc.height) + " film");
+    }
+  }
 
   // The basis must be well defined. Checked in double on the float values makeCamera sees.
   desc.position = glm::vec3(position);
@@ -155,6 +277,7 @@ std::vector<std::string_view> materialKeys(uint type) {
       PT_CHECK(false, "material type without a key list");
   }
   keys.push_back("emission");
+  keys.push_back("twoSided");
   return keys;
 }
 
@@ -326,6 +449,7 @@ void readMaterials(const JsonNode& node, Scene& scene) {
       }
       material.emission = glm::vec3(e);
     }
+    if (auto n = m.find("twoSided")) material.twoSided = n->boolean() ? 1u : 0u;
     scene.materials.push_back(material);
     scene.materialNames.push_back(name);
   }
@@ -568,7 +692,9 @@ void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
                    const std::optional<Transform>& transform, uint material, Scene& scene) {
   const std::vector<Tri>& triangles = shapeTriangles.triangles;
   std::size_t dropped = 0;
-  scene.triangles.reserve(scene.triangles.size() + triangles.size());
+  // Room for the shape, growing geometrically: reserving the exact size for every shape
+  // would copy the whole scene once per shape (855 PLY meshes took 9.6 s, mostly page faults).
+  reserveGeometric(scene.triangles, scene.triangles.size() + triangles.size());
   for (std::size_t i = 0; i < triangles.size(); ++i) {
     const Tri& tri = triangles[i];
     Triangle out{};
@@ -716,6 +842,12 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
             scene_detail::loadPlyMesh(file.bytes, file.path.string(), file.context);
         triangles.triangles = std::move(ply.triangles);
         triangles.normals = std::move(ply.normals);
+        if (ply.nonFiniteNormals > 0) {
+          scene.warnings.push_back(file.path.string() + ": " +
+                                   std::to_string(ply.nonFiniteNormals) +
+                                   " vertex normals are not finite (NaN or infinite): their "
+                                   "triangles take the geometric normal at those vertices");
+        }
         break;
       }
     }
@@ -805,8 +937,84 @@ void setConductorReflectance(Material& material, vec3 reflectance) {
   }
 }
 
-Scene loadScene(const std::filesystem::path& path) {
-  if (path.extension() == ".pbrt") return loadPbrtScene(path);  // docs/pbrt-format.md
+// ---- lights -----------------------------------------------------------------------------
+
+namespace {
+
+// "lights": pbrt-v4's point, spot, distant and infinite lights (docs/scene-format.md), in world
+// space, with their radiometric quantities given directly.
+void readLights(const JsonNode& node, Scene& scene) {
+  node.expectArray();
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const JsonNode l = node[i];
+    l.expectObject();
+    const JsonNode typeNode = l.require("type");
+    const std::string type = typeNode.string();
+    // A non-negative colour that fits a float.
+    const auto colour = [&](const char* key) {
+      const JsonNode n = l.require(key);
+      const glm::dvec3 c = n.vec3();
+      for (std::size_t k = 0; k < 3; ++k) {
+        if (!(c[k] >= 0.0) || !(static_cast<float>(c[k]) < 3.4e38f)) {
+          n[k].fail("expected a non-negative number that fits a 32-bit float, got " +
+                    n[k].describe());
+        }
+      }
+      return glm::vec3(c);
+    };
+    const auto unit = [&](const JsonNode& n, glm::dvec3 v) {
+      const double length = glm::length(v);
+      if (!(length > 0.0)) n.fail("has no direction (zero length)");
+      return glm::vec3(v / length);
+    };
+    Light light{};
+    if (type == "point" || type == "spot") {
+      l.checkKeys(type == "point"
+                      ? std::vector<std::string_view>{"type", "position", "intensity"}
+                      : std::vector<std::string_view>{"type", "position", "target", "intensity",
+                                                      "coneAngle", "coneDeltaAngle"});
+      light.type = type == "point" ? kLightPoint : kLightSpot;
+      const glm::dvec3 position = l.require("position").vec3();
+      light.position = glm::vec3(position);
+      light.radiance = colour("intensity");
+      if (light.type == kLightSpot) {
+        const JsonNode target = l.require("target");
+        light.direction = unit(target, target.vec3() - position);
+        double cone = 30.0, delta = 5.0;  // pbrt-v4's defaults
+        if (auto n = l.find("coneAngle")) {
+          cone = n->number();
+          if (!(cone > 0.0 && cone <= 180.0)) n->fail("expected degrees in (0, 180]");
+        }
+        if (auto n = l.find("coneDeltaAngle")) {
+          delta = n->number();
+          if (!(delta >= 0.0 && delta <= cone)) n->fail("expected degrees in [0, coneAngle]");
+        }
+        const double pi = 3.14159265358979323846;
+        light.cosFalloffEnd = static_cast<float>(std::cos(cone * pi / 180.0));
+        light.cosFalloffStart = static_cast<float>(std::cos((cone - delta) * pi / 180.0));
+      }
+    } else if (type == "distant") {
+      l.checkKeys({"type", "direction", "radiance"});
+      light.type = kLightDistant;
+      const JsonNode direction = l.require("direction");
+      light.direction = unit(direction, direction.vec3());
+      light.radiance = colour("radiance");
+    } else if (type == "environment") {
+      l.checkKeys({"type", "radiance"});
+      light.type = kLightInfinite;
+      light.radiance = colour("radiance");
+    } else {
+      typeNode.fail("unknown light type " + singleQuoted(type) +
+                    " (expected \"point\", \"spot\", \"distant\" or \"environment\")");
+    }
+    scene.lights.push_back(light);
+  }
+}
+
+}  // namespace
+
+Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& options) {
+  if (path.extension() == ".pbrt") return loadPbrtScene(path, options);  // docs/pbrt-format.md
   const std::string file = path.string();
   std::string text;
   std::string why;
@@ -815,7 +1023,7 @@ Scene loadScene(const std::filesystem::path& path) {
   }
   const nlohmann::json document = scene_detail::parseJson(text, file);
   const JsonNode root(document, "", file);
-  root.checkKeys({"description", "camera", "integrator", "materials", "shapes"});
+  root.checkKeys({"description", "camera", "integrator", "materials", "shapes", "lights"});
 
   Scene scene;
   if (auto n = root.find("description")) n->string();
@@ -823,6 +1031,7 @@ Scene loadScene(const std::filesystem::path& path) {
   if (auto n = root.find("integrator")) scene.integrator = readIntegrator(*n);
   readMaterials(root.require("materials"), scene);
   readShapes(root.require("shapes"), path, scene);
+  if (auto n = root.find("lights")) readLights(*n, scene);
   return scene;
 }
 
@@ -842,12 +1051,222 @@ Camera makeCamera(const CameraDesc& desc, int width, int height) {
   camera.up = glm::vec3(up);
   camera.tanHalfFovY = static_cast<float>(tanHalfFovY);
   camera.aspect = static_cast<float>(static_cast<double>(width) / static_cast<double>(height));
-  camera.width = static_cast<uint>(width);
-  camera.height = static_cast<uint>(height);
+  // The screen window: by default centred and tan(vfov / 2) high, so that windowCenter is
+  // forward itself (the pinhole's rays of the renderer before screen windows, bit for bit).
+  camera.windowCenter = camera.forward;
+  if (desc.screenWindow) {
+    const std::array<float, 4>& w = *desc.screenWindow;
+    const double halfWidth = 0.5 * (double(w[1]) - double(w[0])) * tanHalfFovY;
+    const double halfHeight = 0.5 * (double(w[3]) - double(w[2])) * tanHalfFovY;
+    const double cx = 0.5 * (double(w[0]) + double(w[1])) * tanHalfFovY;
+    const double cy = 0.5 * (double(w[2]) + double(w[3])) * tanHalfFovY;
+    PT_CHECK(halfWidth != 0.0 && halfHeight != 0.0, "screen window of no area");
+    camera.tanHalfFovY = static_cast<float>(halfHeight);
+    camera.aspect = static_cast<float>(halfWidth / halfHeight);
+    camera.windowCenter = glm::vec3(forward + cx * right + cy * up);
+  }
+  // The film, and the image: its crop.
+  const std::array<int, 4> crop = cropPixels(desc, width, height);
+  if (!(crop[1] > crop[0] && crop[3] > crop[2])) {
+    throw InputError("the crop window selects no pixel of the " + std::to_string(width) + "x" +
+                     std::to_string(height) + " film");
+  }
+  camera.filmWidth = static_cast<uint>(width);
+  camera.filmHeight = static_cast<uint>(height);
+  camera.cropX = static_cast<uint>(crop[0]);
+  camera.cropY = static_cast<uint>(crop[2]);
+  camera.width = static_cast<uint>(crop[1] - crop[0]);
+  camera.height = static_cast<uint>(crop[3] - crop[2]);
+  // The lens and the filter.
+  camera.lensRadius = desc.lensRadius;
+  camera.focalDistance = desc.focalDistance;
+  setFilterConstants(camera, desc.filter, "camera");
   PT_CHECK(std::isfinite(camera.right.x + camera.right.y + camera.right.z + camera.forward.x +
                          camera.forward.y + camera.forward.z + camera.tanHalfFovY),
            "camera basis is degenerate (up parallel to the view direction?)");
+  PT_CHECK(std::isfinite(camera.windowCenter.x + camera.windowCenter.y + camera.windowCenter.z +
+                         camera.aspect + camera.tanHalfFovY),
+           "screen window beyond the float range");
   return camera;
+}
+
+std::array<int, 4> cropPixels(const CameraDesc& desc, int width, int height) {
+  if (desc.cropWindow) {
+    // pbrt-v4's Film: the fractions ordered and clamped to [0, 1], the bounds rounded up, in
+    // float as it computes them.
+    const std::array<float, 4>& c = *desc.cropWindow;
+    auto edge = [](int size, float fraction) {
+      return static_cast<int>(
+          std::ceil(static_cast<float>(size) * std::clamp(fraction, 0.0f, 1.0f)));
+    };
+    return {edge(width, std::min(c[0], c[1])), edge(width, std::max(c[0], c[1])),
+            edge(height, std::min(c[2], c[3])), edge(height, std::max(c[2], c[3]))};
+  }
+  if (desc.pixelBounds) {
+    // pbrt-v4's Film: the corners ordered, intersected with the film.
+    const std::array<int, 4>& b = *desc.pixelBounds;
+    return {std::clamp(std::min(b[0], b[1]), 0, width), std::clamp(std::max(b[0], b[1]), 0, width),
+            std::clamp(std::min(b[2], b[3]), 0, height),
+            std::clamp(std::max(b[2], b[3]), 0, height)};
+  }
+  return {0, width, 0, height};
+}
+
+namespace {
+
+// Where the cubic c[0] t^3 + c[1] t^2 + c[2] t + c[3] changes sign strictly inside (a, b), in
+// increasing order: the cubic is monotone between the roots of its derivative, so each such
+// piece holds at most one sign change, found by bisection in double. Breakpoints between two
+// segments of the same sign (a root the cubic only touches, or rounding at a piece's end)
+// are dropped: what is left are the real sign changes, at most three.
+std::vector<double> cubicSignChanges(const std::array<double, 4>& c, double a, double b) {
+  auto p = [&](double t) { return ((c[0] * t + c[1]) * t + c[2]) * t + c[3]; };
+  std::vector<double> cuts{a, b};
+  const double qa = 3.0 * c[0], qb = 2.0 * c[1], qc = c[2];
+  if (qa != 0.0) {
+    const double disc = qb * qb - 4.0 * qa * qc;
+    if (disc > 0.0) {
+      for (double sign : {-1.0, 1.0}) cuts.push_back((-qb + sign * std::sqrt(disc)) / (2.0 * qa));
+    }
+  } else if (qb != 0.0) {
+    cuts.push_back(-qc / qb);
+  }
+  std::erase_if(cuts, [&](double t) { return !(t >= a && t <= b); });
+  std::sort(cuts.begin(), cuts.end());
+  std::vector<double> points{a};
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+    double lo = cuts[i], hi = cuts[i + 1];
+    if (!(hi > lo)) continue;
+    // The sign just inside the piece's ends (a piece may end at a root).
+    const double nudge = 1e-9 * (hi - lo);
+    const double pl = p(lo) != 0.0 ? p(lo) : p(lo + nudge);
+    const double ph = p(hi) != 0.0 ? p(hi) : p(hi - nudge);
+    if (!((pl < 0.0 && ph > 0.0) || (pl > 0.0 && ph < 0.0))) continue;
+    for (int step = 0; step < 200; ++step) {
+      const double mid = 0.5 * (lo + hi);
+      ((p(mid) < 0.0) == (pl < 0.0) ? lo : hi) = mid;
+    }
+    const double root = 0.5 * (lo + hi);
+    if (root > a && root < b) points.push_back(root);
+  }
+  points.push_back(b);
+  std::vector<double> changes;
+  for (std::size_t i = 1; i + 1 < points.size(); ++i) {
+    const bool before = p(0.5 * (points[i - 1] + points[i])) < 0.0;
+    const bool after = p(0.5 * (points[i] + points[i + 1])) < 0.0;
+    if (before != after) changes.push_back(points[i]);
+  }
+  return changes;
+}
+
+[[noreturn]] void filterError(const std::string& where, const std::string& problem) {
+  throw InputError((where.empty() ? "" : where + ": ") + problem);
+}
+
+}  // namespace
+
+PixelFilterDesc defaultFilter(uint type) {
+  PixelFilterDesc filter;
+  filter.type = type;
+  const float radius = type == kFilterBox        ? 0.5f
+                       : type == kFilterGaussian ? 1.5f
+                                                 : 2.0f;  // triangle, mitchell
+  filter.radiusX = filter.radiusY = radius;
+  return filter;
+}
+
+void setFilterConstants(Camera& camera, const PixelFilterDesc& filter, const std::string& where) {
+  for (float r : {filter.radiusX, filter.radiusY}) {
+    if (!(r > 0.0f && r <= 4096.0f)) {
+      filterError(
+          where, "filter radius must be in (0, 4096] pixels, got " + scene_detail::formatNumber(r));
+    }
+  }
+  PT_CHECK(filter.type <= kFilterMitchell, "unknown filter type");
+  camera.filterType = filter.type;
+  camera.filterRadiusX = filter.radiusX;
+  camera.filterRadiusY = filter.radiusY;
+  camera.filterWeight = 1.0f;
+  camera.filterScale = 0.0f;
+  camera.filterB = camera.filterC = 0.0f;
+  camera.filterExpX = camera.filterExpY = 0.0f;
+  camera.filterRootsNear = vec3(1.0f);
+  camera.filterRootsFar = vec3(2.0f);
+  if (filter.type == kFilterGaussian) {
+    if (!(filter.sigma > 0.0f && std::isfinite(filter.sigma))) {
+      filterError(where, "gaussian filter: sigma must be a positive number, got " +
+                             scene_detail::formatNumber(filter.sigma));
+    }
+    // filter.h's constants, from the float values it works with.
+    const float k = static_cast<float>(1.0 / (double(filter.sigma) * std::sqrt(2.0)));
+    camera.filterScale = k;
+    const double twoKOverRootPi = 2.0 * double(k) / std::sqrt(3.14159265358979323846);
+    float* exps[2] = {&camera.filterExpX, &camera.filterExpY};
+    const float radii[2] = {filter.radiusX, filter.radiusY};
+    for (int axis = 0; axis < 2; ++axis) {
+      const double kr = double(k) * double(radii[axis]);
+      const double e = std::exp(-kr * kr) * twoKOverRootPi;
+      *exps[axis] = static_cast<float>(e);
+      // The CDF's whole range, erf(kr) twice minus the constant: where sigma dwarfs the
+      // radius the filter is nearly constant and this difference of nearly equal numbers falls
+      // to the erf approximation's error (3e-7), which would then shape the samples.
+      const double total = 2.0 * std::erf(kr) - 2.0 * e * double(radii[axis]);
+      if (!(total > 4e-4)) {
+        filterError(where, "gaussian filter: sigma " + scene_detail::formatNumber(filter.sigma) +
+                               " is too wide for radius " +
+                               scene_detail::formatNumber(radii[axis]) +
+                               " (the filter is within 0.1 % of a box there: use \"box\")");
+      }
+    }
+  } else if (filter.type == kFilterMitchell) {
+    const double b = filter.b, c = filter.c;
+    if (!(std::isfinite(b) && std::isfinite(c) && std::abs(b) <= 100.0 && std::abs(c) <= 100.0)) {
+      filterError(where, "mitchell filter: B and C must be numbers in [-100, 100], got " +
+                             scene_detail::formatNumber(b) + " and " +
+                             scene_detail::formatNumber(c));
+    }
+    camera.filterB = filter.b;
+    camera.filterC = filter.c;
+    // The two cubics (times 6) from the float B and C the sampler uses, their sign changes and
+    // the integrals of |f| and f over t in [0, 2].
+    const double fb = camera.filterB, fc = camera.filterC;
+    const std::array<double, 4> nearCubic = {12.0 - 9.0 * fb - 6.0 * fc,
+                                             -18.0 + 12.0 * fb + 6.0 * fc, 0.0, 6.0 - 2.0 * fb};
+    const std::array<double, 4> farCubic = {-fb - 6.0 * fc, 6.0 * fb + 30.0 * fc,
+                                            -12.0 * fb - 48.0 * fc, 8.0 * fb + 24.0 * fc};
+    const std::vector<double> nearRoots = cubicSignChanges(nearCubic, 0.0, 1.0);
+    const std::vector<double> farRoots = cubicSignChanges(farCubic, 1.0, 2.0);
+    PT_CHECK(nearRoots.size() <= 3 && farRoots.size() <= 3, "a cubic changes sign 3 times at most");
+    for (std::size_t i = 0; i < nearRoots.size(); ++i) {
+      camera.filterRootsNear[int(i)] = static_cast<float>(nearRoots[i]);
+    }
+    for (std::size_t i = 0; i < farRoots.size(); ++i) {
+      camera.filterRootsFar[int(i)] = static_cast<float>(farRoots[i]);
+    }
+    auto integral = [](const std::array<double, 4>& q, double lo, double hi) {
+      auto antiderivative = [&](double t) {
+        return t * (q[3] + t * (q[2] / 2.0 + t * (q[1] / 3.0 + t * q[0] / 4.0)));
+      };
+      return antiderivative(hi) - antiderivative(lo);
+    };
+    double absolute = 0.0, signed_ = 0.0;
+    for (int piece = 0; piece < 2; ++piece) {
+      const std::array<double, 4>& q = piece == 0 ? nearCubic : farCubic;
+      std::vector<double> points = piece == 0 ? nearRoots : farRoots;
+      points.insert(points.begin(), piece == 0 ? 0.0 : 1.0);
+      points.push_back(piece == 0 ? 1.0 : 2.0);
+      for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+        const double part = integral(q, points[i], points[i + 1]);
+        absolute += std::abs(part);
+        signed_ += part;
+      }
+    }
+    // Mitchell1D integrates to 1 over [-2, 2] whatever B and C (pbrt-v4's Integral() is
+    // radius^2 / 4): 3 here, half of it times 6.
+    PT_CHECK(signed_ > 0.0, "the Mitchell filter's integral is positive");
+    const double perAxis = absolute / signed_;
+    camera.filterWeight = static_cast<float>(perAxis * perAxis);
+  }
 }
 
 }  // namespace pt

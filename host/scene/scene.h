@@ -2,8 +2,11 @@
 // Knows nothing of BVHs or Vulkan; the BVH builder reorders the triangles later.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,14 +15,39 @@
 
 namespace pt {
 
+// A pixel filter as pbrt-v4 describes it (its filters.h): the type (kFilter*), the radius on
+// each axis in pixels, and gaussian's sigma or mitchell's B and C. The default is the box of
+// one pixel, the renderer's filter before others were added (pbrt-v4's files default to
+// gaussian: its reader says so).
+struct PixelFilterDesc {
+  uint type = kFilterBox;
+  float radiusX = 0.5f;
+  float radiusY = 0.5f;
+  float sigma = 0.5f;     // gaussian
+  float b = 1.0f / 3.0f;  // mitchell
+  float c = 1.0f / 3.0f;
+};
+
 // The camera as the user describes it; makeCamera turns it into the GPU struct.
 struct CameraDesc {
   vec3 position{0.0f, 0.0f, 0.0f};
   vec3 target{0.0f, 0.0f, 1.0f};
   vec3 up{0.0f, 1.0f, 0.0f};
   float vfovDegrees = 45.0f;
-  int width = 256;
+  int width = 256;  // the whole film, which a crop window cuts the image from
   int height = 256;
+  PixelFilterDesc filter;
+  // Thin lens (pbrt-v4's lensradius, focaldistance): 0 is a pinhole.
+  float lensRadius = 0.0f;
+  float focalDistance = 1e6f;  // pbrt-v4's default
+  // The screen window [x0, x1, y0, y1] on the plane at unit distance along the view direction,
+  // in units of tan(vfov / 2); unset: [-width/height, width/height, -1, 1], the field of view.
+  std::optional<std::array<float, 4>> screenWindow;
+  // The part of the film rendered (pbrt-v4's Film "cropwindow" and "pixelbounds"): fractions
+  // [x0, x1, y0, y1] of the film, or pixels [x0, x1) x [y0, y1); the window wins when both are
+  // set. Unset: the whole film.
+  std::optional<std::array<float, 4>> cropWindow;
+  std::optional<std::array<int, 4>> pixelBounds;
 };
 
 // Integrator settings from the scene's "integrator" object (command-line flags override).
@@ -44,12 +72,22 @@ struct Scene {
   // Vertex normals per triangle, parallel to `triangles`, or empty when no mesh has normals
   // (triangles of meshes without them then repeat their geometric normal).
   std::vector<TriangleNormals> normals;
+  // Lights that are not triangles (point, spot, distant, infinite), in world space.
+  std::vector<Light> lights;
   std::vector<std::string> warnings;  // e.g. dropped zero-area triangles, one line each
+};
+
+// How a scene file is read.
+struct SceneLoadOptions {
+  // pbrt-v4 files: what the reader would warn about, something it ignores or renders
+  // otherwise than pbrt-v4, is an InputError instead ("file:line:column: ..."), so that an
+  // image is pbrt-v4's scene or nothing (pt render --strict). JSON scenes have no such warnings.
+  bool strict = false;
 };
 
 // Reads a scene file. Throws InputError with "<file>: <field or line>: <message>" for
 // anything malformed (see docs/scene-format.md). Mesh paths are relative to the JSON file.
-Scene loadScene(const std::filesystem::path& path);
+Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& options = {});
 
 // A material of type `type` (kMaterial*) with the defaults of docs/scene-format.md (pbrt-v4's,
 // for the types taken from pbrt-v4) and no emission. The JSON reader and the MTL mapping both
@@ -79,7 +117,30 @@ inline constexpr std::int64_t kMaxCoatedWalk = 1000;
 // rotate with it.
 std::pair<double, double> cosSinDegrees(double degrees);
 
-// Builds the GPU camera for a film of width x height pixels.
+// Makes room for `size` elements, at least doubling the capacity when it grows, so that
+// appending shape after shape costs amortized linear time (std::vector::reserve would allocate
+// exactly `size`, and the next shape would copy everything again).
+template <typename T>
+void reserveGeometric(std::vector<T>& v, std::size_t size) {
+  if (size > v.capacity()) v.reserve(std::max(size, 2 * v.capacity()));
+}
+
+// Builds the GPU camera for a film of width x height pixels: the image is the crop of it (the
+// whole film without a crop window). Throws InputError when the crop selects no pixel of that
+// film (the readers check the file's own film; --width and --height can make another).
 Camera makeCamera(const CameraDesc& desc, int width, int height);
+
+// The pixels a crop window or pixel bounds select of a width x height film, as pbrt-v4's film
+// computes them: [x0, x1) x [y0, y1], in {x0, x1, y0, y1}; the whole film without either.
+std::array<int, 4> cropPixels(const CameraDesc& desc, int width, int height);
+
+// pbrt-v4's filter of type `type` (kFilter*) with its defaults: radius 0.5 for box, 2 for
+// triangle, 1.5 and sigma 0.5 for gaussian, 2 and B = C = 1/3 for mitchell.
+PixelFilterDesc defaultFilter(uint type);
+
+// The constants of a filter that makeCamera puts in the Camera (filter.h reads them):
+// filterWeight, filterScale, filterB, filterC, filterRootsNear/Far, filterExpX/Y. Throws
+// InputError (naming `where`) for parameters no sampler can follow. Exposed for tests.
+void setFilterConstants(Camera& camera, const PixelFilterDesc& filter, const std::string& where);
 
 }  // namespace pt

@@ -57,6 +57,8 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       scene.emitters.empty() ? std::vector<Emitter>{Emitter{}} : scene.emitters;
   const std::vector<TriangleNormals> normals =
       scene.normals.empty() ? std::vector<TriangleNormals>{TriangleNormals{}} : scene.normals;
+  const std::vector<Light> lights =
+      scene.lights.empty() ? std::vector<Light>{Light{}} : scene.lights;
   const GpuBvh bvh = buildGpuBvh(scene.bvh);
   const std::vector<uint32_t> traversal = gpuTraversalTexels(bvh, scene.bvh.triangles);
   // In PT_BINDING_* order, followed by the accumulation and the counters.
@@ -67,10 +69,11 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       {"material", scene.materials.data(), scene.materials.size() * sizeof(Material), true},
       {"emitter", emitters.data(), emitters.size() * sizeof(Emitter), true},
       {"vertex normal", normals.data(), normals.size() * sizeof(TriangleNormals), true},
+      {"light", lights.data(), lights.size() * sizeof(Light), true},
   };
   static_assert(PT_BINDING_PARAMS == 0 && PT_BINDING_NODES == 1 && PT_BINDING_TRIANGLES == 2 &&
                 PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 && PT_BINDING_NORMALS == 5 &&
-                PT_BINDING_ACCUM == 6 && PT_BINDING_COUNTERS == 7);
+                PT_BINDING_LIGHTS == 6 && PT_BINDING_ACCUM == 7 && PT_BINDING_COUNTERS == 8);
   static_assert(std::size(uploads) + 2 == PT_BINDING_COUNT, "every binding is a buffer");
 
   // Every size is checked before anything is allocated: a scene too large for the device is
@@ -106,14 +109,16 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
        all || fx.mis, all || fx.russianRoulette, all ? kSpecAtRunTime : params.fastIntersection,
        all ? kSpecAtRunTime : params.samplerType, buffers.stackRows, all || fx.conductor,
        all || fx.dielectric, all || fx.thinDielectric, all || fx.diffuseTransmission,
-       all || fx.coatedDiffuse, all || fx.shadingNormals}};
+       all || fx.coatedDiffuse, all || fx.shadingNormals, all || fx.deltaLights,
+       all || fx.environment, all || fx.twoSidedEmitters}};
   static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
                 PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
                 PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
                 PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 &&
                 PT_SPEC_THIN_DIELECTRIC == 11 && PT_SPEC_DIFFUSE_TRANSMISSION == 12 &&
                 PT_SPEC_COATED_DIFFUSE == 13 && PT_SPEC_SHADING_NORMALS == 14 &&
-                PT_SPEC_COUNT == 15);
+                PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
+                PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_COUNT == 18);
   std::vector<vk::SpecializationMapEntry> entries;
   for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));
@@ -123,9 +128,11 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   for (size_t i = 0; i < buffers.bound.size(); ++i) {
     bound.push_back(Binding{&buffers.bound[i], buffers.texels[i]});
   }
-  // The variant without bsdf.h's materials where the scene needs none of them (the same
-  // image: it is the full shader with those effects switched off before compiling).
-  const bool full = all || fx.hasBsdfMaterials() || fx.shadingNormals;
+  // The variant without bsdf.h's materials and the analytic lights where the scene needs none
+  // of them (the same image: it is the full shader with those effects switched off before
+  // compiling).
+  const bool full = all || fx.hasBsdfMaterials() || fx.shadingNormals || fx.deltaLights ||
+                    fx.environment || fx.twoSidedEmitters;
   const std::span<const uint32_t> spirv = options.context.debugPrintf
                                               ? std::span<const uint32_t>(kPathtraceDebugSpv)
                                           : full ? std::span<const uint32_t>(kPathtraceSpv)

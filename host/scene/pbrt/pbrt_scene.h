@@ -16,12 +16,14 @@ namespace pt {
 
 // Reads a pbrt-v4 scene file and the files it includes. Throws InputError
 // "file:line:column: message" for anything malformed; what it reads but does not simulate
-// becomes one warning per kind in Scene::warnings ("file:line: message").
-Scene loadPbrtScene(const std::filesystem::path& path);
+// becomes one warning per kind in Scene::warnings ("file:line: message"), or with
+// options.strict the InputError "file:line:column: message".
+Scene loadPbrtScene(const std::filesystem::path& path, const SceneLoadOptions& options = {});
 
 // The same for `text` given as the content of the file `path` (which need not exist;
 // relative paths in it resolve against its directory).
-Scene loadPbrtSceneText(std::string text, const std::filesystem::path& path);
+Scene loadPbrtSceneText(std::string text, const std::filesystem::path& path,
+                        const SceneLoadOptions& options = {});
 
 namespace pbrt {
 
