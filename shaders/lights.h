@@ -28,6 +28,33 @@ PT_INLINE vec3 sampleUniformSphere(vec2 u) {
   return vec3(r * cs.x, r * cs.y, z);
 }
 
+// The cone a sphere of `radius` about `center` subtends from p (pbrt-v4's Sphere::Sample and
+// PDF): sin^2 of its half-angle and 1 - its cosine, the latter from sin^2 / 2 where the cone is
+// so narrow (below 1.5 degrees) that 1 - cos would cancel. False where p is inside.
+struct SphereCone {
+  bool outside;
+  float sin2ThetaMax;
+  float oneMinusCosThetaMax;
+};
+PT_INLINE SphereCone sphereCone(vec3 center, float radius, vec3 p) {
+  SphereCone cone;
+  vec3 toCenter = center - p;
+  float dc2 = dot(toCenter, toCenter);
+  cone.outside = dc2 > radius * radius;
+  cone.sin2ThetaMax = cone.outside ? radius * radius / dc2 : 1.0f;
+  float cosThetaMax = sqrt(max(0.0f, 1.0f - cone.sin2ThetaMax));
+  cone.oneMinusCosThetaMax =
+      cone.sin2ThetaMax < 0.00068523f ? 0.5f * cone.sin2ThetaMax : 1.0f - cosThetaMax;
+  return cone;
+}
+
+// The density of light sampling's directions towards a sphere light seen from p: uniform over
+// its cone, 1 / (2 pi (1 - cos thetaMax)); 0 from inside (no sample is drawn there).
+PT_INLINE float sphereLightPdf(Light light, vec3 p) {
+  SphereCone cone = sphereCone(light.position, light.radius, p);
+  return cone.outside ? 1.0f / (2.0f * kPi * cone.oneMinusCosThetaMax) : 0.0f;
+}
+
 // A light sample seen from a receiving point.
 struct AnalyticLightSample {
   vec3 wi;      // unit direction from the receiving point towards the light
@@ -44,6 +71,39 @@ PT_INLINE AnalyticLightSample sampleAnalyticLight(Light light, vec3 p, vec2 u, f
   AnalyticLightSample s;
   s.delta = light.type != kLightInfinite;
   s.pdf = 1.0f;
+  if (light.type == kLightSphere) {
+    // A direction uniform in the cone the sphere subtends, and where it meets the sphere
+    // (pbrt-v4's Sphere::Sample: the angle alpha at the centre between the axis and that
+    // point, from theta by the law of sines).
+    s.delta = false;
+    SphereCone cone = sphereCone(light.position, light.radius, p);
+    vec3 toCenter = light.position - p;
+    float dc = sqrt(dot(toCenter, toCenter));
+    float sinThetaMax = sqrt(cone.sin2ThetaMax);
+    float cosTheta = 1.0f - cone.oneMinusCosThetaMax * u.x;
+    float sin2Theta = 1.0f - cosTheta * cosTheta;
+    if (cone.sin2ThetaMax < 0.00068523f) {
+      sin2Theta = cone.sin2ThetaMax * u.x;
+      cosTheta = sqrt(1.0f - sin2Theta);
+    }
+    float cosAlpha = sin2Theta / sinThetaMax +
+                     cosTheta * sqrt(max(0.0f, 1.0f - sin2Theta / (sinThetaMax * sinThetaMax)));
+    float sinAlpha = sqrt(max(0.0f, 1.0f - cosAlpha * cosAlpha));
+    vec2 cs = cosSinTwoPi(u.y);
+    vec3 n = -localToWorld(vec3(sinAlpha * cs.x, sinAlpha * cs.y, cosAlpha), toCenter / dc);
+    vec3 q = light.position + light.radius * n;
+    vec3 toPoint = q - p;
+    s.wi = toPoint / sqrt(dot(toPoint, toPoint));
+    // The shadow ray ends just outside the sphere (the ray offset's distance, as at a
+    // triangle light): the triangles that stand for it lie inside, up to a hair's breadth
+    // from q near their edges.
+    vec3 aq = abs(q);
+    s.target = offsetRayOrigin(q, n, max(aq.x, max(aq.y, aq.z)));
+    s.pdf = 1.0f / (2.0f * kPi * cone.oneMinusCosThetaMax);
+    // From inside, or where rounding leaves no cone: no sample.
+    s.Li = (cone.outside && cone.oneMinusCosThetaMax > 0.0f) ? light.radiance : vec3(0.0f);
+    return s;
+  }
   if (light.type == kLightPoint || light.type == kLightSpot) {
     vec3 toLight = light.position - p;
     float dist2 = dot(toLight, toLight);

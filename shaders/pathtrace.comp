@@ -37,6 +37,7 @@ const bool kShadingNormals = false;
 const bool kDeltaLights = false;
 const bool kEnvironment = false;
 const bool kTwoSidedEmitters = false;
+const bool kSphereLights = false;
 #else
 layout(constant_id = PT_SPEC_CONDUCTOR) const bool kConductor = true;
 layout(constant_id = PT_SPEC_DIELECTRIC) const bool kDielectric = true;
@@ -47,9 +48,10 @@ layout(constant_id = PT_SPEC_SHADING_NORMALS) const bool kShadingNormals = true;
 layout(constant_id = PT_SPEC_DELTA_LIGHTS) const bool kDeltaLights = true;
 layout(constant_id = PT_SPEC_ENVIRONMENT) const bool kEnvironment = true;
 layout(constant_id = PT_SPEC_TWO_SIDED_EMITTERS) const bool kTwoSidedEmitters = true;
+layout(constant_id = PT_SPEC_SPHERE_LIGHTS) const bool kSphereLights = true;
 #endif
 // Some emitter is one of lights.h's (not a triangle).
-const bool kAnalyticLights = kDeltaLights || kEnvironment;
+const bool kAnalyticLights = kDeltaLights || kEnvironment || kSphereLights;
 // Some surface has one of bsdf.h's materials; bsdf.h's switch sees only the types in use.
 const bool kBsdfMaterials =
     kConductor || kDielectric || kThinDielectric || kDiffuseTransmission || kCoatedDiffuse;
@@ -152,8 +154,10 @@ Light loadLight(uint i) {
   uvec4 a = texelFetch(lightTexels, at);
   uvec4 b = texelFetch(lightTexels, at + 1);
   uvec4 c = texelFetch(lightTexels, at + 2);
+  uvec4 d = texelFetch(lightTexels, at + 3);
   return Light(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), uintBitsToFloat(b.w),
-               uintBitsToFloat(c.xyz), uintBitsToFloat(c.w));
+               uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.x), d.y, d.z,
+               d.w);
 }
 #endif
 
@@ -500,7 +504,15 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
       float weight = 1.0;
       if (misOn()) {
         float area = 0.5 * length(edgeCross);
-        float lightPdf = loadEmitter(tri.emitter).pmf * hit.t * hit.t / (cosEmit * area);
+        Emitter emitter = loadEmitter(tri.emitter);
+        float lightPdf = emitter.pmf * hit.t * hit.t / (cosEmit * area);
+#ifndef PT_NO_BSDF_MATERIALS
+        // A sphere light's triangle: light sampling draws its cone (seen from the ray's origin).
+        if (kSphereLights && (emitter.triangle & kEmitterLight) != 0u) {
+          lightPdf = emitter.pmf *
+                     sphereLightPdf(loadLight(emitter.triangle & ~kEmitterLight), path.origin);
+        }
+#endif
         weight = powerHeuristic(path.bsdfPdf, lightPdf);
       }
       path.L += path.beta * weight * Le;

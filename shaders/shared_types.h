@@ -148,7 +148,11 @@ PT_CONST uint kLightPoint = 0u;     // isotropic point: intensity I at position
 PT_CONST uint kLightSpot = 1u;      // point with pbrt-v4's smoothstep falloff about an axis
 PT_CONST uint kLightDistant = 2u;   // parallel light from one direction (radiance L, a delta)
 PT_CONST uint kLightInfinite = 3u;  // constant radiance from every direction (an environment)
-PT_CONST uint kLightTypeCount = 4u;
+// A sphere area light: its surface is triangles of material `material` (emissive, one-sided,
+// outward), which BSDF-sampled rays hit; light sampling takes the cone the exact sphere
+// subtends (pbrt-v4's Sphere::Sample), and those triangles' Emitter is this light's.
+PT_CONST uint kLightSphere = 4u;
+PT_CONST uint kLightTypeCount = 5u;
 PT_CONST uint kEmitterLight = 0x80000000u;
 
 struct Light {
@@ -160,8 +164,12 @@ struct Light {
   vec3 direction;         // 12 bytes: spot: unit axis it shines along; distant: unit
                           //           direction towards the light
   float cosFalloffEnd;    //  4 bytes: spot: dark outside this cosine
-};                        // 48 bytes
-PT_CONST uint kLightTexels = 3u;
+  float radius;           //  4 bytes: sphere: its radius (position: its centre)
+  uint material;          //  4 bytes: sphere: the material of its triangles
+  uint reserved0;         //  4 bytes: zero
+  uint reserved1;         //  4 bytes: zero
+};                        // 64 bytes
+PT_CONST uint kLightTexels = 4u;
 
 // ---- Camera and per-render parameters --------------------------------------------------
 
@@ -284,7 +292,8 @@ struct RenderParams {
 #define PT_SPEC_DELTA_LIGHTS 15        // bool: point, spot or distant lights occur
 #define PT_SPEC_ENVIRONMENT 16         // bool: an infinite light occurs
 #define PT_SPEC_TWO_SIDED_EMITTERS 17  // bool: some emissive triangle emits on both sides
-#define PT_SPEC_COUNT 18
+#define PT_SPEC_SPHERE_LIGHTS 18       // bool: some sphere area light is sampled by solid angle
+#define PT_SPEC_COUNT 19
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever

@@ -7,9 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
+#include "chi2.h"
 #include "cpu/integrator.h"
 #include "lights.h"
 #include "render/prepare.h"
@@ -519,6 +521,175 @@ TEST(AnalyticLights, ImageEnvironmentFallsBackToItsMean) {
   for (const std::string& w : loaded.warnings)
     warned |= w.find("mean radiance") != std::string::npos;
   EXPECT_TRUE(warned);
+}
+
+// Pearson's chi-square test of a light's sampled directions (seen from `p`) against `pdf`
+// (tests/chi2.h, as the BSDF tests use it): a grid focused where pilot samples fall, each
+// cell's expected count the pdf's integral over it.
+template <typename Pdf>
+test::Chi2Result lightChi2(const Light& light, vec3 p, float sceneRadius, const Pdf& pdf,
+                           uint32_t seed, bool isTheSamplersPdf = true) {
+  constexpr int kSamples = 200000;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  const auto draw = [&] {
+    const vec2 u(uniform(rng), uniform(rng));
+    return sampleAnalyticLight(light, p, u, sceneRadius);
+  };
+  std::vector<glm::vec3> pilot;
+  for (int i = 0; i < 2000; ++i) pilot.push_back(draw().wi);
+  const test::SphereGrid grid = test::focusedGrid(pilot, 20, 40);
+  std::vector<double> observed(size_t(grid.cellCount()), 0.0);
+  for (int i = 0; i < kSamples; ++i) {
+    const AnalyticLightSample s = draw();
+    EXPECT_FALSE(s.delta);
+    if (isTheSamplersPdf) {
+      EXPECT_NEAR(double(s.pdf), pdf(s.wi), 1e-4 * pdf(s.wi)) << "the sample's own pdf";
+    }
+    observed[size_t(grid.cellOf(s.wi))] += 1.0;
+  }
+  const double n = kSamples;
+  std::vector<double> expected =
+      grid.integrate(pdf, [n](double q) { return 0.05 * std::sqrt(std::max(q * n, 1.0)) / n; });
+  for (double& e : expected) e *= n;
+  return test::pearsonChi2(observed, expected);
+}
+
+TEST(AnalyticLights, InfiniteLightSamplerPassesChiSquare) {
+  Light sky{};
+  sky.type = kLightInfinite;
+  sky.radiance = vec3(1.0f);
+  const auto uniform = [](vec3) { return 1.0 / (4.0 * kPiD); };
+  const test::Chi2Result good = lightChi2(sky, vec3(0.0f), 1.0f, uniform, 7u);
+  EXPECT_GE(good.pValue, 1e-4) << "chi2 " << good.statistic << ", " << good.dof << " dof";
+  // A density leaning 20 % towards +z is told apart.
+  const auto leaning = [](vec3 w) { return (1.0 + 0.2 * double(w.z)) / (4.0 * kPiD); };
+  const test::Chi2Result bad = lightChi2(sky, vec3(0.0f), 1.0f, leaning, 7u, false);
+  EXPECT_LT(bad.pValue, 1e-4) << "chi2 " << bad.statistic;
+}
+
+// Pearson's chi-square test of a sphere light's sampled directions, seen from p, against the
+// density uniform over the cone of a sphere of `coneRadius` (1 / (2 pi (1 - cos thetaMax))):
+// uniform in (1 - cos theta) / (1 - cos thetaMax) and in the angle about the axis, the
+// variables the histogram takes (a grid over directions would cut the cone's sharp edge into
+// slivers no quadrature resolves).
+test::Chi2Result sphereChi2(const Light& sphere, vec3 p, double coneRadius, uint32_t seed) {
+  constexpr int kSamples = 200000, kRings = 20, kSectors = 20;
+  const glm::dvec3 toCentre = glm::dvec3(sphere.position) - glm::dvec3(p);
+  const glm::dvec3 axis = glm::normalize(toCentre);
+  const glm::dvec3 t = glm::normalize(
+      glm::cross(axis, std::fabs(axis.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
+  const glm::dvec3 b = glm::cross(axis, t);
+  const double sin2 = coneRadius * coneRadius / glm::dot(toCentre, toCentre);
+  const double oneMinusCosMax = sin2 / (1.0 + std::sqrt(1.0 - sin2));  // 1 - cos, no cancelling
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  // One cell more than the grid: samples outside the cone.
+  std::vector<double> observed(size_t(kRings * kSectors) + 1, 0.0);
+  for (int i = 0; i < kSamples; ++i) {
+    const AnalyticLightSample s =
+        sampleAnalyticLight(sphere, p, vec2(uniform(rng), uniform(rng)), 1.0f);
+    const glm::dvec3 w(s.wi);
+    const double sin2Theta = glm::dot(glm::cross(w, axis), glm::cross(w, axis));
+    const double cosTheta = glm::dot(w, axis);
+    const double v = (sin2Theta / (1.0 + cosTheta)) / oneMinusCosMax;
+    double phi = std::atan2(glm::dot(w, b), glm::dot(w, t)) / (2.0 * kPiD);
+    if (phi < 0.0) phi += 1.0;
+    const int ring = int(v * kRings);
+    const int sector = std::min(int(phi * kSectors), kSectors - 1);
+    observed[ring < kRings ? size_t(ring * kSectors + sector) : observed.size() - 1] += 1.0;
+  }
+  std::vector<double> expected(observed.size(), double(kSamples) / (kRings * kSectors));
+  expected.back() = 1e-6;  // nothing outside the cone
+  return test::pearsonChi2(observed, expected);
+}
+
+TEST(AnalyticLights, SphereLightSamplerPassesChiSquare) {
+  // Seen from 3 and from 200 radii away (pbrt-v4's small-angle branch below 1.5 degrees).
+  for (float distance : {3.0f, 200.0f}) {
+    SCOPED_TRACE(distance);
+    Light sphere{};
+    sphere.type = kLightSphere;
+    sphere.position = vec3(0.3f, -0.2f, distance);
+    sphere.radius = 1.0f;
+    sphere.radiance = vec3(1.0f);
+    const vec3 p(0.0f);
+    const test::Chi2Result good = sphereChi2(sphere, p, 1.0, 11u);
+    EXPECT_GE(good.pValue, 1e-4) << "chi2 " << good.statistic << ", " << good.dof << " dof";
+    // The cone of a sphere 2 % larger, or 2 % smaller, is told apart.
+    EXPECT_LT(sphereChi2(sphere, p, 1.02, 11u).pValue, 1e-4);
+    EXPECT_LT(sphereChi2(sphere, p, 0.98, 11u).pValue, 1e-4);
+    // Each sample's own density is the cone's, and its point on the sphere (the shadow ray
+    // ends the ray offset beyond it), on the side facing p.
+    const double dc = double(length(sphere.position));
+    const double sin2 = 1.0 / (dc * dc);
+    const double oneMinusCosMax = sin2 < 0.00068523 ? 0.5 * sin2 : 1.0 - std::sqrt(1.0 - sin2);
+    for (int i = 0; i < 1000; ++i) {
+      const vec2 u((float(i) + 0.5f) / 1000.0f, float((i * 7919) % 1000) / 1000.0f);
+      const AnalyticLightSample ls = sampleAnalyticLight(sphere, p, u, 1.0f);
+      EXPECT_FALSE(ls.delta);
+      EXPECT_NEAR(ls.pdf, 1.0 / (2.0 * kPiD * oneMinusCosMax), 1e-4 * ls.pdf);
+      const vec3 n = normalize(ls.target - sphere.position);
+      EXPECT_NEAR(length(ls.target - sphere.position), 1.0f + dc / 65536.0, 1e-4f);
+      EXPECT_LT(dot(n, ls.wi), 1e-3f);
+      EXPECT_EQ(ls.Li, vec3(1.0f));
+    }
+    // From inside: no sample, density 0.
+    EXPECT_EQ(sampleAnalyticLight(sphere, sphere.position, vec2(0.5f), 1.0f).Li, vec3(0.0f));
+    EXPECT_EQ(sphereLightPdf(sphere, sphere.position), 0.0f);
+  }
+}
+
+TEST(AnalyticLights, SphereLightIrradianceOnAPlane) {
+  // A sphere of radius 0.5 and radiance 5 centred 1.2 above the plane (out of the camera's
+  // view): irradiance
+  // pi L sin^2(thetaMax) cos(theta) where it sees the whole sphere, so the plane shows
+  // albedo * L * sin^2(thetaMax) * cos(theta). The sphere is drawn by solid angle; BSDF-sampled
+  // rays find its 16128 triangles (1 - 2e-4 of its solid angle: the tolerance's floor).
+  const glm::dvec3 centre(4.5, 0.5, 1.2);
+  // 128 samples: MIS mixes in the rarer BSDF-sampled hits, the only noise here.
+  const std::string text = header(24, 128, 1) +
+                           "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [5 5 5]\n"
+                           "Translate 4.5 0.5 1.2\nShape \"sphere\" \"float radius\" 0.5\n"
+                           "AttributeEnd\n" +
+                           kPlane;
+  const SceneData data = prepare(text);
+  ASSERT_EQ(data.lights.size(), 1u);
+  EXPECT_EQ(data.lights[0].type, kLightSphere);
+  EXPECT_EQ(data.emitters.size(), 1u);  // the sphere, not its triangles
+  EXPECT_NE(data.effects.toString().find("sphere-lights"), std::string::npos);
+  expectClosedForm(
+      text,
+      [&](glm::dvec3 x) {
+        const glm::dvec3 d = centre - x;
+        const double dist2 = glm::dot(d, d);
+        const double cosTheta = d.z / std::sqrt(dist2);
+        // (It holds where the whole sphere is above the horizon: everywhere, the sphere's
+        // lowest point being 0.7 above the plane.)
+        return glm::dvec3(0.5 * 5.0 * (0.25 / dist2) * cosTheta);
+      },
+      0.01, 1e-4);
+}
+
+TEST(AnalyticLights, OnlyTrueSpheresAreSampledByTheirCone) {
+  const auto lightsOf = [&](const std::string& shape) {
+    return loadPbrtSceneText(
+               header(8, 1, 1) + "AttributeBegin\n" + shape + "AttributeEnd\n" + kPlane, "s.pbrt")
+        .lights;
+  };
+  const char* sphere = "Shape \"sphere\" \"float radius\" 0.5\n";
+  const std::string light = "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n";
+  // Rotated and uniformly scaled: a sphere of radius 0.5 x 3 about the moved centre.
+  const auto scaled = lightsOf(light + "Translate 1 2 3\nRotate 30 1 1 0\nScale 3 3 3\n" + sphere);
+  ASSERT_EQ(scaled.size(), 1u);
+  EXPECT_NEAR(scaled[0].radius, 1.5f, 1e-6f);
+  EXPECT_NEAR(distance(scaled[0].position, vec3(1, 2, 3)), 0.0f, 1e-6f);
+  // An ellipsoid, a two-sided or an inward light, a sphere without light: triangles only.
+  EXPECT_TRUE(lightsOf(light + "Scale 1 2 1\n" + sphere).empty());
+  EXPECT_TRUE(lightsOf("AreaLightSource \"diffuse\" \"bool twosided\" true\n" + std::string(sphere))
+                  .empty());
+  EXPECT_TRUE(lightsOf(light + "ReverseOrientation\n" + sphere).empty());
+  EXPECT_TRUE(lightsOf(sphere).empty());
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 
 #include "common/check.h"
 #include "cpu/integrator.h"
+#include "image/image.h"
 #include "render/prepare.h"
 #include "scene/pbrt/pbrt_scene.h"
 #include "scene/pbrt/spectra.h"
@@ -409,40 +410,50 @@ TEST(PbrtMaterials, EachTypeWithPbrtV4sParameterNames) {
 }
 
 TEST(PbrtMaterials, NamedMaterialsTexturesAttributesAndMix) {
+  const test::TempDir dir;
+  Image image(2, 1);  // mean (0.3, 0.5, 0.7)
+  image.pixels = {vec3(0.2f, 0.4f, 0.6f), vec3(0.4f, 0.6f, 0.8f)};
+  writeImage(image, dir / "a.pfm");
   const Scene scene = load(
       std::string(kUnmirrored) +
-      "Texture \"grey\" \"spectrum\" \"constant\" \"rgb value\" [0.3 0.3 0.3]\n"
-      "Texture \"rough\" \"float\" \"constant\" \"float value\" 0.09\n"
-      "Texture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"a.png\"\n"
-      "NamedMaterial \"late\"\n" +
-      kTriangle +  // defined below: resolved at the end
-      "MakeNamedMaterial \"late\" \"string type\" \"diffuse\" \"texture reflectance\" \"grey\"\n"
-      "MakeNamedMaterial \"metal\" \"string type\" \"conductor\" \"texture roughness\" \"rough\"\n"
-      "MakeNamedMaterial \"pic\" \"string type\" \"diffuse\" \"texture reflectance\" \"img\"\n"
-      "MakeNamedMaterial \"both\" \"string type\" \"mix\" \"string materials\" [\"late\" "
-      "\"metal\"] \"float amount\" 0.8\n"
-      "AttributeBegin\nAttribute \"material\" \"rgb reflectance\" [0.7 0.7 0.7]\n"
-      "Material \"diffuse\"\n" +
-      kTriangle +
-      "AttributeEnd\n"
-      "NamedMaterial \"metal\"\n" +
-      kTriangle + "NamedMaterial \"pic\"\n" + kTriangle + "NamedMaterial \"both\"\n" + kTriangle +
-      "NamedMaterial \"late\"\n" + kTriangle);
+          "Texture \"grey\" \"spectrum\" \"constant\" \"rgb value\" [0.3 0.3 0.3]\n"
+          "Texture \"rough\" \"float\" \"constant\" \"float value\" 0.09\n"
+          "Texture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"a.pfm\"\n"
+          "NamedMaterial \"late\"\n" +
+          kTriangle +  // defined below: resolved at the end
+          "MakeNamedMaterial \"late\" \"string type\" \"diffuse\" \"texture reflectance\" "
+          "\"grey\"\n"
+          "MakeNamedMaterial \"metal\" \"string type\" \"conductor\" \"texture roughness\" "
+          "\"rough\"\n"
+          "MakeNamedMaterial \"pic\" \"string type\" \"diffuse\" \"texture reflectance\" \"img\"\n"
+          "MakeNamedMaterial \"both\" \"string type\" \"mix\" \"string materials\" [\"late\" "
+          "\"metal\"] \"float amount\" 0.8\n"
+          "AttributeBegin\nAttribute \"material\" \"rgb reflectance\" [0.7 0.7 0.7]\n"
+          "Material \"diffuse\"\n" +
+          kTriangle +
+          "AttributeEnd\n"
+          "NamedMaterial \"metal\"\n" +
+          kTriangle + "NamedMaterial \"pic\"\n" + kTriangle + "NamedMaterial \"both\"\n" +
+          kTriangle + "NamedMaterial \"late\"\n" + kTriangle,
+      dir / "scene.pbrt");
   ASSERT_EQ(scene.triangles.size(), 6u);
   auto material = [&](int i) { return scene.materials[scene.triangles[i].material]; };
   EXPECT_EQ(material(0).reflectance, vec3(0.3f));
   EXPECT_EQ(material(1).reflectance, vec3(0.7f));  // from the Attribute
   EXPECT_EQ(material(2).type, kMaterialConductor);
   EXPECT_EQ(material(2).alphaX, 0.3f);
-  EXPECT_EQ(material(3).reflectance, vec3(0.5f));   // an image texture: the default, warned
+  // An image texture: its mean texel, warned (until textures exist).
+  EXPECT_NEAR(material(3).reflectance.x, 0.3f, 1e-6f);
+  EXPECT_NEAR(material(3).reflectance.y, 0.5f, 1e-6f);
+  EXPECT_NEAR(material(3).reflectance.z, 0.7f, 1e-6f);
   EXPECT_EQ(material(4).type, kMaterialConductor);  // amount 0.8: the second, mostly
   EXPECT_EQ(scene.triangles[5].material, scene.triangles[0].material);  // one slot per name
   EXPECT_EQ(scene.materials.size(), 5u);  // "both" shares metal's definition but not its slot
   EXPECT_EQ(scene.materialNames[scene.triangles[0].material], "late");
   std::string joined;
   for (const std::string& w : scene.warnings) joined += w + "\n";
-  EXPECT_NE(joined.find("scene.pbrt:13: textures of class 'imagemap' are not supported yet: "
-                        "parameters that use one (here 'reflectance') take their default value"),
+  EXPECT_NE(joined.find("scene.pbrt:13: textures of class 'imagemap' are not simulated yet: "
+                        "parameters that use one take its mean value (an image's mean texel)"),
             std::string::npos)
       << joined;
   EXPECT_NE(joined.find("Material \"mix\" is rendered as the one of its two materials"),
@@ -937,6 +948,51 @@ TEST(PbrtCameraFilm, StrictMakesEveryWarningAnError) {
   }
   // Configs/cornell-box.pbrt has nothing to warn about.
   EXPECT_NO_THROW(loadScene(test::kConfigs / "cornell-box.pbrt", SceneLoadOptions{.strict = true}));
+}
+
+TEST(PbrtMaterials, TexturesStandInByTheirMeans) {
+  // Until textures exist (issue 25) a texture is its mean over the (u, v) square.
+  const test::TempDir dir;
+  Image image(2, 2);  // mean 0.25 in every channel
+  image.pixels = {vec3(0.0f), vec3(0.5f), vec3(0.25f), vec3(0.25f)};
+  writeImage(image, dir / "g.pfm");
+  dir.write("photo.jpg", "not read yet");
+  const auto reflectance = [&](const std::string& textures) {
+    const Scene scene = load(std::string(kUnmirrored) + textures +
+                                 "Material \"diffuse\" \"texture reflectance\" \"t\"\n" + kTriangle,
+                             dir / "scene.pbrt");
+    return scene.materials[scene.triangles[0].material].reflectance;
+  };
+  // A checkerboard: each texture covers half.
+  EXPECT_EQ(reflectance("Texture \"t\" \"spectrum\" \"checkerboard\" \"rgb tex1\" [0.2 0.4 0.6] "
+                        "\"rgb tex2\" [0.6 0.4 0.2]\n"),
+            vec3(0.4f));
+  // scale x an image, nested; mix by a constant amount; invert.
+  EXPECT_NEAR(reflectance("Texture \"g\" \"spectrum\" \"imagemap\" \"string filename\" \"g.pfm\"\n"
+                          "Texture \"t\" \"spectrum\" \"scale\" \"texture tex\" \"g\" "
+                          "\"float scale\" 2\n")
+                  .x,
+              0.5f, 1e-6f);
+  EXPECT_NEAR(
+      reflectance("Texture \"t\" \"spectrum\" \"mix\" \"rgb tex1\" [0 0 0] \"rgb tex2\" [1 1 1] "
+                  "\"float amount\" 0.25\n")
+          .y,
+      0.25f, 1e-6f);
+  EXPECT_NEAR(reflectance("Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"g.pfm\" "
+                          "\"bool invert\" true\n")
+                  .z,
+              0.75f, 1e-6f);
+  // An image format not read yet: the parameter's default, warned.
+  EXPECT_EQ(
+      reflectance("Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"photo.jpg\"\n"),
+      vec3(0.5f));
+  // A missing image is an error naming it, as in pbrt-v4.
+  try {
+    reflectance("Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"none.pfm\"\n");
+    ADD_FAILURE() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("none.pfm"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

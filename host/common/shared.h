@@ -64,7 +64,8 @@ static_assert(offsetof(RenderParams, sceneRadius) == kParamsBase + 44);
 static_assert(offsetof(RenderParams, environment) == kParamsBase + 48);
 static_assert(offsetof(RenderParams, sceneCenter) == kParamsBase + 64);
 
-static_assert(sizeof(Light) == 48 && sizeof(Light) == 16 * kLightTexels);
+static_assert(sizeof(Light) == 64 && sizeof(Light) == 16 * kLightTexels);
+static_assert(offsetof(Light, radius) == 48 && offsetof(Light, material) == 52);
 static_assert(offsetof(Light, type) == 12 && offsetof(Light, radiance) == 16);
 static_assert(offsetof(Light, cosFalloffStart) == 28 && offsetof(Light, direction) == 32);
 static_assert(offsetof(Light, cosFalloffEnd) == 44);

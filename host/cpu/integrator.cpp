@@ -349,8 +349,14 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
         // Weigh against the chance that light sampling had produced this point.
         float weight = 1.0f;
         if (misOn) {
-          const float lightPdf = scene.emitters[tri.emitter].pmf * hit->t * hit->t /
-                                 (cosEmit * shading.area);  // |direction| = 1: t is the distance
+          const Emitter& emitter = scene.emitters[tri.emitter];
+          // A sphere light's triangle: light sampling draws its cone (seen from the ray's
+          // origin); any other: a uniform point on the triangle.
+          const float lightPdf =
+              (emitter.triangle & kEmitterLight) != 0u
+                  ? emitter.pmf * sphereLightPdf(*analyticLight(scene, emitter), ray.origin)
+                  : emitter.pmf * hit->t * hit->t /
+                        (cosEmit * shading.area);  // |direction| = 1: t is the distance
           weight = powerHeuristic(bsdfPdf, lightPdf);
         }
         L += beta * weight * Le;

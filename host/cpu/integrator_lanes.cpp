@@ -727,9 +727,11 @@ HWY_EXPORT(sampleRadianceLanesImpl);
 void sampleRadianceLanes(const SceneData& scene, const uvec2* pixels, size_t count,
                          uint32_t sampleIndex, vec3* out, uint64_t& rays) {
   // The lanes shade about the geometric normal only and sample one-sided emissive triangles
-  // (and lights.h's lights) only; a scene with shading normals or two-sided lights takes the
-  // reference path by path (the same results by definition).
-  if (scene.effects.shadingNormals || scene.effects.twoSidedEmitters) {
+  // (and lights.h's point, spot, distant and infinite lights) only; a scene with shading
+  // normals, two-sided or sphere lights takes the reference path by path (the same results by
+  // definition).
+  if (scene.effects.shadingNormals || scene.effects.twoSidedEmitters ||
+      scene.effects.sphereLights) {
     for (size_t i = 0; i < count; ++i) out[i] = sampleRadiance(scene, pixels[i], sampleIndex, rays);
     return;
   }

@@ -46,6 +46,7 @@ std::string EffectSet::toString() const {
   add(deltaLights, "delta-lights");
   add(environment, "environment");
   add(twoSidedEmitters, "two-sided-emitters");
+  add(sphereLights, "sphere-lights");
   add(lightSampling, "nee");
   add(mis, "mis");
   add(russianRoulette, "rr");
@@ -72,6 +73,8 @@ double lightPowerOverPi(const Light& light, double sceneRadius) {
       return 2.0 * y * (1.0 - 0.5 * (double(light.cosFalloffStart) + double(light.cosFalloffEnd)));
     case kLightDistant:
       return y * sceneRadius * sceneRadius;
+    case kLightSphere:
+      return 4.0 * pi * double(light.radius) * double(light.radius) * y;
     default:
       return 4.0 * pi * y * sceneRadius * sceneRadius;
   }
@@ -91,9 +94,17 @@ std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
   // needs proportions, and luminance weights the channels.
   std::vector<Emitter> emitters;
   std::vector<double> power;
+  // The triangles of a sphere light are not emitters of their own: its Emitter is theirs.
+  std::vector<uint32_t> sphereOf(materials.size(), kNoEmitter);
+  for (uint32_t i = 0; i < lights.size(); ++i) {
+    if (lights[i].type == kLightSphere && lights[i].material < materials.size()) {
+      sphereOf[lights[i].material] = i;
+    }
+  }
   for (uint32_t i = 0; i < triangles.size(); ++i) {
     Triangle& tri = triangles[i];
     tri.emitter = kNoEmitter;
+    if (sphereOf[tri.material] != kNoEmitter) continue;
     const vec3 e = materials[tri.material].emission;
     const double luminance = 0.2126 * e.x + 0.7152 * e.y + 0.0722 * e.z;
     const double area = 0.5 * double(length(cross(tri.v1 - tri.v0, tri.v2 - tri.v0)));
@@ -112,6 +123,11 @@ std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
   for (uint32_t i = 0; i < lights.size(); ++i) {
     const double phi = lightPowerOverPi(lights[i], sceneRadius);
     if (!(phi > 0.0)) continue;  // a black light, or a distant one in an empty scene
+    if (lights[i].type == kLightSphere) {
+      for (Triangle& tri : triangles) {
+        if (tri.material == lights[i].material) tri.emitter = uint32_t(emitters.size());
+      }
+    }
     emitters.push_back(Emitter{kEmitterLight | i, 0.0f, 1.0f, uint32_t(emitters.size())});
     power.push_back(phi);
     unbounded.push_back(lights[i].type == kLightDistant || lights[i].type == kLightInfinite);
@@ -251,6 +267,8 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     if (light.type == kLightInfinite) {
       p.environmentEmitter = i;
       p.environment = light.radiance;
+    } else if (light.type == kLightSphere) {
+      data.effects.sphereLights = true;
     } else {
       data.effects.deltaLights = true;
     }
@@ -284,7 +302,7 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   fx.lightSampling = (fx.diffuse || lightSampled) && scatters && !data.emitters.empty() &&
                      p.strategy != kStrategyBsdf;
   // Emission found by BSDF-sampled rays: some triangle or the environment emits.
-  bool hittable = fx.environment;
+  bool hittable = fx.environment || fx.sphereLights;
   for (const Emitter& e : data.emitters) {
     if ((e.triangle & kEmitterLight) != 0u) continue;
     hittable = true;

@@ -63,6 +63,7 @@ struct EffectSet {
   bool deltaLights = false;       // point, spot or distant lights (sampled, never hit)
   bool environment = false;       // an infinite light: rays that leave the scene see it
   bool twoSidedEmitters = false;  // some emissive triangle emits on both sides
+  bool sphereLights = false;      // sphere area lights, sampled by the cone they subtend
   bool lightSampling = false;     // next-event estimation (needs emitters, a diffuse surface)
   bool bsdfEmission = false;      // emission found by BSDF-sampled rays is counted (MIS/BSDF)
   bool mis = false;               // both of the above, weighed by the power heuristic

@@ -110,15 +110,15 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
        all ? kSpecAtRunTime : params.samplerType, buffers.stackRows, all || fx.conductor,
        all || fx.dielectric, all || fx.thinDielectric, all || fx.diffuseTransmission,
        all || fx.coatedDiffuse, all || fx.shadingNormals, all || fx.deltaLights,
-       all || fx.environment, all || fx.twoSidedEmitters}};
-  static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
-                PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
-                PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
-                PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 &&
-                PT_SPEC_THIN_DIELECTRIC == 11 && PT_SPEC_DIFFUSE_TRANSMISSION == 12 &&
-                PT_SPEC_COATED_DIFFUSE == 13 && PT_SPEC_SHADING_NORMALS == 14 &&
-                PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
-                PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_COUNT == 18);
+       all || fx.environment, all || fx.twoSidedEmitters, all || fx.sphereLights}};
+  static_assert(
+      PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
+      PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
+      PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
+      PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 && PT_SPEC_THIN_DIELECTRIC == 11 &&
+      PT_SPEC_DIFFUSE_TRANSMISSION == 12 && PT_SPEC_COATED_DIFFUSE == 13 &&
+      PT_SPEC_SHADING_NORMALS == 14 && PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
+      PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_SPHERE_LIGHTS == 18 && PT_SPEC_COUNT == 19);
   std::vector<vk::SpecializationMapEntry> entries;
   for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));
@@ -132,7 +132,7 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   // of them (the same image: it is the full shader with those effects switched off before
   // compiling).
   const bool full = all || fx.hasBsdfMaterials() || fx.shadingNormals || fx.deltaLights ||
-                    fx.environment || fx.twoSidedEmitters;
+                    fx.environment || fx.twoSidedEmitters || fx.sphereLights;
   const std::span<const uint32_t> spirv = options.context.debugPrintf
                                               ? std::span<const uint32_t>(kPathtraceDebugSpv)
                                           : full ? std::span<const uint32_t>(kPathtraceSpv)

@@ -485,6 +485,11 @@ class Builder {
                                bool allowFloat = false);
   vec3 spectrumValue(const Params& p, const Param& q, Use use, int depth = 0);
   std::optional<double> floatOrTexture(const Params& p, std::string_view name);
+  // The mean value of a texture over its (u, v) square, standing in for it until textures
+  // exist (issue 25); nullopt where it cannot be told (the parameter keeps its default).
+  std::optional<vec3> textureMean(const Texture& t, bool isFloat, const Location& use, int depth);
+  std::optional<vec3> textureParamMean(const Texture& t, const char* name, bool isFloat,
+                                       vec3 fallback, int depth);
   void readRoughness(const Params& p, Material& m, const std::string& prefix = "");
 
   uint slotFor(const MaterialRef& ref);
@@ -498,6 +503,9 @@ class Builder {
   Scene scene_;
   std::set<std::string> warned_;
   // Zero-area triangles dropped so far, in how many shapes, and where the first was.
+  // Sphere area lights (their Light, with the material slot of their triangles), sampled by the
+  // cone they subtend once the slots are materials (finish).
+  std::vector<std::pair<Light, uint>> sphereLights_;
   std::size_t droppedTriangles_ = 0;
   std::size_t droppedShapes_ = 0;
   std::string firstDrop_;
@@ -1239,20 +1247,149 @@ std::optional<double> Builder::floatOrTexture(const Params& p, std::string_view 
     fail(q->location,
          "unknown float texture " + singleQuoted(q->strings[0]) + " for " + singleQuoted(q->name));
   }
-  const Texture& t = it->second;
-  if (t.className == "constant") {
+  if (auto mean = textureMean(it->second, /*isFloat=*/true, q->location, 0)) return (*mean).x;
+  return std::nullopt;
+}
+
+// What each texture class averages to over the (u, v) square: a constant its value, an image
+// its mean texel (decoded as pbrt-v4 decodes it, then scaled and inverted as it says), a
+// checkerboard the mean of its two textures (each covers half), scale the product, mix and
+// bilerp the mix of the means (exact for a constant amount). Anything else keeps the
+// parameter's default. One warning per class says what stood in.
+std::optional<vec3> Builder::textureMean(const Texture& t, bool isFloat, const Location& use,
+                                         int depth) {
+  const std::string& c = t.className;
+  std::optional<vec3> mean;
+  if (c == "constant") {
+    return textureParamMean(t, "value", isFloat, vec3(1.0f), depth);
+  } else if (c == "scale") {
+    const auto a = textureParamMean(t, "tex", isFloat, vec3(1.0f), depth);
+    const auto b = textureParamMean(t, "scale", true, vec3(1.0f), depth);
+    if (a && b) mean = *a * (*b).x;
+  } else if (c == "mix") {
+    const auto a = textureParamMean(t, "tex1", isFloat, vec3(0.0f), depth);
+    const auto b = textureParamMean(t, "tex2", isFloat, vec3(1.0f), depth);
+    const auto amount = textureParamMean(t, "amount", true, vec3(0.5f), depth);
+    if (a && b && amount) mean = *a + ((*b) - (*a)) * (*amount).x;
+  } else if (c == "checkerboard") {
+    const auto a = textureParamMean(t, "tex1", isFloat, vec3(1.0f), depth);
+    const auto b = textureParamMean(t, "tex2", isFloat, vec3(0.0f), depth);
+    if (a && b) mean = 0.5f * (*a + *b);
+  } else if (c == "bilerp") {
+    vec3 sum(0.0f);
+    bool all = true;
+    for (const char* corner : {"v00", "v01", "v10", "v11"}) {
+      const vec3 fallback(corner[1] == corner[2] ? 0.0f : 1.0f);  // pbrt-v4: 0, 1, 1, 0
+      const auto v = textureParamMean(t, corner, isFloat, fallback, depth);
+      if (v)
+        sum += *v;
+      else
+        all = false;
+    }
+    if (all) mean = 0.25f * sum;
+  } else if (c == "imagemap") {
+    std::string file;
+    Location at = t.location;
     for (auto v = t.params.rbegin(); v != t.params.rend(); ++v) {
-      if (v->name == "value" && v->type == ParamType::kFloat && v->numbers.size() == 1) {
-        return v->numbers[0];
+      if (v->name == "filename" && v->type == ParamType::kString && !v->strings.empty()) {
+        file = v->strings[0];
+        at = v->location;
+        v->used = true;
+        break;
       }
     }
-    return 1.0;  // pbrt-v4's constant texture's default value
+    if (file.empty()) fail(t.location, "Texture \"imagemap\" without a \"filename\"");
+    const fs::path path = resolvePath(file, at, mainFile_);
+    Image image;
+    bool readable = true;
+    try {
+      imageFormatOf(path);
+    } catch (const InputError&) {
+      readable = false;  // JPEG, TGA, ...: not read yet
+    }
+    if (readable) {
+      try {
+        image = readImage(path);
+      } catch (const InputError& e) {
+        fail(at, std::string("Texture \"imagemap\": ") + e.what());
+      }
+      // PNG is decoded from sRGB (pbrt-v4's default for 8-bit images); "linear" or "gamma g"
+      // take the stored numbers instead. Float images are linear whatever it says.
+      std::string encoding = "sRGB";
+      for (auto v = t.params.rbegin(); v != t.params.rend(); ++v) {
+        if (v->name == "encoding" && v->type == ParamType::kString && !v->strings.empty()) {
+          encoding = v->strings[0];
+          v->used = true;
+          break;
+        }
+      }
+      const bool png = imageFormatOf(path) == ImageFormat::kPng;
+      double gamma = 0.0;  // 0: the decoded values as they are
+      if (png && encoding == "linear") gamma = 1.0;
+      if (png && encoding.rfind("gamma ", 0) == 0) gamma = std::atof(encoding.c_str() + 6);
+      glm::dvec3 sum(0.0);
+      for (const vec3& px : image.pixels) {
+        glm::dvec3 v(px);
+        if (gamma > 0.0) {
+          for (int k = 0; k < 3; ++k) v[k] = std::pow(double(linearToSrgb(px[k])), gamma);
+        }
+        sum += v;
+      }
+      vec3 m = image.pixels.empty() ? vec3(0.0f) : vec3(sum / double(image.pixels.size()));
+      if (isFloat) m = vec3((m.x + m.y + m.z) / 3.0f);
+      const auto scale = textureParamMean(t, "scale", true, vec3(1.0f), depth);
+      if (scale) m *= (*scale).x;
+      bool invert = false;
+      for (auto v = t.params.rbegin(); v != t.params.rend(); ++v) {
+        if (v->name == "invert" && v->type == ParamType::kBool && !v->bools.empty()) {
+          invert = v->bools[0];
+          v->used = true;
+          break;
+        }
+      }
+      if (invert) m = max(vec3(0.0f), vec3(1.0f) - m);
+      mean = m;
+    }
   }
-  warnOnce("texture " + t.className, q->location,
-           "textures of class " + singleQuoted(t.className) +
-               " are not supported yet: parameters that use one (here " + singleQuoted(q->name) +
-               ") take their default value");
-  return std::nullopt;
+  warnOnce("texture " + c, use,
+           "textures of class " + singleQuoted(c) + " are not simulated yet: " +
+               (mean ? std::string("parameters that use one take its mean value") +
+                           (c == "imagemap" ? " (an image's mean texel)" : "")
+                     : std::string("parameters that use one keep their default value")));
+  return mean;
+}
+
+// A parameter of texture t as its mean: a number or colour as it is, a texture by textureMean;
+// `fallback` (pbrt-v4's default) when t does not give it.
+std::optional<vec3> Builder::textureParamMean(const Texture& t, const char* name, bool isFloat,
+                                              vec3 fallback, int depth) {
+  for (auto v = t.params.rbegin(); v != t.params.rend(); ++v) {
+    if (v->name != name) continue;
+    v->used = true;
+    if (v->type == ParamType::kTexture && !v->strings.empty()) {
+      if (depth > 16) fail(v->location, "textures nested more than 16 deep (a cycle?)");
+      auto& table = isFloat ? floatTextures_ : spectrumTextures_;
+      auto it = table.find(v->strings[0]);
+      if (it == table.end()) {
+        fail(v->location, "unknown " + std::string(isFloat ? "float" : "spectrum") + " texture " +
+                              singleQuoted(v->strings[0]));
+      }
+      return textureMean(it->second, isFloat, v->location, depth + 1);
+    }
+    if (v->type == ParamType::kFloat && v->numbers.size() == 1) {
+      return vec3(static_cast<float>(v->numbers[0]));
+    }
+    if (!isFloat && (v->type == ParamType::kRgb || v->type == ParamType::kSpectrum ||
+                     v->type == ParamType::kBlackbody)) {
+      Statement texture;
+      texture.directive = "Texture";
+      texture.location = t.location;
+      texture.params = t.params;
+      return spectrumValue(Params(*this, texture, nullptr, "Texture"), *v, Use::kUnbounded);
+    }
+    return fallback;
+  }
+  return fallback;
 }
 
 std::optional<vec3> Builder::spectrum(const Params& p, std::string_view name, Use use,
@@ -1270,21 +1407,9 @@ std::optional<vec3> Builder::spectrum(const Params& p, std::string_view name, Us
       fail(q->location, "unknown spectrum texture " + singleQuoted(q->strings[0]) + " for " +
                             singleQuoted(q->name));
     }
-    const Texture& t = it->second;
-    if (t.className == "constant") {
-      for (auto v = t.params.rbegin(); v != t.params.rend(); ++v) {
-        if (v->name == "value" && v->type != ParamType::kTexture) {
-          v->used = true;
-          return spectrumValue(p, *v, use);
-        }
-      }
-      return vec3(1.0f);  // pbrt-v4's constant texture's default value
-    }
-    warnOnce("texture " + t.className, q->location,
-             "textures of class " + singleQuoted(t.className) +
-                 " are not supported yet: parameters that use one (here " + singleQuoted(q->name) +
-                 ") take their default value");
-    return std::nullopt;
+    std::optional<vec3> mean = textureMean(it->second, /*isFloat=*/false, q->location, 0);
+    if (mean && use == Use::kAlbedo) mean = clamp(*mean, vec3(0.0f), vec3(1.0f));
+    return mean;
   }
   return spectrumValue(p, *q, use);
 }
@@ -1736,6 +1861,25 @@ void Builder::shape(Statement& s) {
     slot = static_cast<uint>(slots_.size());
     slots_.push_back(Slot{gs_.material, vec3(emission),
                           "AreaLightSource at " + light.location.fileLine(), light.twoSided});
+    // A sphere that stays a sphere (a rotation and a uniform scale, no mirror) and emits
+    // outwards on one side: light sampling takes the cone it subtends, as pbrt-v4's does.
+    const glm::dmat3 m(gs_.ctm.m);
+    const double size = glm::length(m[0]);
+    bool similar = glm::determinant(m) > 0.0 && size > 0.0;
+    for (int a = 0; a < 3 && similar; ++a) {
+      similar = std::fabs(glm::length(m[a]) - size) <= 1e-6 * size &&
+                std::fabs(glm::dot(m[a], m[(a + 1) % 3])) <= 1e-6 * size * size;
+    }
+    if (type == "sphere" && similar && !light.twoSided && !gs_.reverseOrientation) {
+      Light sphere{};
+      sphere.type = kLightSphere;
+      glm::dvec3 centre = transformPoint(gs_.ctm.m, glm::dvec3(0.0));
+      if (mirrored_) centre.x = -centre.x;
+      sphere.position = vec3(centre);
+      sphere.radius = static_cast<float>(p.number("radius").value_or(1.0) * size);
+      sphere.radiance = vec3(emission);
+      sphereLights_.emplace_back(sphere, slot);
+    }
   } else {
     slot = slotFor(gs_.material);
   }
@@ -2090,6 +2234,11 @@ Scene Builder::finish(const Location& end) {
     scene_.materialNames.push_back(names[i]);
   }
   for (Triangle& t : scene_.triangles) t.material = remap[t.material];
+  for (auto& [sphere, slot] : sphereLights_) {
+    if (!used[slot]) continue;  // all its triangles dropped
+    sphere.material = remap[slot];
+    scene_.lights.push_back(sphere);
+  }
   if (scene_.triangles.empty()) {
     fail(end, "the scene has no triangles to render" +
                   (skippedShapes_ > 0
