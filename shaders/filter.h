@@ -31,6 +31,9 @@
 #ifndef PT_FILTER_LOOP_TICK
 #define PT_FILTER_LOOP_TICK()
 #endif
+// Defined by a shader variant for box filters and pinholes only (pathtrace.comp's base
+// variant, which the host picks for such cameras): the other filters and the lens are left
+// out, which lavapipe would otherwise compile for every scene.
 
 #ifdef __cplusplus
 namespace pt {
@@ -229,6 +232,7 @@ PT_INLINE FilmSample sampleFilm(Camera cam, vec2 u) {
   FilmSample s;
   s.point = sampleBoxFilter(u, radius);
   s.weight = 1.0f;
+#ifndef PT_FILTER_BOX_PINHOLE
   if (cam.filterType == kFilterTriangle) {
     s.point = vec2(0.5f + sampleTent(u.x, radius.x), 0.5f + sampleTent(u.y, radius.y));
   }
@@ -269,6 +273,7 @@ PT_INLINE FilmSample sampleFilm(Camera cam, vec2 u) {
     s.point = 0.5f + t * (0.5f * radius);  // x = t r / 2
     s.weight = cam.filterWeight * mitchellSign(cam, t.x) * mitchellSign(cam, t.y);
   }
+#endif
   return s;
 }
 
@@ -308,12 +313,14 @@ PT_INLINE CameraSample generateCameraRay(Camera cam, uvec2 filmPixel, vec2 uFilt
   s.origin = cam.position;
   s.direction = normalize(w);
   s.weight = film.weight;
+#ifndef PT_FILTER_BOX_PINHOLE
   if (cam.lensRadius > 0.0f) {
     vec2 lens = cam.lensRadius * sampleConcentricDisk(uLens);
     vec3 offset = lens.x * cam.right + lens.y * cam.up;
     s.origin = cam.position + offset;
     s.direction = normalize(cam.focalDistance * w - offset);
   }
+#endif
   return s;
 }
 

@@ -113,6 +113,9 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 #include "bvh.glsl"
 // The camera's samples (pixel filter, thin lens), the bisection loops counted.
 #define PT_FILTER_LOOP_TICK() gLoopIterations++
+#ifdef PT_NO_BSDF_MATERIALS
+#define PT_FILTER_BOX_PINHOLE
+#endif
 #include "filter.h"
 
 // The rows beyond the first two only where a scene has bsdf.h's materials.

@@ -128,11 +128,13 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   for (size_t i = 0; i < buffers.bound.size(); ++i) {
     bound.push_back(Binding{&buffers.bound[i], buffers.texels[i]});
   }
-  // The variant without bsdf.h's materials and the analytic lights where the scene needs none
-  // of them (the same image: it is the full shader with those effects switched off before
-  // compiling).
+  // The variant without bsdf.h's materials, the analytic lights, the pixel filters other than
+  // the box and the thin lens where the scene needs none of them (the same image: it is the
+  // full shader with those switched off before compiling).
+  const Camera& camera = scene.params.camera;
   const bool full = all || fx.hasBsdfMaterials() || fx.shadingNormals || fx.deltaLights ||
-                    fx.environment || fx.twoSidedEmitters || fx.sphereLights;
+                    fx.environment || fx.twoSidedEmitters || fx.sphereLights ||
+                    camera.filterType != kFilterBox || camera.lensRadius > 0.0f;
   const std::span<const uint32_t> spirv = options.context.debugPrintf
                                               ? std::span<const uint32_t>(kPathtraceDebugSpv)
                                           : full ? std::span<const uint32_t>(kPathtraceSpv)
