@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,14 @@ std::vector<Case> cases() {
     s.strategy = strategy;
     list.push_back({"sun-and-sky.json", s});
   }
+  // Vertex normals (shading normals) on diffuse and conductor surfaces, with each strategy.
+  const std::string normals =
+      (std::filesystem::path(PT_SOURCE_DIR) / "tests/data/lanes-shading-normals.pbrt").string();
+  for (uint strategy : {kStrategyMis, kStrategyNee, kStrategyBsdf}) {
+    RenderSettings s = small;
+    s.strategy = strategy;
+    list.push_back({normals, s});
+  }
   auto variant = [&](auto&& change) {
     RenderSettings s = small;
     change(s);
@@ -63,6 +72,9 @@ TEST(CpuLanes, EqualsTheReferenceBitForBit) {
   for (const Case& c : cases()) {
     SCOPED_TRACE(c.config);
     const SceneData data = prepareScene(loadScene(kConfigs / c.config), c.settings);
+    if (c.config.find("shading-normals") != std::string::npos) {
+      ASSERT_TRUE(data.effects.shadingNormals) << data.effects.toString();
+    }
     const Camera& cam = data.params.camera;
     std::vector<uvec2> pixels;
     for (uint y = 0; y < cam.height; ++y) {

@@ -27,6 +27,7 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
+#include "bsdf.h"
 #include "bvh/wide_bvh.h"
 #include "bvh/wide_traverse-inl.h"
 #include "cpu/integrator.h"
@@ -359,6 +360,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   const bool neeOn = params.strategy != kStrategyBsdf && params.emitterCount > 0;
   const bool bsdfEmissionOn = params.strategy != kStrategyNee;
   const bool environment = params.environmentEmitter != kNoEmitter;  // an infinite light
+  const bool shadingNormals = !scene.normals.empty();  // vertex normals: shade about them
   const Intersection intersection =
       params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
   const V zero = hn::Zero(d);
@@ -374,7 +376,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   TriangleLanes hitTriangle, lightTriangle;
   Lanes uLightChooseX, uLightChooseY, uLightX, uLightY, uBsdfX, uBsdfY, uRoulette, uRouletteY;
   uint32_t hitIndex[kMaxLanes] = {};  // the hit triangle (Bvh::triangles)
-  Lanes3 shadingPoint, shadingNormal, wiOther, sideOther;
+  Lanes3 shadingPoint, shadingNormal, hitNs, wiOther, sideOther;
   Lanes3 lightEmission, shadowFrom, shadowDir;
   const Emitter* analyticEmitter[kMaxLanes] = {};  // a lane's light of lights.h, if it chose one
   Lanes lightPmf;
@@ -475,6 +477,11 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       t.v[i] = hit->t;
       bary.set(i, hit->barycentrics);
       hitTriangle.set(i, tri, shading);
+      // The shading normal, as the reference interpolates it (bsdf.h's interpolatedNormal).
+      if (shadingNormals) {
+        hitNs.set(
+            i, interpolatedNormal(scene.normals[tri.primitive], hit->barycentrics, shading.normal));
+      }
       reflectance.set(i, material.reflectance);
       emission.set(i, material.emission);
       if (tri.emitter != kNoEmitter) {
@@ -536,8 +543,13 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
     drawRandom2(sobol, path, sampleIndex, kDimBsdf, seed, live, uBsdfX, &uBsdfY);
     drawRandom2(sobol, path, sampleIndex, kDimRoulette, seed, live, uRoulette, &uRouletteY);
 
-    // Both materials are two-sided: shade with the normal facing the incoming ray.
-    const V3 n = select(hn::Ge(cosOut, zero), ngv, -ngv);
+    // Both materials are two-sided: shade with the normal facing the incoming ray (the shading
+    // normal where the mesh has vertex normals).
+    V3 n = select(hn::Ge(cosOut, zero), ngv, -ngv);
+    if (shadingNormals) {
+      const V3 ns = load(hitNs);
+      n = select(hn::Ge(dot(ns, wo), zero), ns, -ns);
+    }
     const V3 refl = load(reflectance);
     const V mag = hitTriangle.magnitude.load();
     const uint32_t diffuse = live & ~mirror & ~other;
@@ -584,8 +596,10 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       const V cosSurface = dot(n, wl);
       const uint32_t facing =
           nee & ~analytic & bits(hn::And(hn::Gt(cosLight, zero), hn::Gt(cosSurface, zero)));
-      // Shadow ray between the two offset points; t in [0, 1) spans the segment.
-      const V3 from = offsetRayOrigin(p, n, mag);
+      // Shadow ray between the two offset points; t in [0, 1) spans the segment. It leaves
+      // along n, or with shading normals on the side of the geometric normal the light is on.
+      const V3 from = offsetRayOrigin(
+          p, shadingNormals ? select(hn::Gt(dot(ngv, wl), zero), ngv, -ngv) : n, mag);
       const V3 to = offsetRayOrigin(lightPoint, lightN, lightTriangle.magnitude.load());
       store(shadowFrom, from);
       store(shadowDir, to - from);
@@ -622,10 +636,11 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
           const vec3 ns = shadingNormal.get(i);
           path.L.set(
               i, path.L.get(i) + sampleAnalyticLightDiffuse(
-                                     scene, *analyticEmitter[i], shadingPoint.get(i), ns, ns,
-                                     /*shadingNormals=*/false, hitTriangle.magnitude.v[i],
-                                     path.beta.get(i), kInvPi * reflectance.get(i),
-                                     vec2(uLightX.v[i], uLightY.v[i]), misOn, intersection, rays));
+                                     scene, *analyticEmitter[i], shadingPoint.get(i), ns,
+                                     hitTriangle.normal.get(i), shadingNormals,
+                                     hitTriangle.magnitude.v[i], path.beta.get(i),
+                                     kInvPi * reflectance.get(i), vec2(uLightX.v[i], uLightY.v[i]),
+                                     misOn, intersection, rays));
         });
         L = load(path.L);
       }
@@ -648,7 +663,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
                                 &scene.materials[tri.material],
                                 shadingPoint.get(i),
                                 ng,
-                                ng,
+                                shadingNormals ? hitNs.get(i) : ng,
                                 -path.direction.get(i),
                                 hitTriangle.magnitude.v[i],
                                 u,
@@ -699,8 +714,10 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       }
     }
 
-    // Leave the surface on the side of the new direction.
-    store(path.origin, offsetRayOrigin(p, select(isOther, load(sideOther), n), mag));
+    // Leave the surface on the side of the new direction (of the geometric normal's sides,
+    // with shading normals).
+    const V3 side = shadingNormals ? select(hn::Gt(dot(ngv, wi), zero), ngv, -ngv) : n;
+    store(path.origin, offsetRayOrigin(p, select(isOther, load(sideOther), side), mag));
     store(path.direction, wi);
     store(path.L, L);
     store(path.beta, beta);
@@ -726,12 +743,10 @@ HWY_EXPORT(sampleRadianceLanesImpl);
 
 void sampleRadianceLanes(const SceneData& scene, const uvec2* pixels, size_t count,
                          uint32_t sampleIndex, vec3* out, uint64_t& rays) {
-  // The lanes shade about the geometric normal only and sample one-sided emissive triangles
-  // (and lights.h's point, spot, distant and infinite lights) only; a scene with shading
-  // normals, two-sided or sphere lights takes the reference path by path (the same results by
-  // definition).
-  if (scene.effects.shadingNormals || scene.effects.twoSidedEmitters ||
-      scene.effects.sphereLights) {
+  // The lanes sample one-sided emissive triangles (and lights.h's point, spot, distant and
+  // infinite lights) only; a scene with two-sided or sphere lights takes the reference path by
+  // path (the same results by definition).
+  if (scene.effects.twoSidedEmitters || scene.effects.sphereLights) {
     for (size_t i = 0; i < count; ++i) out[i] = sampleRadiance(scene, pixels[i], sampleIndex, rays);
     return;
   }
