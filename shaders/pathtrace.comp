@@ -159,8 +159,7 @@ Light loadLight(uint i) {
   uvec4 c = texelFetch(lightTexels, at + 2);
   uvec4 d = texelFetch(lightTexels, at + 3);
   return Light(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), uintBitsToFloat(b.w),
-               uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.x), d.y, d.z,
-               d.w);
+               uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.x), d.y, d.z, d.w);
 }
 #endif
 
@@ -273,8 +272,8 @@ vec3 analyticLightContribution(AnalyticLightSample ls, float pmf, vec3 from, vec
   float weight = (misOn && !ls.delta) ? powerHeuristic(lightPdf, bsdfDensity) : 1.0;
 #ifdef PT_DEBUG_PRINTF
   if (gDebug) {
-    debugPrintfEXT("gpu depth %u: light sample on analytic light pdf=%g weight=%g", depth,
-                   lightPdf, weight);
+    debugPrintfEXT("gpu depth %u: light sample on analytic light pdf=%g weight=%g", depth, lightPdf,
+                   weight);
   }
 #endif
   vec3 contribution = beta * fCos * ls.Li * (weight / lightPdf);
@@ -419,9 +418,8 @@ Path startPath(uvec2 pixel, uint sampleIndex) {
   vec2 uLens = params.camera.lensRadius > 0.0
                    ? random2(PT_SOBOL, pixel, sampleIndex, kDimLens, params.seed)
                    : vec2(0.0);
-  CameraSample camera =
-      generateCameraRay(params.camera, pixel,
-                        random2(PT_SOBOL, pixel, sampleIndex, kDimPixel, params.seed), uLens);
+  CameraSample camera = generateCameraRay(
+      params.camera, pixel, random2(PT_SOBOL, pixel, sampleIndex, kDimPixel, params.seed), uLens);
   path.origin = camera.origin;
   path.direction = camera.direction;
   path.weight = camera.weight;
@@ -467,8 +465,7 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
       } else if (bsdfEmissionOn()) {
         float weight = 1.0;
         if (misOn()) {
-          weight = powerHeuristic(path.bsdfPdf,
-                                  environmentLightPdf(loadEmitter(params.environmentEmitter).pmf));
+          weight = powerHeuristic(path.bsdfPdf, params.environmentPdf);
         }
         path.L += path.beta * weight * params.environment;
       }

@@ -243,7 +243,8 @@ struct RenderParams {
   uint environmentEmitter;  // 4 bytes: the Emitter of the infinite light, or kNoEmitter
   float sceneRadius;        //  4 bytes: radius of a sphere about sceneCenter holding the scene
   vec3 environment;         // 12 bytes: radiance of the infinite light (zero when none)
-  uint reserved0;           //  4 bytes: zero
+  float environmentPdf;     //  4 bytes: its light-sampling density, environmentLightPdf of
+                            //           its Emitter's pmf (for MIS where rays leave the scene)
   vec3 sceneCenter;         // 12 bytes: centre of the scene's bounding box
   uint reserved1;           //  4 bytes: zero
 };                          // 240 bytes

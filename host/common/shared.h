@@ -62,6 +62,7 @@ static_assert(offsetof(RenderParams, russianRoulette) == kParamsBase + 20);
 static_assert(offsetof(RenderParams, normalsPresent) == kParamsBase + 32);
 static_assert(offsetof(RenderParams, sceneRadius) == kParamsBase + 44);
 static_assert(offsetof(RenderParams, environment) == kParamsBase + 48);
+static_assert(offsetof(RenderParams, environmentPdf) == kParamsBase + 60);
 static_assert(offsetof(RenderParams, sceneCenter) == kParamsBase + 64);
 
 static_assert(sizeof(Light) == 64 && sizeof(Light) == 16 * kLightTexels);

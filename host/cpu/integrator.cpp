@@ -229,10 +229,7 @@ vec3 environmentSeen(const SceneData& scene, vec3 beta, bool specularBounce, flo
   if (specularBounce) return beta * params.environment;
   if (params.strategy == kStrategyNee) return vec3(0.0f);
   const float weight =
-      params.strategy == kStrategyMis
-          ? powerHeuristic(bsdfPdf,
-                           environmentLightPdf(scene.emitters[params.environmentEmitter].pmf))
-          : 1.0f;
+      params.strategy == kStrategyMis ? powerHeuristic(bsdfPdf, params.environmentPdf) : 1.0f;
   return beta * weight * params.environment;
 }
 

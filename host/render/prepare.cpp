@@ -6,6 +6,7 @@
 
 #include "bsdf.h"
 #include "common/check.h"
+#include "lights.h"
 
 namespace pt {
 
@@ -267,6 +268,7 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     if (light.type == kLightInfinite) {
       p.environmentEmitter = i;
       p.environment = light.radiance;
+      p.environmentPdf = environmentLightPdf(data.emitters[i].pmf);
     } else if (light.type == kLightSphere) {
       data.effects.sphereLights = true;
     } else {

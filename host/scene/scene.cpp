@@ -664,24 +664,14 @@ ShapeTriangles readObjWithMtl(const JsonNode& shape, const MeshFile& file,
 }
 
 // A vertex normal in world space: transformed by the inverse transpose of the shape's linear
-// map (rotation times scale: the rotation times the inverse scale), normalized; the triangle's
-// geometric normal `ng` where the file's normal is zero or the result is not finite.
-vec3 worldNormal(glm::dvec3 n, const std::optional<Transform>& transform, vec3 ng) {
-  if (transform) {
-    const Transform& t = *transform;
-    n /= t.scale;
-    n = n * t.cosAngle + glm::cross(t.axis, n) * t.sinAngle +
-        t.axis * (glm::dot(t.axis, n) * (1.0 - t.cosAngle));
-  }
-  const double len = glm::length(n);
-  if (!(len > 0.0) || !std::isfinite(len)) return ng;
-  const vec3 unit = vec3(n / len);
-  return std::isfinite(unit.x) && std::isfinite(unit.y) && std::isfinite(unit.z) ? unit : ng;
-}
-
-TriangleNormals flatNormals(const Triangle& t) {
-  const vec3 ng = glm::normalize(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
-  return TriangleNormals{ng, 0.0f, ng, 0.0f, ng, 0.0f};
+// map (rotation times scale: the rotation times the inverse scale); appendTriangle makes it
+// unit.
+glm::dvec3 worldNormal(glm::dvec3 n, const std::optional<Transform>& transform) {
+  if (!transform) return n;
+  const Transform& t = *transform;
+  n /= t.scale;
+  return n * t.cosAngle + glm::cross(t.axis, n) * t.sinAngle +
+         t.axis * (glm::dot(t.axis, n) * (1.0 - t.cosAngle));
 }
 
 // Appends the triangles of one shape to the scene, transformed and rounded to float,
@@ -707,37 +697,18 @@ void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
         shape.fail("transform moves vertices beyond the range of 32-bit floats");
       }
     }
-    // Zero area: the edges at v0 are parallel to within double rounding, i.e. the sine of
-    // the angle between them is at most 1e-12 (scale-invariant; computed in double on the
-    // float vertices the renderer will see, so thin but real slivers are kept). Covers
-    // coincident vertices too.
-    const glm::dvec3 e1 = glm::dvec3(out.v1) - glm::dvec3(out.v0);
-    const glm::dvec3 e2 = glm::dvec3(out.v2) - glm::dvec3(out.v0);
-    if (!(glm::length(glm::cross(e1, e2)) > 1e-12 * glm::length(e1) * glm::length(e2))) {
-      ++dropped;
-      continue;
-    }
-    if (scene.triangles.size() >= static_cast<std::size_t>(kNoEmitter)) {
-      shape.fail("too many triangles in the scene (at most 4294967295)");
-    }
     out.material = shapeTriangles.materials.empty() ? material : shapeTriangles.materials[i];
-    out.emitter = kNoEmitter;
-    out.primitive = static_cast<uint>(scene.triangles.size());
-    scene.triangles.push_back(out);
-    if (!shapeTriangles.normals.empty() && scene.normals.empty()) {
-      // The first triangle with vertex normals: the triangles before it shade flat.
-      for (std::size_t t = 0; t + 1 < scene.triangles.size(); ++t) {
-        scene.normals.push_back(flatNormals(scene.triangles[t]));
+    std::array<glm::dvec3, 3> normals;
+    if (!shapeTriangles.normals.empty()) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        normals[k] = worldNormal(shapeTriangles.normals[i][k], transform);
       }
     }
-    if (!shapeTriangles.normals.empty()) {
-      const vec3 ng = flatNormals(out).n0;
-      const Tri& n = shapeTriangles.normals[i];
-      scene.normals.push_back(TriangleNormals{worldNormal(n[0], transform, ng), 0.0f,
-                                              worldNormal(n[1], transform, ng), 0.0f,
-                                              worldNormal(n[2], transform, ng), 0.0f});
-    } else if (!scene.normals.empty()) {
-      scene.normals.push_back(flatNormals(out));
+    const Appended appended =
+        appendTriangle(scene, out, shapeTriangles.normals.empty() ? nullptr : &normals);
+    if (appended == Appended::kZeroArea) ++dropped;
+    if (appended == Appended::kTooMany) {
+      shape.fail("too many triangles in the scene (at most 4294967295)");
     }
   }
   if (dropped > 0) {
@@ -935,6 +906,44 @@ void setConductorReflectance(Material& material, vec3 reflectance) {
     const double r = std::clamp(static_cast<double>(reflectance[c]), 0.0, 0.9999);
     material.k[c] = static_cast<float>(2.0 * std::sqrt(r) / std::sqrt(1.0 - r));
   }
+}
+
+Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3>* normals) {
+  const glm::dvec3 e1 = glm::dvec3(t.v1) - glm::dvec3(t.v0);
+  const glm::dvec3 e2 = glm::dvec3(t.v2) - glm::dvec3(t.v0);
+  if (!(glm::length(glm::cross(e1, e2)) > 1e-12 * glm::length(e1) * glm::length(e2))) {
+    return Appended::kZeroArea;
+  }
+  if (scene.triangles.size() >= static_cast<std::size_t>(kNoEmitter)) return Appended::kTooMany;
+  // A normal made unit; the geometric normal where it is zero or not finite.
+  const auto unitNormal = [](glm::dvec3 n, vec3 ng) {
+    const double len = glm::length(n);
+    if (!(len > 0.0) || !std::isfinite(len)) return ng;
+    const vec3 unit = vec3(n / len);
+    return std::isfinite(unit.x) && std::isfinite(unit.y) && std::isfinite(unit.z) ? unit : ng;
+  };
+  const auto flatNormals = [](const Triangle& f) {
+    const vec3 ng = glm::normalize(glm::cross(f.v1 - f.v0, f.v2 - f.v0));
+    return TriangleNormals{ng, 0.0f, ng, 0.0f, ng, 0.0f};
+  };
+  t.emitter = kNoEmitter;
+  t.primitive = static_cast<uint>(scene.triangles.size());
+  scene.triangles.push_back(t);
+  if (normals != nullptr && scene.normals.empty()) {
+    // The first triangle with vertex normals: the triangles before it shade flat.
+    for (std::size_t k = 0; k + 1 < scene.triangles.size(); ++k) {
+      scene.normals.push_back(flatNormals(scene.triangles[k]));
+    }
+  }
+  if (normals != nullptr) {
+    const vec3 ng = flatNormals(t).n0;
+    const std::array<glm::dvec3, 3>& n = *normals;
+    scene.normals.push_back(TriangleNormals{unitNormal(n[0], ng), 0.0f, unitNormal(n[1], ng), 0.0f,
+                                            unitNormal(n[2], ng), 0.0f});
+  } else if (!scene.normals.empty()) {
+    scene.normals.push_back(flatNormals(t));
+  }
+  return Appended::kAdded;
 }
 
 // ---- lights -----------------------------------------------------------------------------

@@ -117,6 +117,20 @@ inline constexpr std::int64_t kMaxCoatedWalk = 1000;
 // rotate with it.
 std::pair<double, double> cosSinDegrees(double degrees);
 
+// How appendTriangle ended.
+enum class Appended { kAdded, kZeroArea, kTooMany };
+
+// Appends triangle `t` (its vertices and material set; emitter and primitive are filled here)
+// to scene.triangles, as both scene readers do: not if it has zero area (the edges at v0
+// parallel to within double rounding, i.e. the sine of the angle between them at most 1e-12:
+// scale-invariant, computed in double on the float vertices the renderer will see, so thin
+// but real slivers are kept; coincident vertices too), nor beyond kNoEmitter - 1 triangles.
+// `normals`: the vertex normals in world space (any length), or null where the mesh has none;
+// each is made unit, the geometric normal standing in for one that is zero or not finite.
+// Once some triangle has normals, every triangle has an entry in scene.normals (its geometric
+// normal at all three vertices where its mesh has none).
+Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3>* normals);
+
 // Makes room for `size` elements, at least doubling the capacity when it grows, so that
 // appending shape after shape costs amortized linear time (std::vector::reserve would allocate
 // exactly `size`, and the next shape would copy everything again).

@@ -214,19 +214,6 @@ Mesh transformMesh(const Mesh& mesh, const glm::dmat4& m) {
   return out;
 }
 
-TriangleNormals flatNormals(const Triangle& t) {
-  const vec3 ng = glm::normalize(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
-  return TriangleNormals{ng, 0.0f, ng, 0.0f, ng, 0.0f};
-}
-
-// A world-space vertex normal made unit; the geometric normal where it is zero or not finite.
-vec3 unitNormal(glm::dvec3 n, vec3 ng) {
-  const double len = glm::length(n);
-  if (!(len > 0.0) || !std::isfinite(len)) return ng;
-  const vec3 unit = vec3(n / len);
-  return std::isfinite(unit.x) && std::isfinite(unit.y) && std::isfinite(unit.z) ? unit : ng;
-}
-
 // ---- parameters ---------------------------------------------------------------------------
 
 class Builder;
@@ -2125,32 +2112,12 @@ void Builder::emit(const Mesh& mesh, uint slot, const Location& where, const std
         fail(where, context + ": the transform moves vertices beyond the range of 32-bit floats");
       }
     }
-    // Zero area as the JSON reader defines it: the sine of the angle at v0 at most 1e-12.
-    const glm::dvec3 e1 = glm::dvec3(out.v1) - glm::dvec3(out.v0);
-    const glm::dvec3 e2 = glm::dvec3(out.v2) - glm::dvec3(out.v0);
-    if (!(glm::length(glm::cross(e1, e2)) > 1e-12 * glm::length(e1) * glm::length(e2))) {
-      ++dropped;
-      continue;
-    }
-    if (scene.triangles.size() >= static_cast<std::size_t>(kNoEmitter)) {
-      fail(where, "too many triangles in the scene (at most 4294967295)");
-    }
+    // Zero-area triangles dropped, normals made unit, as the JSON reader does.
     out.material = slot;
-    out.emitter = kNoEmitter;
-    out.primitive = static_cast<uint>(scene.triangles.size());
-    scene.triangles.push_back(out);
-    if (!mesh.normals.empty() && scene.normals.empty()) {
-      // The first triangle with vertex normals: the triangles before it shade flat.
-      for (std::size_t k = 0; k + 1 < scene.triangles.size(); ++k) {
-        scene.normals.push_back(flatNormals(scene.triangles[k]));
-      }
-    }
-    if (!mesh.normals.empty()) {
-      const vec3 ng = flatNormals(out).n0;
-      scene.normals.push_back(TriangleNormals{unitNormal(n[0], ng), 0.0f, unitNormal(n[1], ng),
-                                              0.0f, unitNormal(n[2], ng), 0.0f});
-    } else if (!scene.normals.empty()) {
-      scene.normals.push_back(flatNormals(out));
+    const Appended appended = appendTriangle(scene, out, mesh.normals.empty() ? nullptr : &n);
+    if (appended == Appended::kZeroArea) ++dropped;
+    if (appended == Appended::kTooMany) {
+      fail(where, "too many triangles in the scene (at most 4294967295)");
     }
   }
   if (dropped > 0) {
