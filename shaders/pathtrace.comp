@@ -38,6 +38,9 @@ const bool kDeltaLights = false;
 const bool kEnvironment = false;
 const bool kTwoSidedEmitters = false;
 const bool kSphereLights = false;
+const bool kTextures = false;
+const bool kAlphaCutouts = false;
+const bool kBumpMaps = false;
 #else
 layout(constant_id = PT_SPEC_CONDUCTOR) const bool kConductor = true;
 layout(constant_id = PT_SPEC_DIELECTRIC) const bool kDielectric = true;
@@ -49,6 +52,9 @@ layout(constant_id = PT_SPEC_DELTA_LIGHTS) const bool kDeltaLights = true;
 layout(constant_id = PT_SPEC_ENVIRONMENT) const bool kEnvironment = true;
 layout(constant_id = PT_SPEC_TWO_SIDED_EMITTERS) const bool kTwoSidedEmitters = true;
 layout(constant_id = PT_SPEC_SPHERE_LIGHTS) const bool kSphereLights = true;
+layout(constant_id = PT_SPEC_TEXTURES) const bool kTextures = true;
+layout(constant_id = PT_SPEC_ALPHA) const bool kAlphaCutouts = true;
+layout(constant_id = PT_SPEC_BUMP) const bool kBumpMaps = true;
 #endif
 // Some emitter is one of lights.h's (not a triangle).
 const bool kAnalyticLights = kDeltaLights || kEnvironment || kSphereLights;
@@ -72,6 +78,11 @@ layout(set = 0, binding = PT_BINDING_MATERIALS) uniform usamplerBuffer materialT
 layout(set = 0, binding = PT_BINDING_EMITTERS) uniform usamplerBuffer emitterTexels;
 layout(set = 0, binding = PT_BINDING_NORMALS) uniform usamplerBuffer normalTexels;
 layout(set = 0, binding = PT_BINDING_LIGHTS) uniform usamplerBuffer lightTexels;
+layout(set = 0, binding = PT_BINDING_UVS) uniform usamplerBuffer uvTexels;
+layout(set = 0, binding = PT_BINDING_TEXTURES) uniform usamplerBuffer textureTexels;
+layout(set = 0, binding = PT_BINDING_IMAGES) uniform usamplerBuffer imageTexels;
+layout(set = 0,
+       binding = PT_BINDING_MATERIAL_TEXTURES) uniform usamplerBuffer materialTextureTexels;
 layout(std430, set = 0, binding = PT_BINDING_ACCUM) buffer AccumBuffer {
   AccumPixel accum[];
 };
@@ -102,6 +113,36 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 #define PT_LOOP_TICK() gLoopIterations++
 #include "bsdf.h"
 #include "lights.h"
+
+// What texture.h reads (see there), from the texture bindings.
+TextureNode textureNodeAt(uint i) {
+  int at = int(kTextureNodeTexels * i);
+  uvec4 a = texelFetch(textureTexels, at);
+  uvec4 b = texelFetch(textureTexels, at + 1);
+  uvec4 c = texelFetch(textureTexels, at + 2);
+  uvec4 d = texelFetch(textureTexels, at + 3);
+  return TextureNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b), c.x, c.y, c.z, c.w, d.x, d.y,
+                     d.z, d.w);
+}
+uint imageWordAt(uint i) {
+  return texelFetch(imageTexels, int(i >> 2u))[i & 3u];
+}
+MaterialTextures materialTexturesAt(uint i) {
+  int at = int(kMaterialTextureTexels * i);
+  uvec4 a = texelFetch(materialTextureTexels, at);
+  uvec4 b = texelFetch(materialTextureTexels, at + 1);
+  uvec4 c = texelFetch(materialTextureTexels, at + 2);
+  return MaterialTextures(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, uintBitsToFloat(c.y), c.z,
+                          c.w);
+}
+TriangleUVs uvsAt(uint primitive) {
+  int at = int(2u * primitive);
+  vec4 a = uintBitsToFloat(texelFetch(uvTexels, at));
+  vec4 b = uintBitsToFloat(texelFetch(uvTexels, at + 1));
+  return TriangleUVs(a.xy, a.zw, b.xy, b.zw);
+}
+#define PT_TEXTURE_LOOP_TICK() gLoopIterations++
+#include "texture.h"
 #endif
 
 // Watertight unless switched off by specialization or, unspecialized, by the parameters.
@@ -477,6 +518,13 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   Material material = loadMaterial(tri.material);
   // Hit point from barycentrics (more accurate than origin + t * direction).
   vec3 b = hitBarycentrics(path.origin, path.direction, tri);
+#ifndef PT_NO_BSDF_MATERIALS
+  // The parameters that textures give, at the hit's texture coordinates.
+  if (kTextures && params.texturesPresent != 0u) {
+    vec2 uv = interpolatedUV(uvsAt(tri.primitive), b);
+    material = resolveMaterial(material, materialTexturesAt(tri.material), uv);
+  }
+#endif
   vec3 p = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
   vec3 edgeCross = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
   vec3 ng = normalize(edgeCross);

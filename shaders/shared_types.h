@@ -171,6 +171,87 @@ struct Light {
 };                        // 64 bytes
 PT_CONST uint kLightTexels = 4u;
 
+// ---- Textures ----------------------------------------------------------------------------
+
+// pbrt-v4's textures (its Texture directive's classes, their parameters and definitions;
+// shaders/texture.h evaluates them). A texture is a short program in postfix order: leaves
+// (constant, image) push a value, the others pop their operands and push their result, so that
+// nesting needs no recursion. A texture is named by the index of its first node, whose `count`
+// is the program's length; values are RGB (a float texture's value is in all three channels).
+PT_CONST uint kNoTexture = 0xFFFFFFFFu;
+PT_CONST uint kTextureConstant = 0u;      // pushes value
+PT_CONST uint kTextureImage = 1u;         // pushes the image's filtered value (imagemap)
+PT_CONST uint kTextureCheckerboard = 2u;  // pops tex2, tex1: tex1 on even squares, else tex2
+PT_CONST uint kTextureScale = 3u;         // pops scale, tex: tex * scale.x (0 where scale is 0)
+PT_CONST uint kTextureMix = 4u;           // pops amount, tex2, tex1: (1 - a) tex1 + a tex2
+PT_CONST uint kTextureStackSize = 4u;     // the deepest a program's stack may grow
+
+// An image node's flags: its texel format in bits 0-3, wrap mode in 4-7, filter in 8-11, what
+// a float texture reads in 12-15, and bit 16 for pbrt-v4's "invert".
+PT_CONST uint kTexel8 = 0u;       // one word per texel, RGBA bytes decoded by the image's table
+PT_CONST uint kTexelFloat1 = 1u;  // one float per texel (grey)
+PT_CONST uint kTexelFloat3 = 2u;  // three floats (RGB)
+PT_CONST uint kTexelFloat4 = 3u;  // four floats (RGBA)
+PT_CONST uint kWrapRepeat = 0u;
+PT_CONST uint kWrapClamp = 1u;
+PT_CONST uint kWrapBlack = 2u;  // zero outside the image
+PT_CONST uint kTextureBilinear = 0u;
+PT_CONST uint kTexturePoint = 1u;  // the nearest texel
+// What a float texture reads of an image (pbrt-v4's MIPMap::Bilerp<Float>): the one channel
+// of a grey image, the average of R, G and B, or the alpha of an image that has one that is
+// not all ones; a point lookup reads the first channel whatever the image (MIPMap::Texel).
+PT_CONST uint kFloatChannelFirst = 0u;
+PT_CONST uint kFloatChannelAverage = 1u;
+PT_CONST uint kFloatChannelAlpha = 2u;
+PT_CONST uint kTextureInvert = 0x10000u;
+PT_CONST uint kTextureFloat = 0x20000u;  // the texture is a float texture (image lookups)
+
+struct TextureNode {
+  vec3 value;      // 12 bytes: constant: its value; image: pbrt-v4's "scale" (all three)
+  uint type;       //  4 bytes: kTexture*
+  vec4 mapping;    // 16 bytes: image, checkerboard: (uscale, vscale, udelta, vdelta), so that
+                   //           (s, t) = (uscale u + udelta, vscale v + vdelta)
+  uint texels;     //  4 bytes: image: its first word in the image buffer
+  uint width;      //  4 bytes: image: texels per row
+  uint height;     //  4 bytes: image: rows (row 0 at the top, where t = 1)
+  uint flags;      //  4 bytes: image: format, wrap, filter, float channel, invert (above)
+  uint decode;     //  4 bytes: image, kTexel8: the first word of its 256 decoded byte values
+  uint count;      //  4 bytes: a texture's first node: the nodes of its program
+  uint reserved0;  // 4 bytes: zero
+  uint reserved1;  // 4 bytes: zero
+};                 // 64 bytes
+PT_CONST uint kTextureNodeTexels = 4u;
+
+// The texture coordinates of one triangle's vertices, in the scene's load order (indexed by
+// Triangle::primitive); pbrt-v4's (0, 0), (1, 0), (1, 1) where a mesh has none. Uploaded only
+// where some material has a texture.
+struct TriangleUVs {
+  vec2 uv0;       // 8 bytes
+  vec2 uv1;       // 8 bytes
+  vec2 uv2;       // 8 bytes
+  vec2 reserved;  // 8 bytes: zero
+};                // 32 bytes
+
+// The textures of one material's parameters (kNoTexture: the Material's own value), parallel
+// to the materials; uploaded only where some material has one. A texture's value replaces the
+// parameter at each hit before the BSDF sees it (shaders/texture.h, resolveMaterial).
+struct MaterialTextures {
+  uint reflectance;    // reflectance (all types that have one; a conductor's by its k)
+  uint transmittance;  // diffusetransmission: transmittance; coateddiffuse: albedo
+  uint uRoughness;     // roughness along u (float)
+  uint vRoughness;     // along v (float)
+  uint eta;            // conductor: eta (spectrum)
+  uint k;              // conductor: k (spectrum)
+  uint displacement;   // bump map (float)
+  uint alpha;          // cut-out (float): the surface is missing where it is 0
+  uint flags;          // kRemapRoughness
+  float scale;         // diffusetransmission: pbrt-v4's "scale" of both colours
+  uint reserved0;      // zero
+  uint reserved1;      // zero
+};                     // 48 bytes
+PT_CONST uint kMaterialTextureTexels = 3u;
+PT_CONST uint kRemapRoughness = 1u;  // roughness textures give pbrt-v4's roughness, not alpha
+
 // ---- Camera and per-render parameters --------------------------------------------------
 
 // Pixel filters (pbrt-v4's, its definitions and parameters; shaders/filter.h samples them).
@@ -246,7 +327,7 @@ struct RenderParams {
   float environmentPdf;     //  4 bytes: its light-sampling density, environmentLightPdf of
                             //           its Emitter's pmf (for MIS where rays leave the scene)
   vec3 sceneCenter;         // 12 bytes: centre of the scene's bounding box
-  uint reserved1;           //  4 bytes: zero
+  uint texturesPresent;     //  4 bytes: 1 when the texture buffers hold the scene's textures
 };                          // 240 bytes
 
 // ---- Compute pipeline interface (Vulkan backend) ----------------------------------------
@@ -259,16 +340,22 @@ struct RenderParams {
 // (Mesa 22.3 fetches these texels in a function of its own, called four times per traversal
 // step; as storage texel buffers read by imageLoad, which it inlines, they were no faster:
 // Cornell box the same, bunny box 2-4 % slower.)
-#define PT_BINDING_PARAMS 0     // RenderParams
-#define PT_BINDING_NODES 1      // GpuBvhNode[], then Triangle[] (gpuTraversalTexels), texels
-#define PT_BINDING_TRIANGLES 2  // Triangle[], texels
-#define PT_BINDING_MATERIALS 3  // Material[], texels
-#define PT_BINDING_EMITTERS 4   // Emitter[], texels (one dummy entry when the scene has none)
-#define PT_BINDING_NORMALS 5    // TriangleNormals[], texels (one dummy entry when none)
-#define PT_BINDING_LIGHTS 6     // Light[], texels (one dummy entry when the scene has none)
-#define PT_BINDING_ACCUM 7      // AccumPixel[width * height]
-#define PT_BINDING_COUNTERS 8   // DeviceCounters
-#define PT_BINDING_COUNT 9
+#define PT_BINDING_PARAMS 0       // RenderParams
+#define PT_BINDING_NODES 1        // GpuBvhNode[], then Triangle[] (gpuTraversalTexels), texels
+#define PT_BINDING_TRIANGLES 2    // Triangle[], texels
+#define PT_BINDING_MATERIALS 3    // Material[], texels
+#define PT_BINDING_EMITTERS 4     // Emitter[], texels (one dummy entry when the scene has none)
+#define PT_BINDING_NORMALS 5      // TriangleNormals[], texels (one dummy entry when none)
+#define PT_BINDING_LIGHTS 6       // Light[], texels (one dummy entry when the scene has none)
+#define PT_BINDING_ACCUM 7        // AccumPixel[width * height]
+#define PT_BINDING_COUNTERS 8     // DeviceCounters
+#define PT_BINDING_ENVIRONMENT 9  // the environment image and its sampling distribution
+// Textures: one dummy entry each where no material has a texture.
+#define PT_BINDING_UVS 10                // TriangleUVs[], texels
+#define PT_BINDING_TEXTURES 11           // TextureNode[], texels
+#define PT_BINDING_IMAGES 12             // the image buffer: uint words (R32_UINT texels)
+#define PT_BINDING_MATERIAL_TEXTURES 13  // MaterialTextures[], texels
+#define PT_BINDING_COUNT 14
 
 // Specialization constant ids: the effect set. An effect switched off is compiled out.
 #define PT_SPEC_DIFFUSE 0        // bool: Lambertian surfaces occur
@@ -294,7 +381,11 @@ struct RenderParams {
 #define PT_SPEC_ENVIRONMENT 16         // bool: an infinite light occurs
 #define PT_SPEC_TWO_SIDED_EMITTERS 17  // bool: some emissive triangle emits on both sides
 #define PT_SPEC_SPHERE_LIGHTS 18       // bool: some sphere area light is sampled by solid angle
-#define PT_SPEC_COUNT 19
+#define PT_SPEC_ENVIRONMENT_IMAGE 19   // bool: the infinite light is an image
+#define PT_SPEC_TEXTURES 20            // bool: some material parameter is a texture
+#define PT_SPEC_ALPHA 21               // bool: some material has an alpha cut-out
+#define PT_SPEC_BUMP 22                // bool: some material has a bump map
+#define PT_SPEC_COUNT 23
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever

@@ -50,25 +50,10 @@ SceneData prepare(const std::string& text) {
 // footprint (16 x 16 points of the box filter's square), for comparison with a render.
 template <typename Radiance>
 Image expectedImage(const SceneData& data, const Radiance& radiance) {
-  const Camera& cam = data.params.camera;
-  Image image(int(cam.width), int(cam.height));
-  constexpr int kSub = 16;
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      glm::dvec3 sum(0.0);
-      for (int j = 0; j < kSub; ++j) {
-        for (int i = 0; i < kSub; ++i) {
-          const vec2 film(float(x) + (float(i) + 0.5f) / kSub, float(y) + (float(j) + 0.5f) / kSub);
-          const Ray ray = cameraRay(cam, film);
-          const glm::dvec3 o(ray.origin), d(ray.direction);
-          const glm::dvec3 hit = o + d * (-o.z / d.z);
-          sum += radiance(hit);
-        }
-      }
-      image.at(x, y) = vec3(sum / double(kSub * kSub));
-    }
-  }
-  return image;
+  return pixelAverages(data.params.camera, [&](const Ray& ray) {
+    const glm::dvec3 o(ray.origin), d(ray.direction);
+    return radiance(o + d * (-o.z / d.z));
+  });
 }
 
 // Both backends' renders against the closed form, pixel by pixel: within `tolerance` times the

@@ -73,4 +73,25 @@ inline void expectAgreement(const Comparison& c) {
   EXPECT_GT(c.gpu.rays, 0u);
 }
 
+// The image of radiance(ray), averaged over each pixel's box-filter square (16 x 16 camera
+// rays): closed forms to compare renders with.
+template <typename Radiance>
+Image pixelAverages(const Camera& cam, const Radiance& radiance) {
+  Image image(int(cam.width), int(cam.height));
+  constexpr int kSub = 16;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      glm::dvec3 sum(0.0);
+      for (int j = 0; j < kSub; ++j) {
+        for (int i = 0; i < kSub; ++i) {
+          const vec2 film(float(x) + (float(i) + 0.5f) / kSub, float(y) + (float(j) + 0.5f) / kSub);
+          sum += radiance(cameraRay(cam, film));
+        }
+      }
+      image.at(x, y) = vec3(sum / double(kSub * kSub));
+    }
+  }
+  return image;
+}
+
 }  // namespace pt

@@ -317,7 +317,15 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
       break;
     }
     const Triangle& tri = bvh.triangles[hit->triangle];
-    const Material& material = scene.materials[tri.material];
+    // The parameters that textures give, at the hit's texture coordinates.
+    const Material* untextured = &scene.materials[tri.material];
+    Material textured;
+    if (scene.params.texturesPresent != 0u) {
+      textured =
+          resolveMaterial(scene.textureTables(), *untextured, scene.materialTextures[tri.material],
+                          interpolatedUV(scene.uvs[tri.primitive], hit->barycentrics));
+    }
+    const Material& material = scene.params.texturesPresent != 0u ? textured : *untextured;
     // Hit point from barycentrics (more accurate than origin + t * direction).
     const vec3 p =
         hit->barycentrics.x * tri.v0 + hit->barycentrics.y * tri.v1 + hit->barycentrics.z * tri.v2;

@@ -744,9 +744,11 @@ HWY_EXPORT(sampleRadianceLanesImpl);
 void sampleRadianceLanes(const SceneData& scene, const uvec2* pixels, size_t count,
                          uint32_t sampleIndex, vec3* out, uint64_t& rays) {
   // The lanes sample one-sided emissive triangles (and lights.h's point, spot, distant and
-  // infinite lights) only; a scene with two-sided or sphere lights takes the reference path by
-  // path (the same results by definition).
-  if (scene.effects.twoSidedEmitters || scene.effects.sphereLights) {
+  // infinite lights) only, on untextured surfaces; a scene with two-sided or sphere lights, or
+  // with textures, alpha cut-outs or bump maps, takes the reference path by path (the same
+  // results by definition).
+  if (scene.effects.twoSidedEmitters || scene.effects.sphereLights ||
+      scene.params.texturesPresent != 0u) {
     for (size_t i = 0; i < count; ++i) out[i] = sampleRadiance(scene, pixels[i], sampleIndex, rays);
     return;
   }

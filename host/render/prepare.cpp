@@ -48,6 +48,9 @@ std::string EffectSet::toString() const {
   add(environment, "environment");
   add(twoSidedEmitters, "two-sided-emitters");
   add(sphereLights, "sphere-lights");
+  add(textures, "textures");
+  add(alphaCutouts, "alpha");
+  add(bumpMaps, "bump");
   add(lightSampling, "nee");
   add(mis, "mis");
   add(russianRoulette, "rr");
@@ -233,6 +236,17 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   data.normals = std::move(scene.normals);
   PT_CHECK(data.normals.empty() || data.normals.size() == scene.triangles.size());
 
+  // Textures only where some material has one; then every triangle has coordinates.
+  if (!scene.materialTextures.empty()) {
+    PT_CHECK(scene.materialTextures.size() == scene.materials.size());
+    PT_CHECK(scene.uvs.empty() || scene.uvs.size() == scene.triangles.size());
+    if (scene.uvs.empty()) scene.uvs.assign(scene.triangles.size(), defaultTriangleUVs());
+    data.uvs = std::move(scene.uvs);
+    data.textureNodes = std::move(scene.textureNodes);
+    data.imageWords = std::move(scene.imageWords);
+    data.materialTextures = std::move(scene.materialTextures);
+  }
+
   std::vector<Triangle> triangles = std::move(scene.triangles);
   CameraDesc camera = scene.camera;
   std::vector<Light> lights = mergeInfiniteLights(std::move(scene.lights));
@@ -290,7 +304,23 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   for (size_t i = 0; i < used.size(); ++i) {
     if (!used[i]) continue;
     const Material& m = data.materials[i];
-    const bool reflects = m.reflectance != vec3(0.0f);
+    // A texture's value is known only at a hit: a parameter with one counts as non-zero.
+    const MaterialTextures* t = data.materialTextures.empty() ? nullptr : &data.materialTextures[i];
+    const bool reflects =
+        m.reflectance != vec3(0.0f) || (t != nullptr && t->reflectance != kNoTexture);
+    if (t != nullptr) {
+      const bool any = t->reflectance != kNoTexture || t->transmittance != kNoTexture ||
+                       t->uRoughness != kNoTexture || t->vRoughness != kNoTexture ||
+                       t->eta != kNoTexture || t->k != kNoTexture;
+      fx.textures = fx.textures || any;
+      fx.alphaCutouts = fx.alphaCutouts || t->alpha != kNoTexture;
+      fx.bumpMaps = fx.bumpMaps || t->displacement != kNoTexture;
+      // Roughness that a texture gives may be smooth somewhere and rough elsewhere.
+      if (m.type > kMaterialMirror &&
+          (t->uRoughness != kNoTexture || t->vRoughness != kNoTexture)) {
+        lightSampled = true;
+      }
+    }
     if (m.type == kMaterialMirror && reflects) fx.mirror = true;
     if (m.type == kMaterialDiffuse && reflects) fx.diffuse = true;
     if (m.type == kMaterialConductor) fx.conductor = true;
@@ -313,6 +343,7 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     }
   }
   fx.bsdfEmission = hittable && p.strategy != kStrategyNee;
+  p.texturesPresent = (fx.textures || fx.alphaCutouts || fx.bumpMaps) ? 1u : 0u;
   fx.shadingNormals = !data.normals.empty();
   p.normalsPresent = fx.shadingNormals ? 1u : 0u;
   fx.watertight = !settings.fastIntersection;

@@ -16,6 +16,7 @@
 #include "bvh/bvh.h"
 #include "bvh/wide_bvh.h"
 #include "scene/scene.h"
+#include "texture.h"
 
 namespace pt {
 
@@ -64,6 +65,9 @@ struct EffectSet {
   bool environment = false;       // an infinite light: rays that leave the scene see it
   bool twoSidedEmitters = false;  // some emissive triangle emits on both sides
   bool sphereLights = false;      // sphere area lights, sampled by the cone they subtend
+  bool textures = false;          // some material has a parameter given by a texture
+  bool alphaCutouts = false;      // some material has an alpha texture (any-hit tests)
+  bool bumpMaps = false;          // some material has a displacement texture
   bool lightSampling = false;     // next-event estimation (needs emitters, a diffuse surface)
   bool bsdfEmission = false;      // emission found by BSDF-sampled rays is counted (MIS/BSDF)
   bool mis = false;               // both of the above, weighed by the power heuristic
@@ -133,6 +137,13 @@ struct SceneData {
   std::vector<Light> lights;      // the analytic lights the emitters beyond the triangles name
   // Vertex normals by Triangle::primitive (load order), or empty when no mesh has any.
   std::vector<TriangleNormals> normals;
+  // Textures (shaders/texture.h), all empty where no material has one: texture coordinates by
+  // Triangle::primitive (every triangle's, pbrt-v4's defaults where its mesh has none), the
+  // textures' programs, the image buffer, and per material the textures of its parameters.
+  std::vector<TriangleUVs> uvs;
+  std::vector<TextureNode> textureNodes;
+  std::vector<uint32_t> imageWords;
+  std::vector<MaterialTextures> materialTextures;
   RenderParams params{};
   int spp = 0;
   EffectSet effects;
@@ -144,6 +155,11 @@ struct SceneData {
   // The BVH the CPU reference traverses: bvh collapsed to eight-wide nodes, with the same
   // answers to every query (wide_bvh.h).
   const WideBvh& wideBvh() const { return cpuCopies().wide; }
+  // What shaders/texture.h reads on the CPU.
+  TextureTables textureTables() const {
+    return TextureTables{textureNodes.data(), imageWords.data(), materialTextures.data(),
+                         uvs.data()};
+  }
 };
 
 // Takes the scene by value: pass it with std::move when it is not needed afterwards, so that

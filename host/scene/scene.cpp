@@ -20,16 +20,19 @@
 #include "common/check.h"
 #include "common/named_values.h"
 #include "scene/json_reader.h"
+#include "scene/json_textures.h"
 #include "scene/mtl_materials.h"
 #include "scene/obj_mesh.h"
 #include "scene/pbrt/pbrt_scene.h"
 #include "scene/ply_mesh.h"
+#include "scene/textures.h"
 
 namespace pt {
 
 namespace {
 
 using scene_detail::JsonNode;
+using scene_detail::JsonTextures;
 using scene_detail::quotedPath;
 using scene_detail::singleQuoted;
 using Tri = std::array<glm::dvec3, 3>;
@@ -278,6 +281,8 @@ std::vector<std::string_view> materialKeys(uint type) {
   }
   keys.push_back("emission");
   keys.push_back("twoSided");
+  keys.push_back("alpha");
+  keys.push_back("displacement");
   return keys;
 }
 
@@ -421,7 +426,72 @@ void readMaterialParameters(const JsonNode& m, Material& material) {
   }
 }
 
-void readMaterials(const JsonNode& node, Scene& scene) {
+// The parameters of material `m` (of type `type`) that name a texture (a string in place of a
+// value; docs/scene-format.md), and its "alpha" and "displacement". Returns the textures and a
+// copy of the material's JSON without the textured keys, for the value readers.
+MaterialTextures readMaterialTextures(const JsonNode& m, uint type, JsonTextures& textures,
+                                      nlohmann::json& values) {
+  MaterialTextures t = noMaterialTextures();
+  values = m.json();
+  const auto take = [&](const char* key, bool isFloat, uint& slot) {
+    const std::optional<JsonNode> n = m.find(key);
+    if (!n || !n->json().is_string()) return false;
+    slot = textures.use(*n, isFloat);
+    values.erase(key);
+    return true;
+  };
+  const bool rough =
+      type == kMaterialConductor || type == kMaterialDielectric || type == kMaterialCoatedDiffuse;
+  if (type != kMaterialDielectric && type != kMaterialThinDielectric) {
+    take("reflectance", false, t.reflectance);
+  }
+  if (type == kMaterialDiffuseTransmission) take("transmittance", false, t.transmittance);
+  if (type == kMaterialCoatedDiffuse) take("albedo", false, t.transmittance);
+  if (type == kMaterialConductor) {
+    take("eta", false, t.eta);
+    take("k", false, t.k);
+    if (t.reflectance != kNoTexture && (m.find("eta") || m.find("k"))) {
+      m.find("reflectance")
+          ->fail(
+              "a conductor takes either 'reflectance' or 'eta' and 'k', not both (as in "
+              "pbrt-v4)");
+    }
+  }
+  if (rough) {
+    uint both = kNoTexture;
+    if (take("roughness", true, both)) t.uRoughness = t.vRoughness = both;
+    take("uroughness", true, t.uRoughness);
+    take("vroughness", true, t.vRoughness);
+    bool remap = true;
+    if (auto n = m.find("remaproughness")) remap = n->boolean();
+    if (remap) t.flags |= kRemapRoughness;
+  }
+  if (type == kMaterialDiffuseTransmission) {
+    if (auto n = m.find("scale"); n && n->json().is_number()) {
+      t.scale = static_cast<float>(n->floatNumber());
+    }
+  }
+  // Alpha and displacement: a texture's name or a number (a constant).
+  const auto floatOrTexture = [&](const char* key, uint& slot) {
+    const std::optional<JsonNode> n = m.find(key);
+    if (!n) return;
+    if (n->json().is_string()) {
+      slot = textures.use(*n, true);
+      return;
+    }
+    const float v = static_cast<float>(n->floatNumber());
+    if (std::string_view(key) == "alpha") {
+      if (!(v >= 0.0f && v <= 1.0f)) n->fail("expected a number in [0, 1], got " + n->describe());
+      if (v == 1.0f) return;  // opaque: nothing to test
+    }
+    slot = textures.constant(vec3(v));
+  };
+  floatOrTexture("alpha", t.alpha);
+  floatOrTexture("displacement", t.displacement);
+  return t;
+}
+
+void readMaterials(const JsonNode& node, Scene& scene, JsonTextures& textures) {
   if (node.size() == 0) node.fail("expected at least one material");
   std::unordered_map<std::string, std::size_t> firstIndex;
   for (std::size_t i = 0; i < node.size(); ++i) {
@@ -439,7 +509,9 @@ void readMaterials(const JsonNode& node, Scene& scene) {
     }
 
     Material material = defaultMaterial(type);
-    readMaterialParameters(m, material);
+    nlohmann::json values;
+    const MaterialTextures materialTextures = readMaterialTextures(m, type, textures, values);
+    readMaterialParameters(JsonNode(values, m.path(), m.file()), material);
     if (auto n = m.find("emission")) {
       const glm::dvec3 e = n->vec3();
       for (std::size_t c = 0; c < 3; ++c) {
@@ -452,6 +524,7 @@ void readMaterials(const JsonNode& node, Scene& scene) {
     if (auto n = m.find("twoSided")) material.twoSided = n->boolean() ? 1u : 0u;
     scene.materials.push_back(material);
     scene.materialNames.push_back(name);
+    setMaterialTextures(scene, scene.materials.size() - 1, materialTextures);
   }
 }
 
@@ -579,6 +652,8 @@ struct ShapeTriangles {
   // Per triangle, the vertex normals as the mesh file gives them (not unit, untransformed;
   // zero where a face has none), or empty when the mesh has no normals.
   std::vector<Tri> normals;
+  // Per triangle, the texture coordinates of its vertices, or empty where the shape has none.
+  std::vector<std::array<glm::vec2, 3>> uvs;
 };
 
 // Scene materials made from MTL files, shared by every shape that uses the same file.
@@ -705,7 +780,8 @@ void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
       }
     }
     const Appended appended =
-        appendTriangle(scene, out, shapeTriangles.normals.empty() ? nullptr : &normals);
+        appendTriangle(scene, out, shapeTriangles.normals.empty() ? nullptr : &normals,
+                       shapeTriangles.uvs.empty() ? nullptr : &shapeTriangles.uvs[i]);
     if (appended == Appended::kZeroArea) ++dropped;
     if (appended == Appended::kTooMany) {
       shape.fail("too many triangles in the scene (at most 4294967295)");
@@ -790,6 +866,10 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
         const std::vector<glm::dvec3> v = readPoints(shape.require("vertices"), 4);
         // Fixed split along the v0-v2 diagonal; both halves keep the quad's winding.
         triangles.triangles = {Tri{v[0], v[1], v[2]}, Tri{v[0], v[2], v[3]}};
+        // The corners' (u, v): (0, 0), (1, 0), (1, 1), (0, 1) in the order given, as pbrt-v4's
+        // bilinear patch maps its four corners.
+        const glm::vec2 c[4] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {1.0f, 1.0f}, {0.0f, 1.0f}};
+        triangles.uvs = {{c[0], c[1], c[2]}, {c[0], c[2], c[3]}};
         break;
       }
       case Kind::kTriangles:
@@ -823,6 +903,8 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
       }
     }
     total += triangles.triangles.size();
+    // Texture coordinates only where some material has a texture (materials come first).
+    if (scene.materialTextures.empty()) triangles.uvs.clear();
     emitTriangles(shape, triangles, transform, material.value_or(0u), scene);
   }
   if (scene.triangles.empty()) {
@@ -908,7 +990,8 @@ void setConductorReflectance(Material& material, vec3 reflectance) {
   }
 }
 
-Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3>* normals) {
+Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3>* normals,
+                        const std::array<glm::vec2, 3>* uvs) {
   const glm::dvec3 e1 = glm::dvec3(t.v1) - glm::dvec3(t.v0);
   const glm::dvec3 e2 = glm::dvec3(t.v2) - glm::dvec3(t.v0);
   if (!(glm::length(glm::cross(e1, e2)) > 1e-12 * glm::length(e1) * glm::length(e2))) {
@@ -942,6 +1025,15 @@ Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3
                                             unitNormal(n[2], ng), 0.0f});
   } else if (!scene.normals.empty()) {
     scene.normals.push_back(flatNormals(t));
+  }
+  if (uvs != nullptr && scene.uvs.empty()) {
+    // The first triangle with texture coordinates: the triangles before it take the defaults.
+    scene.uvs.assign(scene.triangles.size() - 1, defaultTriangleUVs());
+  }
+  if (uvs != nullptr) {
+    scene.uvs.push_back(TriangleUVs{(*uvs)[0], (*uvs)[1], (*uvs)[2], vec2(0.0f)});
+  } else if (!scene.uvs.empty()) {
+    scene.uvs.push_back(defaultTriangleUVs());
   }
   return Appended::kAdded;
 }
@@ -1032,15 +1124,19 @@ Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& optio
   }
   const nlohmann::json document = scene_detail::parseJson(text, file);
   const JsonNode root(document, "", file);
-  root.checkKeys({"description", "camera", "integrator", "materials", "shapes", "lights"});
+  root.checkKeys(
+      {"description", "camera", "integrator", "textures", "materials", "shapes", "lights"});
 
   Scene scene;
   if (auto n = root.find("description")) n->string();
   if (auto n = root.find("camera")) scene.camera = readCamera(*n);
   if (auto n = root.find("integrator")) scene.integrator = readIntegrator(*n);
-  readMaterials(root.require("materials"), scene);
+  scene_detail::JsonTextures textures(scene, path.parent_path());
+  if (auto n = root.find("textures")) textures.read(*n);
+  readMaterials(root.require("materials"), scene, textures);
   readShapes(root.require("shapes"), path, scene);
   if (auto n = root.find("lights")) readLights(*n, scene);
+  padMaterialTextures(scene);
   return scene;
 }
 

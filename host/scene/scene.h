@@ -72,6 +72,15 @@ struct Scene {
   // Vertex normals per triangle, parallel to `triangles`, or empty when no mesh has normals
   // (triangles of meshes without them then repeat their geometric normal).
   std::vector<TriangleNormals> normals;
+  // Texture coordinates per triangle, parallel to `triangles`, or empty when no mesh has any
+  // (once some mesh has them, triangles of meshes without take pbrt-v4's (0,0), (1,0), (1,1)).
+  std::vector<TriangleUVs> uvs;
+  // The textures (shaders/texture.h): their programs' nodes, the image buffer they read, and
+  // per material the textures of its parameters, parallel to `materials` (empty when no
+  // material has a texture). host/scene/textures.h builds them.
+  std::vector<TextureNode> textureNodes;
+  std::vector<uint32_t> imageWords;
+  std::vector<MaterialTextures> materialTextures;
   // Lights that are not triangles (point, spot, distant, infinite), in world space.
   std::vector<Light> lights;
   std::vector<std::string> warnings;  // e.g. dropped zero-area triangles, one line each
@@ -88,6 +97,11 @@ struct SceneLoadOptions {
 // Reads a scene file. Throws InputError with "<file>: <field or line>: <message>" for
 // anything malformed (see docs/scene-format.md). Mesh paths are relative to the JSON file.
 Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& options = {});
+
+// pbrt-v4's texture coordinates for the triangles of a mesh without any: (0,0), (1,0), (1,1).
+inline TriangleUVs defaultTriangleUVs() {
+  return TriangleUVs{vec2(0.0f, 0.0f), vec2(1.0f, 0.0f), vec2(1.0f, 1.0f), vec2(0.0f)};
+}
 
 // A material of type `type` (kMaterial*) with the defaults of docs/scene-format.md (pbrt-v4's,
 // for the types taken from pbrt-v4) and no emission. The JSON reader and the MTL mapping both
@@ -129,7 +143,10 @@ enum class Appended { kAdded, kZeroArea, kTooMany };
 // each is made unit, the geometric normal standing in for one that is zero or not finite.
 // Once some triangle has normals, every triangle has an entry in scene.normals (its geometric
 // normal at all three vertices where its mesh has none).
-Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3>* normals);
+// `uvs`: the vertices' texture coordinates, or null where the mesh has none (scene.uvs then
+// gets pbrt-v4's defaults for it once some triangle has coordinates).
+Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3>* normals,
+                        const std::array<glm::vec2, 3>* uvs = nullptr);
 
 // Makes room for `size` elements, at least doubling the capacity when it grows, so that
 // appending shape after shape costs amortized linear time (std::vector::reserve would allocate

@@ -59,6 +59,18 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       scene.normals.empty() ? std::vector<TriangleNormals>{TriangleNormals{}} : scene.normals;
   const std::vector<Light> lights =
       scene.lights.empty() ? std::vector<Light>{Light{}} : scene.lights;
+  // The texture arrays, one dummy entry each where the scene has no textures; the image
+  // buffer padded to whole 16-byte texels.
+  const auto orDummy = [](const auto& v) {
+    using T = typename std::decay_t<decltype(v)>::value_type;
+    return v.empty() ? std::vector<T>{T{}} : v;
+  };
+  const std::vector<TriangleUVs> uvs = orDummy(scene.uvs);
+  const std::vector<TextureNode> textureNodes = orDummy(scene.textureNodes);
+  std::vector<uint32_t> imageWords = orDummy(scene.imageWords);
+  imageWords.resize((imageWords.size() + 3) / 4 * 4, 0u);
+  const std::vector<MaterialTextures> materialTextures = orDummy(scene.materialTextures);
+  const uint32_t environmentDummy[4] = {0u, 0u, 0u, 0u};
   const GpuBvh bvh = buildGpuBvh(scene.bvh);
   const std::vector<uint32_t> traversal = gpuTraversalTexels(bvh, scene.bvh.triangles);
   // In PT_BINDING_* order, followed by the accumulation and the counters.
@@ -70,10 +82,18 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       {"emitter", emitters.data(), emitters.size() * sizeof(Emitter), true},
       {"vertex normal", normals.data(), normals.size() * sizeof(TriangleNormals), true},
       {"light", lights.data(), lights.size() * sizeof(Light), true},
+      {"environment", environmentDummy, sizeof(environmentDummy), true},
+      {"texture coordinate", uvs.data(), uvs.size() * sizeof(TriangleUVs), true},
+      {"texture", textureNodes.data(), textureNodes.size() * sizeof(TextureNode), true},
+      {"texture image", imageWords.data(), imageWords.size() * sizeof(uint32_t), true},
+      {"material texture", materialTextures.data(),
+       materialTextures.size() * sizeof(MaterialTextures), true},
   };
   static_assert(PT_BINDING_PARAMS == 0 && PT_BINDING_NODES == 1 && PT_BINDING_TRIANGLES == 2 &&
                 PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 && PT_BINDING_NORMALS == 5 &&
-                PT_BINDING_LIGHTS == 6 && PT_BINDING_ACCUM == 7 && PT_BINDING_COUNTERS == 8);
+                PT_BINDING_LIGHTS == 6 && PT_BINDING_ACCUM == 7 && PT_BINDING_COUNTERS == 8 &&
+                PT_BINDING_ENVIRONMENT == 9 && PT_BINDING_UVS == 10 && PT_BINDING_TEXTURES == 11 &&
+                PT_BINDING_IMAGES == 12 && PT_BINDING_MATERIAL_TEXTURES == 13);
   static_assert(std::size(uploads) + 2 == PT_BINDING_COUNT, "every binding is a buffer");
 
   // Every size is checked before anything is allocated: a scene too large for the device is
@@ -87,10 +107,13 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   checkUploads(ctx, uploads);
   buffers.bound = recordUploads(ctx, cmd, uploads, staging);
   for (const Upload& u : uploads) buffers.texels.push_back(u.texels);
+  // The accumulation and the counters between the uploads, at their bindings.
   const auto readWrite = U::eStorageBuffer | U::eTransferSrc | U::eTransferDst;
-  buffers.bound.push_back(makeBuffer(ctx, buffers.accumSize, readWrite, false));
-  buffers.bound.push_back(makeBuffer(ctx, sizeof(DeviceCounters), readWrite, false));
-  buffers.texels.resize(buffers.bound.size(), false);
+  buffers.bound.insert(buffers.bound.begin() + PT_BINDING_ACCUM,
+                       makeBuffer(ctx, buffers.accumSize, readWrite, false));
+  buffers.bound.insert(buffers.bound.begin() + PT_BINDING_COUNTERS,
+                       makeBuffer(ctx, sizeof(DeviceCounters), readWrite, false));
+  buffers.texels.insert(buffers.texels.begin() + PT_BINDING_ACCUM, 2, false);
   buffers.readback =
       makeBuffer(ctx, buffers.accumSize + sizeof(DeviceCounters), U::eTransferDst, true);
   return buffers;
@@ -104,21 +127,39 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   const EffectSet& fx = scene.effects;
   const bool all = !options.specialize;
   const RenderParams& params = scene.params;
-  const SpecData spec{
-      {all || fx.diffuse, all || fx.mirror, all || fx.lightSampling, all || fx.bsdfEmission,
-       all || fx.mis, all || fx.russianRoulette, all ? kSpecAtRunTime : params.fastIntersection,
-       all ? kSpecAtRunTime : params.samplerType, buffers.stackRows, all || fx.conductor,
-       all || fx.dielectric, all || fx.thinDielectric, all || fx.diffuseTransmission,
-       all || fx.coatedDiffuse, all || fx.shadingNormals, all || fx.deltaLights,
-       all || fx.environment, all || fx.twoSidedEmitters, all || fx.sphereLights}};
-  static_assert(
-      PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
-      PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
-      PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
-      PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 && PT_SPEC_THIN_DIELECTRIC == 11 &&
-      PT_SPEC_DIFFUSE_TRANSMISSION == 12 && PT_SPEC_COATED_DIFFUSE == 13 &&
-      PT_SPEC_SHADING_NORMALS == 14 && PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
-      PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_SPHERE_LIGHTS == 18 && PT_SPEC_COUNT == 19);
+  const SpecData spec{{all || fx.diffuse,
+                       all || fx.mirror,
+                       all || fx.lightSampling,
+                       all || fx.bsdfEmission,
+                       all || fx.mis,
+                       all || fx.russianRoulette,
+                       all ? kSpecAtRunTime : params.fastIntersection,
+                       all ? kSpecAtRunTime : params.samplerType,
+                       buffers.stackRows,
+                       all || fx.conductor,
+                       all || fx.dielectric,
+                       all || fx.thinDielectric,
+                       all || fx.diffuseTransmission,
+                       all || fx.coatedDiffuse,
+                       all || fx.shadingNormals,
+                       all || fx.deltaLights,
+                       all || fx.environment,
+                       all || fx.twoSidedEmitters,
+                       all || fx.sphereLights,
+                       /*environment image*/ all,
+                       all || fx.textures,
+                       all || fx.alphaCutouts,
+                       all || fx.bumpMaps}};
+  static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
+                PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
+                PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
+                PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 &&
+                PT_SPEC_THIN_DIELECTRIC == 11 && PT_SPEC_DIFFUSE_TRANSMISSION == 12 &&
+                PT_SPEC_COATED_DIFFUSE == 13 && PT_SPEC_SHADING_NORMALS == 14 &&
+                PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
+                PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_SPHERE_LIGHTS == 18 &&
+                PT_SPEC_ENVIRONMENT_IMAGE == 19 && PT_SPEC_TEXTURES == 20 && PT_SPEC_ALPHA == 21 &&
+                PT_SPEC_BUMP == 22 && PT_SPEC_COUNT == 23);
   std::vector<vk::SpecializationMapEntry> entries;
   for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));
@@ -133,8 +174,9 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   // full shader with those switched off before compiling).
   const Camera& camera = scene.params.camera;
   const bool full = all || fx.hasBsdfMaterials() || fx.shadingNormals || fx.deltaLights ||
-                    fx.environment || fx.twoSidedEmitters || fx.sphereLights ||
-                    camera.filterType != kFilterBox || camera.lensRadius > 0.0f;
+                    fx.environment || fx.twoSidedEmitters || fx.sphereLights || fx.textures ||
+                    fx.alphaCutouts || fx.bumpMaps || camera.filterType != kFilterBox ||
+                    camera.lensRadius > 0.0f;
   const std::span<const uint32_t> spirv = options.context.debugPrintf
                                               ? std::span<const uint32_t>(kPathtraceDebugSpv)
                                           : full ? std::span<const uint32_t>(kPathtraceSpv)

@@ -1,0 +1,263 @@
+#include "scene/textures.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "common/check.h"
+#include "image/texture_image.h"
+
+namespace pt {
+
+namespace {
+
+uint floatWord(float f) {
+  uint w;
+  std::memcpy(&w, &f, sizeof w);
+  return w;
+}
+
+// The sRGB curve's decoding (IEC 61966-2-1), in double.
+double srgbDecode(double c) {
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+// A value of an encoded channel in [0, 1] made linear: sRGB (gamma 0) or the power gamma.
+double decodeEncoded(double c, double gamma) {
+  return gamma == 0.0 ? srgbDecode(c) : std::pow(c, gamma);
+}
+
+}  // namespace
+
+bool parseColorEncoding(const std::string& encoding, double& gamma) {
+  if (encoding == "sRGB") {
+    gamma = 0.0;
+    return true;
+  }
+  if (encoding == "linear") {
+    gamma = 1.0;
+    return true;
+  }
+  if (encoding.rfind("gamma ", 0) == 0) {
+    const std::string number = encoding.substr(6);
+    char* end = nullptr;
+    const double g = std::strtod(number.c_str(), &end);
+    if (end != number.c_str() && *end == '\0' && std::isfinite(g) && g > 0.0) {
+      gamma = g;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool parseWrapMode(const std::string& name, uint& wrap) {
+  if (name == "repeat") {
+    wrap = kWrapRepeat;
+  } else if (name == "clamp") {
+    wrap = kWrapClamp;
+  } else if (name == "black") {
+    wrap = kWrapBlack;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+void setMaterialTextures(Scene& scene, std::size_t material, const MaterialTextures& t) {
+  PT_CHECK(material < scene.materials.size(), "textures for a material that does not exist");
+  if (scene.materialTextures.empty() && !hasTextures(t)) return;
+  scene.materialTextures.resize(scene.materials.size(), noMaterialTextures());
+  scene.materialTextures[material] = t;
+}
+
+void padMaterialTextures(Scene& scene) {
+  if (scene.materialTextures.empty()) return;
+  scene.materialTextures.resize(scene.materials.size(), noMaterialTextures());
+}
+
+uint TextureBuilder::constant(vec3 value) {
+  TextureNode node{};
+  node.type = kTextureConstant;
+  node.value = value;
+  node.count = 1;
+  scene_.textureNodes.push_back(node);
+  return uint(scene_.textureNodes.size() - 1);
+}
+
+// One table of 256 floats per encoding, in the image buffer: what each byte value decodes to.
+uint TextureBuilder::decodeTable(double gamma) {
+  const auto found = decodeTables_.find(gamma);
+  if (found != decodeTables_.end()) return found->second;
+  const uint at = uint(scene_.imageWords.size());
+  for (int b = 0; b < 256; ++b) {
+    scene_.imageWords.push_back(floatWord(float(decodeEncoded(b / 255.0, gamma))));
+  }
+  decodeTables_.emplace(gamma, at);
+  return at;
+}
+
+const TextureBuilder::StoredImage& TextureBuilder::storeImage(const std::filesystem::path& path,
+                                                              const std::string& encoding) {
+  double gamma = 0.0;
+  if (!parseColorEncoding(encoding, gamma)) {
+    throw InputError(path.string() + ": unknown colour encoding '" + encoding +
+                     "' (expected \"sRGB\", \"linear\" or \"gamma <g>\" with g > 0)");
+  }
+  const auto key = std::make_tuple(path.lexically_normal().string(), encoding);
+  const auto found = images_.find(key);
+  if (found != images_.end()) return found->second;
+  return images_.emplace(key, storeDecoded(readTextureImage(path), path, encoding)).first->second;
+}
+
+TextureBuilder::StoredImage TextureBuilder::storeDecoded(const TextureImage& image,
+                                                         const std::filesystem::path& path,
+                                                         const std::string& encoding) {
+  double gamma = 0.0;
+  if (!parseColorEncoding(encoding, gamma)) {
+    throw InputError(path.string() + ": unknown colour encoding '" + encoding +
+                     "' (expected \"sRGB\", \"linear\" or \"gamma <g>\" with g > 0)");
+  }
+  PT_CHECK(image.width > 0 && image.height > 0, "an image reader returned an empty image");
+  PT_CHECK(image.channels == 1 || image.channels == 3 || image.channels == 4,
+           "an image reader returned " + std::to_string(image.channels) + " channels");
+  const std::size_t texels = std::size_t(image.width) * std::size_t(image.height);
+  const std::size_t c = std::size_t(image.channels);
+  StoredImage stored;
+  stored.width = uint(image.width);
+  stored.height = uint(image.height);
+  // What a float texture reads (pbrt-v4's MIPMap): the grey channel, the alpha where some
+  // texel is not opaque (it drops an alpha channel of ones), else the average of R, G, B.
+  bool opaque = true;
+  if (c == 4) {
+    for (std::size_t i = 0; i < texels && opaque; ++i) {
+      opaque = image.eightBit() ? image.bytes[4 * i + 3] == 255 : image.floats[4 * i + 3] == 1.0f;
+    }
+  }
+  stored.floatChannel = c == 1                ? kFloatChannelFirst
+                        : (c == 4 && !opaque) ? kFloatChannelAlpha
+                                              : kFloatChannelAverage;
+  const std::size_t words = image.eightBit() ? texels : texels * (c == 1 ? 1 : c == 3 ? 3 : 4);
+  if (scene_.imageWords.size() + words + 256 > std::size_t(UINT32_MAX)) {
+    throw InputError(path.string() + ": the scene's images exceed 2^32 words (16 GiB)");
+  }
+  if (image.eightBit()) {
+    stored.format = kTexel8;
+    stored.decode = decodeTable(gamma);
+    stored.texels = uint(scene_.imageWords.size());
+    scene_.imageWords.reserve(scene_.imageWords.size() + texels);
+    for (std::size_t i = 0; i < texels; ++i) {
+      const uint8_t* t = &image.bytes[c * i];
+      const uint r = t[0];
+      const uint g = c >= 3 ? t[1] : t[0];
+      const uint b = c >= 3 ? t[2] : t[0];
+      const uint a = c == 4 ? t[3] : 255u;
+      scene_.imageWords.push_back(r | g << 8 | b << 16 | a << 24);
+    }
+  } else {
+    stored.format = c == 1 ? kTexelFloat1 : c == 3 ? kTexelFloat3 : kTexelFloat4;
+    stored.texels = uint(scene_.imageWords.size());
+    scene_.imageWords.reserve(scene_.imageWords.size() + texels * c);
+    for (std::size_t i = 0; i < texels * c; ++i) {
+      float v = image.floats[i];
+      // 16-bit PNGs hold encoded values, decoded here as pbrt-v4 decodes them (to half floats;
+      // we keep floats).
+      if (image.floatsEncoded) v = float(decodeEncoded(std::clamp(double(v), 0.0, 1.0), gamma));
+      if (!std::isfinite(v)) {
+        throw InputError(path.string() + ": texel " + std::to_string(i / c) + " (row " +
+                         std::to_string(i / c / std::size_t(image.width)) +
+                         ") is not a finite number");
+      }
+      scene_.imageWords.push_back(floatWord(v));
+    }
+  }
+  return stored;
+}
+
+uint TextureBuilder::image(const ImageTextureDesc& desc, bool isFloat) {
+  return imageNode(storeImage(desc.filename, desc.encoding), desc, isFloat);
+}
+
+uint TextureBuilder::image(const TextureImage& image, const ImageTextureDesc& desc, bool isFloat) {
+  return imageNode(storeDecoded(image, desc.filename, desc.encoding), desc, isFloat);
+}
+
+uint TextureBuilder::imageNode(const StoredImage& stored, const ImageTextureDesc& desc,
+                               bool isFloat) {
+  TextureNode node{};
+  node.type = kTextureImage;
+  node.value = vec3(desc.scale);
+  node.mapping = desc.mapping;
+  node.texels = stored.texels;
+  node.width = stored.width;
+  node.height = stored.height;
+  node.decode = stored.decode;
+  node.flags = stored.format | desc.wrap << 4 | desc.filter << 8 | stored.floatChannel << 12 |
+               (desc.invert ? kTextureInvert : 0u) | (isFloat ? kTextureFloat : 0u);
+  node.count = 1;
+  scene_.textureNodes.push_back(node);
+  return uint(scene_.textureNodes.size() - 1);
+}
+
+uint TextureBuilder::composite(std::vector<uint> operands, TextureNode node) {
+  std::vector<TextureNode> program;
+  for (uint first : operands) {
+    PT_CHECK(first < scene_.textureNodes.size(), "a texture index beyond the nodes");
+    const uint count = scene_.textureNodes[first].count;
+    for (uint i = 0; i < count; ++i) {
+      TextureNode copy = scene_.textureNodes[first + i];
+      copy.count = 0;
+      program.push_back(copy);
+    }
+  }
+  program.push_back(node);
+  if (program.size() > kMaxProgram) {
+    throw InputError("the texture combines more than " + std::to_string(kMaxProgram) + " textures");
+  }
+  program.front().count = uint(program.size());
+  const uint first = uint(scene_.textureNodes.size());
+  scene_.textureNodes.insert(scene_.textureNodes.end(), program.begin(), program.end());
+  if (stackDepth(first) > kTextureStackSize) {
+    scene_.textureNodes.resize(first);
+    throw InputError("the texture nests textures more than " + std::to_string(kTextureStackSize) +
+                     " deep");
+  }
+  return first;
+}
+
+uint TextureBuilder::stackDepth(uint first) const {
+  uint top = 0;
+  uint deepest = 0;
+  const uint count = scene_.textureNodes[first].count;
+  for (uint i = 0; i < count; ++i) {
+    const uint type = scene_.textureNodes[first + i].type;
+    const uint pops = type == kTextureCheckerboard || type == kTextureScale ? 2
+                      : type == kTextureMix                                 ? 3
+                                                                            : 0;
+    PT_CHECK(top >= pops, "a texture program pops more than it pushed");
+    top = top - pops + 1;
+    deepest = std::max(deepest, top);
+  }
+  PT_CHECK(top == 1, "a texture program leaves other than one value");
+  return deepest;
+}
+
+uint TextureBuilder::checkerboard(vec4 mapping, uint tex1, uint tex2) {
+  TextureNode node{};
+  node.type = kTextureCheckerboard;
+  node.mapping = mapping;
+  return composite({tex1, tex2}, node);
+}
+
+uint TextureBuilder::scale(uint tex, uint scale) {
+  TextureNode node{};
+  node.type = kTextureScale;
+  return composite({tex, scale}, node);
+}
+
+uint TextureBuilder::mix(uint tex1, uint tex2, uint amount) {
+  TextureNode node{};
+  node.type = kTextureMix;
+  return composite({tex1, tex2, amount}, node);
+}
+
+}  // namespace pt
