@@ -1,7 +1,9 @@
 // Tests of the OBJ reader's vertex normals (host/scene/obj_mesh): `v//vn` and `v/vt/vn`
 // references give one normal triple per triangle, fanned like the triangles; faces without
 // normals among faces with them get zeros; a file whose faces reference no normal gives none;
-// `vn` lines that are not three finite floats give their one-line message. The reader's other
+// `vn` lines that are not three finite floats give their one-line message. Texture
+// coordinates likewise: `v/vt` and `v/vt/vn` give one triple per triangle, faces without
+// them get pbrt-v4's defaults, malformed `vt` lines their message. The reader's other
 // messages are tested through the scene loader (scene_test.cpp).
 #include <gtest/gtest.h>
 
@@ -141,6 +143,115 @@ TEST(ObjMeshNormals, MalformedNormalLines) {
   EXPECT_EQ(objError(kVertices + "f 1//-1 2//1 3//1\nvn 0 0 1\n"),
             "bad.obj: line 6: normal index -1 out of range (0 normals defined before this line)" +
                 kContext);
+}
+
+// ---- Texture coordinates ----
+
+// Lines 6-10 (after kVertices): a texture coordinate for each vertex, distinct, exact in a
+// float, some outside [0, 1] and negative (kept as written, not flipped or wrapped).
+const std::string kTexcoords = "vt 0.25 0.5\nvt 0.75 -0.125\nvt 1.5 1 0.5\nvt 0 2\nvt -0.5 0.375\n";
+const std::vector<glm::vec2> kUvValues = {
+    {0.25f, 0.5f}, {0.75f, -0.125f}, {1.5f, 1.0f}, {0.0f, 2.0f}, {-0.5f, 0.375f}};
+
+// Checks the texture coordinates of triangle t against the indices `uvs` into kUvValues
+// (all -1: pbrt-v4's defaults (0,0), (1,0), (1,1)).
+void expectUvs(const ObjMesh& mesh, std::size_t t, const std::array<int, 3>& uvs) {
+  ASSERT_LT(t, mesh.uvs.size());
+  const std::array<glm::vec2, 3> defaults = {glm::vec2(0, 0), glm::vec2(1, 0), glm::vec2(1, 1)};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const glm::vec2 uv = uvs[k] < 0 ? defaults[k] : kUvValues[static_cast<std::size_t>(uvs[k])];
+    EXPECT_EQ(mesh.uvs[t][k], uv) << "triangle " << t << " vertex " << k;
+  }
+}
+
+TEST(ObjMeshUvs, TextureReferencesFollowTheFan) {
+  // v/vt and v/vt/vn; the texture coordinate of each corner differs from its vertex index,
+  // and negative (relative) indices.
+  const ObjMesh mesh = load(kVertices + kTexcoords + kNormals +
+                            "f 1/5 2/4 3/3 4/2 5/1\nf 2/1/1 3/1/1 4/2/2\nf -5/-1 -4/-2 -3/-3\n");
+  ASSERT_EQ(mesh.triangles.size(), 5u);
+  ASSERT_EQ(mesh.uvs.size(), 5u);
+  expectUvs(mesh, 0, {4, 3, 2});
+  expectUvs(mesh, 1, {4, 2, 1});
+  expectUvs(mesh, 2, {4, 1, 0});
+  expectUvs(mesh, 3, {0, 0, 1});
+  expectUvs(mesh, 4, {4, 3, 2});
+  // Normals only where referenced (face 2): zeros elsewhere.
+  ASSERT_EQ(mesh.normals.size(), 5u);
+  expectTriangle(mesh, 3, {1, 2, 3}, {0, 0, 1});
+  EXPECT_EQ(mesh.normals[0][0], glm::dvec3(0.0));
+}
+
+TEST(ObjMeshUvs, FacesWithoutTextureCoordinatesGetTheDefaults) {
+  // Without (v), with (v/vt), without (v//vn), with (v/vt/vn), at only some corners: the
+  // defaults for each triangle of the faces without, also for those before the first with.
+  const ObjMesh mesh = load(kVertices + kTexcoords + kNormals +
+                            "f 1 2 3 4\nf 1/1 2/2 3/3\nf 1//1 3//1 4//1\n"
+                            "f 2/4/4 3/5/5 4/1/1\nf 1/1 2 3\nf 2 3/2/1 4 5\n");
+  ASSERT_EQ(mesh.triangles.size(), 8u);
+  ASSERT_EQ(mesh.uvs.size(), 8u);
+  expectUvs(mesh, 0, {-1, -1, -1});
+  expectUvs(mesh, 1, {-1, -1, -1});
+  expectUvs(mesh, 2, {0, 1, 2});
+  expectUvs(mesh, 3, {-1, -1, -1});
+  expectUvs(mesh, 4, {3, 4, 0});
+  expectUvs(mesh, 5, {-1, -1, -1});
+  expectUvs(mesh, 6, {-1, -1, -1});
+  expectUvs(mesh, 7, {-1, -1, -1});
+  EXPECT_EQ(mesh.material.size(), 8u);
+  EXPECT_EQ(mesh.normals.size(), 8u);
+}
+
+TEST(ObjMeshUvs, FilesWhoseFacesReferenceNoTextureCoordinateHaveNone) {
+  EXPECT_TRUE(load(kVertices + "f 1 2 3 4\n").uvs.empty());
+  // Texture coordinates defined but not referenced by faces (normals, lines and points).
+  const ObjMesh mesh =
+      load(kVertices + kTexcoords + kNormals + "f 1//1 2//1 3//1\nf 1 3 4\nl 1/1 2/2\np 3/3\n");
+  EXPECT_EQ(mesh.triangles.size(), 2u);
+  EXPECT_TRUE(mesh.uvs.empty());
+  EXPECT_EQ(mesh.normals.size(), 2u);
+}
+
+TEST(ObjMeshUvs, TextureCoordinatesAreKeptAsRead) {
+  // A missing v is 0; w is ignored; signs, exponents.
+  const ObjMesh mesh = load(kVertices + "vt 0.5\nvt +3 -0 7\nvt 0.125e0 2E1 .5 9\nf 1/1 2/2 3/3\n");
+  ASSERT_EQ(mesh.uvs.size(), 1u);
+  EXPECT_EQ(mesh.uvs[0][0], glm::vec2(0.5f, 0.0f));
+  EXPECT_EQ(mesh.uvs[0][1], glm::vec2(3.0f, 0.0f));
+  EXPECT_EQ(mesh.uvs[0][2], glm::vec2(0.125f, 20.0f));
+}
+
+TEST(ObjMeshUvs, MalformedTextureCoordinateLines) {
+  // Line 6 is the `vt` line; it is checked whether or not a face uses it.
+  const std::string face = "f 1/1 2/1 3/1\n";
+  EXPECT_EQ(objError(kVertices + "vt 0 nan\n" + face),
+            "bad.obj: line 6: non-finite texture coordinate value 'nan'" + kContext);
+  EXPECT_EQ(objError(kVertices + "vt -inf 0\nf 1 2 3\n"),
+            "bad.obj: line 6: non-finite texture coordinate value '-inf'" + kContext);
+  EXPECT_EQ(objError(kVertices + "vt 0 1e39\n" + face),
+            "bad.obj: line 6: non-finite texture coordinate value '1e39' (too large for a 32-bit "
+            "float)" +
+                kContext);
+  EXPECT_EQ(objError(kVertices + "vt 0 x\n" + face),
+            "bad.obj: line 6: texture coordinate value 'x' is not a number" + kContext);
+  EXPECT_EQ(objError(kVertices + "vt \n" + face),
+            "bad.obj: line 6: texture coordinate has no values (need at least u)" + kContext);
+  // A w is not read, so not checked.
+  EXPECT_EQ(load(kVertices + "vt 0 1 nan\n" + face).uvs.size(), 1u);
+  // References to texture coordinates that do not exist.
+  EXPECT_EQ(objError(kVertices + "vt 0 0\nf 1/1 2/2 3/1\n"),
+            "bad.obj: line 7: texture coordinate index 2 out of range (file has 1 texture "
+            "coordinates)" +
+                kContext);
+  EXPECT_EQ(objError(kVertices + "f 1/-1 2/1 3/1\nvt 0 0\n"),
+            "bad.obj: line 6: texture coordinate index -1 out of range (0 texture coordinates "
+            "defined before this line)" +
+                kContext);
+  EXPECT_EQ(
+      objError(kVertices + "vt 0 0\nf 1/0 2/1 3/1\n"),
+      "bad.obj: line 7: texture coordinate index 0 is invalid (OBJ indices start at 1)" + kContext);
+  EXPECT_EQ(objError(kVertices + "vt 0 0\nf 1/1/ 2/1 3/1\n"),
+            "bad.obj: line 7: malformed vertex reference '1/1/'" + kContext);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // Tests of the PLY reader (host/scene/ply_mesh): one mesh in many layouts and all three
-// formats gives exactly the OBJ reader's triangles; vertex normals follow the triangles;
-// every kind of malformed file gives its one-line message; no truncation or corruption of a
-// file crashes the reader.
+// formats gives exactly the OBJ reader's triangles; vertex normals and texture coordinates
+// follow the triangles; every kind of malformed file gives its one-line message; no
+// truncation or corruption of a file crashes the reader.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -442,6 +442,160 @@ TEST(PlyMesh, FilesWithoutNormalsHaveNone) {
   }
 }
 
+// ---- Texture coordinates ----
+
+// The property name pairs pbrt-v4 accepts, in its order of preference.
+const std::vector<std::array<std::string, 2>> kUvNames = {
+    {"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
+
+// A texture coordinate per vertex of kVertices, distinct, exact in a float, some outside
+// [0, 1] (kept as read).
+glm::vec2 vertexUv(std::size_t i) {
+  return {0.125f * float(i), 1.0f - 0.375f * float(i)};
+}
+
+// The vertex element with texture coordinates named `names` and of `type`, v before u and
+// between the coordinates; with `normals`, normals too; with `list`, a list property too
+// (binary: entries of varying size).
+Elem uvVertices(const std::string& type, const std::array<std::string, 2>& names, bool list,
+                bool normals = false) {
+  Elem vertex{"vertex",
+              {{"float", "x", ""},
+               {type, names[1], ""},
+               {"uchar", "flags", ""},
+               {"float", "y", ""},
+               {type, names[0], ""},
+               {"float", "z", ""}},
+              {}};
+  if (normals) {
+    vertex.props.insert(vertex.props.end(),
+                        {{"float", "nx", ""}, {"float", "ny", ""}, {"float", "nz", ""}});
+  }
+  if (list) vertex.props.push_back({"float", "uvlist", "uint8"});
+  for (std::size_t i = 0; i < kVertices.size(); ++i) {
+    const glm::dvec3& v = kVertices[i];
+    const glm::vec2 uv = vertexUv(i);
+    std::vector<double> row = {v.x, uv.y, double(i), v.y, uv.x, v.z};
+    if (normals) {
+      const glm::dvec3 n = vertexNormal(i);
+      row.insert(row.end(), {n.x, n.y, n.z});
+    }
+    if (list) {
+      row.push_back(double(i % 3));
+      for (std::size_t k = 0; k < i % 3; ++k) row.push_back(0.5 * double(k));
+    }
+    vertex.rows.push_back(row);
+  }
+  return vertex;
+}
+
+// Checks triangle t of `mesh` against the vertex indices `expected`, points and texture
+// coordinates.
+void expectUvTriangle(const PlyMesh& mesh, std::size_t t, const std::array<int, 3>& expected) {
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::size_t v = static_cast<std::size_t>(expected[k]);
+    EXPECT_EQ(mesh.triangles[t][k], kVertices[v]) << "triangle " << t << " vertex " << k;
+    EXPECT_EQ(mesh.uvs[t][k], vertexUv(v)) << "triangle " << t << " vertex " << k;
+  }
+}
+
+TEST(PlyMeshUvs, UvsFollowTheFannedPolygons) {
+  // kFaces fanned as (0, i, i + 1).
+  const std::vector<std::array<int, 3>> expected = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {1, 6, 2},
+                                                    {1, 2, 4}, {1, 4, 3}, {4, 5, 6}};
+  for (const std::string& format : kFormats) {
+    for (const std::string type : {"float", "double"}) {
+      for (const std::array<std::string, 2>& names : kUvNames) {
+        for (const bool list : {false, true}) {
+          SCOPED_TRACE(format + ", " + type + " " + names[0] + "/" + names[1] +
+                       (list ? ", vertex list" : ""));
+          std::vector<Elem> elements = meshElements(kLayouts[0]);
+          elements[0] = uvVertices(type, names, list);
+          const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "uvs.ply", kContext);
+          ASSERT_EQ(mesh.triangles.size(), expected.size());
+          ASSERT_EQ(mesh.uvs.size(), expected.size());
+          EXPECT_TRUE(mesh.normals.empty());
+          for (std::size_t t = 0; t < expected.size(); ++t) {
+            expectUvTriangle(mesh, t, expected[t]);
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(PlyMeshUvs, UvsAndNormalsTogether) {
+  const std::vector<std::array<int, 3>> expected = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {1, 6, 2},
+                                                    {1, 2, 4}, {1, 4, 3}, {4, 5, 6}};
+  for (const std::string& format : kFormats) {
+    for (const bool list : {false, true}) {
+      SCOPED_TRACE(format + (list ? ", vertex list" : ""));
+      std::vector<Elem> elements = meshElements(kLayouts[0]);
+      elements[0] = uvVertices("float", kUvNames[0], list, /*normals=*/true);
+      const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "uvs.ply", kContext);
+      ASSERT_EQ(mesh.uvs.size(), expected.size());
+      ASSERT_EQ(mesh.normals.size(), expected.size());
+      for (std::size_t t = 0; t < expected.size(); ++t) {
+        expectUvTriangle(mesh, t, expected[t]);
+        for (std::size_t k = 0; k < 3; ++k) {
+          EXPECT_EQ(mesh.normals[t][k], vertexNormal(static_cast<std::size_t>(expected[t][k])));
+        }
+      }
+    }
+  }
+}
+
+TEST(PlyMeshUvs, UvsFollowTheTristrips) {
+  std::vector<Elem> elements = meshElements(kLayouts[0]);
+  elements[0] = uvVertices("float", kUvNames[1], false);
+  elements[1] = {"tristrips",
+                 {{"int", "vertex_indices", "int"}},
+                 {{15, 0, 1, 2, 3, -1, 4, 5, 6, 3, -1, 0, 1, 1, 2, 3}}};
+  const std::vector<std::array<int, 3>> expected = {
+      {0, 1, 2}, {2, 1, 3}, {4, 5, 6}, {6, 5, 3}, {1, 2, 3}};
+  for (const std::string& format : kFormats) {
+    SCOPED_TRACE(format);
+    const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "strips.ply", kContext);
+    ASSERT_EQ(mesh.triangles.size(), expected.size());
+    ASSERT_EQ(mesh.uvs.size(), expected.size());
+    for (std::size_t t = 0; t < expected.size(); ++t) expectUvTriangle(mesh, t, expected[t]);
+  }
+}
+
+TEST(PlyMeshUvs, DoubleUvsAreRoundedToFloat) {
+  for (const std::string& format : kFormats) {
+    for (const std::string type : {"float", "double"}) {
+      SCOPED_TRACE(format + " " + type);
+      const std::vector<Elem> elements = {
+          {"vertex",
+           {{"float", "x", ""},
+            {"float", "y", ""},
+            {"float", "z", ""},
+            {type, "texture_u", ""},
+            {type, "texture_v", ""}},
+           {{0, 0, 0, 0.1, -2.5}, {1, 0, 0, 0, 0}, {0, 1, 0, 1e-3, 0.3}}},
+          {"face", {{"int", "vertex_indices", "uchar"}}, {{3, 0, 1, 2}}}};
+      const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "m.ply", kContext);
+      ASSERT_EQ(mesh.uvs.size(), 1u);
+      EXPECT_EQ(mesh.uvs[0][0], glm::vec2(0.1f, -2.5f));
+      EXPECT_EQ(mesh.uvs[0][1], glm::vec2(0.0f));
+      EXPECT_EQ(mesh.uvs[0][2], glm::vec2(1e-3f, 0.3f));
+    }
+  }
+}
+
+TEST(PlyMeshUvs, FilesWithoutUvsHaveNone) {
+  for (const std::string& format : kFormats) {
+    SCOPED_TRACE(format);
+    for (const Layout& layout : kLayouts) {
+      const PlyMesh mesh =
+          loadPlyMesh(plyFile(format, meshElements(layout)), "plain.ply", kContext);
+      EXPECT_EQ(mesh.triangles.size(), 7u);
+      EXPECT_TRUE(mesh.uvs.empty());
+    }
+  }
+}
+
 // ---- Malformed files ----
 
 // The message for `bytes`, checked to be one line naming the file and ending with the
@@ -784,6 +938,94 @@ TEST(PlyMesh, NormalErrors) {
   }
 }
 
+TEST(PlyMeshUvs, TheFirstWholePairIsRead) {
+  // u, v before s, t, whatever the header order; a name alone does not count when a later
+  // pair is whole (pbrt-v4 reads that pair too).
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nproperty float s\nproperty float t\nproperty float u\n"
+      "property float v\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string data = "0 0 0 1 2 3 4\n1 0 0 5 6 7 8\n0 1 0 9 10 11 12\n3 0 1 2\n";
+  PlyMesh mesh = loadPlyMesh(header + data, "m.ply", kContext);
+  ASSERT_EQ(mesh.uvs.size(), 1u);
+  EXPECT_EQ(mesh.uvs[0][0], glm::vec2(3, 4));
+  EXPECT_EQ(mesh.uvs[0][2], glm::vec2(11, 12));
+  mesh = loadPlyMesh(replaced(header, "property float v\n", "property float w\n") + data, "m.ply",
+                     kContext);
+  ASSERT_EQ(mesh.uvs.size(), 1u);
+  EXPECT_EQ(mesh.uvs[0][0], glm::vec2(1, 2));
+  EXPECT_EQ(mesh.uvs[0][1], glm::vec2(5, 6));
+}
+
+// Lines 1-11 the header, 12-14 the vertices, 15 the face.
+const std::string kUvHeader =
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+    "property float z\nproperty float u\nproperty float v\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+const std::string kUvAscii = kUvHeader + "0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n3 0 1 2\n";
+
+TEST(PlyMeshUvs, UvErrors) {
+  ASSERT_EQ(loadPlyMesh(kUvAscii, "good.ply", kContext).uvs.size(), 1u);
+  // One of a pair alone: its line.
+  EXPECT_EQ(plyError(replaced(kUvAscii, "property float v\n", "")),
+            "bad.ply: line 7: vertex property 'u' without 'v' (texture coordinates need both "
+            "'u' and 'v')" +
+                kContext);
+  EXPECT_EQ(plyError(replaced(kUvAscii, "property float u\n", "property float w\n")),
+            "bad.ply: line 8: vertex property 'v' without 'u' (texture coordinates need both "
+            "'u' and 'v')" +
+                kContext);
+  EXPECT_EQ(plyError(replaced(replaced(kUvAscii, "property float u\n", "property float q\n"),
+                              "property float v\n", "property double texture_t\n")),
+            "bad.ply: line 8: vertex property 'texture_t' without 'texture_s' (texture "
+            "coordinates need both 'texture_s' and 'texture_t')" +
+                kContext);
+  // Types, duplicates.
+  EXPECT_EQ(
+      plyError(replaced(kUvAscii, "property float v", "property ushort v")),
+      "bad.ply: line 8: vertex property 'v' is 'ushort' (it must be float or double)" + kContext);
+  EXPECT_EQ(
+      plyError(replaced(kUvAscii, "property float u", "property list uchar float u")),
+      "bad.ply: line 7: vertex property 'u' is a list (it must be float or double)" + kContext);
+  EXPECT_EQ(
+      plyError(replaced(kUvAscii, "property float v\n", "property float v\nproperty double u\n")),
+      "bad.ply: line 9: element 'vertex' already has a property 'u' (line 7)" + kContext);
+  // Values (ascii).
+  EXPECT_EQ(plyError(replaced(kUvAscii, "1 0 0 1 0\n", "1 0 0 nan 0\n")),
+            "bad.ply: vertex 1 (line 13): texture coordinate is not finite (u = 'nan')" + kContext);
+  EXPECT_EQ(
+      plyError(replaced(kUvAscii, "0 1 0 0 1\n", "0 1 0 0 -inf\n")),
+      "bad.ply: vertex 2 (line 14): texture coordinate is not finite (v = '-inf')" + kContext);
+  EXPECT_EQ(plyError(replaced(kUvAscii, "0 0 0 0 0\n", "0 0 0 0 1e39\n")),
+            "bad.ply: vertex 0 (line 12): texture coordinate is too large for a 32-bit float "
+            "(v = '1e39')" +
+                kContext);
+  EXPECT_EQ(plyError(replaced(kUvAscii, "1 0 0 1 0\n", "1 0 0 abc 0\n")),
+            "bad.ply: vertex 1 (line 13): texture coordinate u 'abc' is not a number" + kContext);
+  // Values (binary), for entries of one size and, with a vertex list, of varying size.
+  for (const std::string& format : {kFormats[1], kFormats[2]}) {
+    for (const bool list : {false, true}) {
+      SCOPED_TRACE(format + (list ? ", vertex list" : ""));
+      std::vector<Elem> elements = meshElements(kLayouts[0]);
+      // Properties: x v flags y u z.
+      elements[0] = uvVertices("float", kUvNames[0], list);
+      elements[0].rows[3][1] = std::numeric_limits<double>::quiet_NaN();
+      EXPECT_EQ(plyError(plyFile(format, elements)),
+                "bad.ply: vertex 3: texture coordinate is not finite (v = nan)" + kContext);
+      elements[0] = uvVertices("float", kUvNames[2], list);
+      elements[0].rows[5][4] = -std::numeric_limits<double>::infinity();
+      EXPECT_EQ(plyError(plyFile(format, elements)),
+                "bad.ply: vertex 5: texture coordinate is not finite (texture_u = inf)" + kContext);
+      elements[0] = uvVertices("double", kUvNames[1], list);
+      elements[0].rows[2][4] = 1e300;
+      EXPECT_EQ(plyError(plyFile(format, elements)),
+                "bad.ply: vertex 2: texture coordinate is too large for a 32-bit float (s = "
+                "1e+300)" +
+                    kContext);
+    }
+  }
+}
+
 TEST(PlyMesh, MessagesCarryTheContextAndEscapeControlCharacters) {
   const std::string message = plyError(replaced(kAscii, "1 0 0\n", "1 \x01\x02 0\n"));
   EXPECT_NE(message.find("coordinate y '\\x01\\x02' is not a number"), std::string::npos)
@@ -823,6 +1065,41 @@ TEST(PlyMesh, TruncationsAndCorruptionsNeverCrash) {
         bytes[at] = rng() % 2 ? interesting[rng() % 13] : static_cast<char>(rng());
       }
       tryLoad(bytes);
+    }
+  }
+}
+
+// The same with texture coordinates and normals, for entries of one size and of varying size.
+TEST(PlyMeshUvs, TruncationsAndCorruptionsNeverCrash) {
+  std::mt19937 rng(54321);
+  for (const std::string& format : kFormats) {
+    for (const bool list : {false, true}) {
+      SCOPED_TRACE(format + (list ? ", vertex list" : ""));
+      std::vector<Elem> elements = meshElements(kLayouts[0]);
+      elements[0] = uvVertices("float", kUvNames[3], list, /*normals=*/true);
+      const std::string file = plyFile(format, elements);
+      const std::size_t headerSize = plyHeader(format, elements).size();
+      auto tryLoad = [&](const std::string& bytes) {
+        try {
+          const PlyMesh mesh = loadPlyMesh(bytes, "fuzz.ply", kContext);
+          ASSERT_TRUE(mesh.uvs.empty() || mesh.uvs.size() == mesh.triangles.size());
+          for (const auto& tri : mesh.uvs) {
+            for (const glm::vec2& uv : tri) ASSERT_TRUE(std::isfinite(uv.x) && std::isfinite(uv.y));
+          }
+        } catch (const InputError&) {
+        }
+      };
+      for (std::size_t n = 0; n < file.size(); ++n) tryLoad(file.substr(0, n));
+      for (int round = 0; round < 1000; ++round) {
+        std::string bytes = file;
+        const int edits = 1 + static_cast<int>(rng() % 4);
+        for (int k = 0; k < edits; ++k) {
+          const std::size_t at = rng() % 2 ? rng() % headerSize : rng() % bytes.size();
+          const char* interesting = "0123456789 \n-";
+          bytes[at] = rng() % 2 ? interesting[rng() % 13] : static_cast<char>(rng());
+        }
+        tryLoad(bytes);
+      }
     }
   }
 }

@@ -1,7 +1,8 @@
 // OBJ loading: a light pre-scan of the text gives line-accurate errors for what
 // tinyobjloader would silently accept or mangle (index 0, out-of-range indices, unparsable
-// or non-finite coordinates and normals, polygons of more than 255 vertices); tinyobjloader
-// then does the actual load and the faces are fan-triangulated here, with their normals.
+// or non-finite coordinates, texture coordinates and normals, polygons of more than 255
+// vertices); tinyobjloader then does the actual load and the faces are fan-triangulated
+// here, with their normals and texture coordinates.
 #include "scene/obj_mesh.h"
 
 #include <charconv>
@@ -130,6 +131,8 @@ class ObjScanner {
       vertexLines_.push_back(lineNumber);
       ++sofar_.vertices;
     } else if (key == "vt") {
+      texcoord(rest);
+      texcoordLines_.push_back(lineNumber);
       ++sofar_.texcoords;
     } else if (key == "vn") {
       normal(rest);
@@ -153,6 +156,7 @@ class ObjScanner {
 
   const std::vector<std::size_t>& vertexLines() const { return vertexLines_; }
   const std::vector<std::size_t>& normalLines() const { return normalLines_; }
+  const std::vector<std::size_t>& texcoordLines() const { return texcoordLines_; }
   std::int64_t faces() const { return sofar_.faces; }
 
   [[noreturn]] void fail(std::size_t line, const std::string& problem) const {
@@ -166,6 +170,16 @@ class ObjScanner {
   // short line or a value beyond the float range would give a normal other than the file's.
   void normal(std::string_view rest) const { threeReals(rest, "normal", "component"); }
 
+  // `vt u [v [w]]`: tinyobjloader reads a missing v as 0 and ignores w; u and v are stored as
+  // floats, so they must fit one.
+  void texcoord(std::string_view rest) const {
+    const std::vector<std::string_view> tokens = splitBlanks(rest);
+    if (tokens.empty()) fail(line_, "texture coordinate has no values (need at least u)");
+    for (std::size_t i = 0; i < 2 && i < tokens.size(); ++i) {
+      checkReal(tokens[i], "texture coordinate", "value");
+    }
+  }
+
   // The first three values of a `v` or `vn` line (more are allowed: colours, weights).
   void threeReals(std::string_view rest, const std::string& what, const std::string& part) const {
     const std::vector<std::string_view> tokens = splitBlanks(rest);
@@ -173,15 +187,18 @@ class ObjScanner {
       fail(line_, what + " has " + std::to_string(tokens.size()) + " " + part +
                       (tokens.size() == 1 ? "" : "s") + " (need 3)");
     }
-    for (int i = 0; i < 3; ++i) {
-      double v = 0.0;
-      if (!parseReal(tokens[i], &v)) {
-        fail(line_, what + " " + part + " " + singleQuoted(tokens[i]) + " is not a number");
-      }
-      if (!std::isfinite(static_cast<float>(v))) {
-        fail(line_, "non-finite " + what + " " + part + " " + singleQuoted(tokens[i]) +
-                        (std::isfinite(v) ? " (too large for a 32-bit float)" : ""));
-      }
+    for (std::size_t i = 0; i < 3; ++i) checkReal(tokens[i], what, part);
+  }
+
+  // One value that must be a number and fit a 32-bit float.
+  void checkReal(std::string_view token, const std::string& what, const std::string& part) const {
+    double v = 0.0;
+    if (!parseReal(token, &v)) {
+      fail(line_, what + " " + part + " " + singleQuoted(token) + " is not a number");
+    }
+    if (!std::isfinite(static_cast<float>(v))) {
+      fail(line_, "non-finite " + what + " " + part + " " + singleQuoted(token) +
+                      (std::isfinite(v) ? " (too large for a 32-bit float)" : ""));
     }
   }
 
@@ -264,8 +281,9 @@ class ObjScanner {
   const Counts& totals_;
   Counts sofar_;
   std::size_t line_ = 0;
-  std::vector<std::size_t> vertexLines_;  // line of each vertex, for post-load checks
-  std::vector<std::size_t> normalLines_;  // line of each normal, ditto
+  std::vector<std::size_t> vertexLines_;    // line of each vertex, for post-load checks
+  std::vector<std::size_t> normalLines_;    // line of each normal, ditto
+  std::vector<std::size_t> texcoordLines_;  // line of each texture coordinate, ditto
   int currentMaterial_ = -1;
   std::vector<int> faceMaterials_;
   std::vector<ObjMesh::Statement> usemtl_, mtllib_;
@@ -330,6 +348,13 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
                     "tinyobjloader read " + std::to_string(normalCount) + " normals, expected " +
                         std::to_string(scanner.normalLines().size()) + context);
   }
+  const std::size_t texcoordCount = attrib.texcoords.size() / 2;
+  if (texcoordCount != scanner.texcoordLines().size()) {
+    throwInputError(file, "",
+                    "tinyobjloader read " + std::to_string(texcoordCount) +
+                        " texture coordinates, expected " +
+                        std::to_string(scanner.texcoordLines().size()) + context);
+  }
   // tinyobjloader's own number parser may round differently near the float limit.
   auto finite = [&](const std::vector<tinyobj::real_t>& values, std::size_t count,
                     const std::vector<std::size_t>& lines, const std::string& what) {
@@ -349,6 +374,17 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
       finite(attrib.vertices, vertexCount, scanner.vertexLines(), "vertex coordinate");
   const std::vector<glm::dvec3> normals =
       finite(attrib.normals, normalCount, scanner.normalLines(), "normal component");
+  std::vector<glm::vec2> texcoords(texcoordCount);
+  for (std::size_t i = 0; i < texcoordCount; ++i) {
+    for (int c = 0; c < 2; ++c) {
+      const float value = attrib.texcoords[2 * i + static_cast<std::size_t>(c)];
+      if (!std::isfinite(value)) {
+        throwInputError(file, "line " + std::to_string(scanner.texcoordLines()[i]),
+                        "non-finite texture coordinate value" + context);
+      }
+      texcoords[i][c] = value;
+    }
+  }
 
   ObjMesh mesh;
   std::vector<std::array<glm::dvec3, 3>>& triangles = mesh.triangles;
@@ -359,8 +395,13 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
   // Normals are kept from the first face that references one on; the triangles before it get
   // their zeros then, so that a file without normals costs nothing.
   bool anyNormals = false;
+  // Texture coordinates likewise, with pbrt-v4's default per-triangle coordinates for the
+  // triangles of faces without them.
+  const std::array<glm::vec2, 3> defaultUvs = {glm::vec2(0, 0), glm::vec2(1, 0), glm::vec2(1, 1)};
+  bool anyUvs = false;
   std::vector<std::size_t> face;
   std::vector<glm::dvec3> faceNormals;
+  std::vector<glm::vec2> faceUvs;
   for (const tinyobj::shape_t& shape : shapes) {
     const tinyobj::mesh_t& faces = shape.mesh;
     std::size_t offset = 0;
@@ -370,7 +411,9 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
       if (faceCount >= static_cast<std::int64_t>(faceMaterials.size())) break;  // ditto
       face.resize(n);
       faceNormals.assign(n, glm::dvec3(0.0));
+      faceUvs.resize(n);
       std::size_t withNormal = 0;
+      std::size_t withUv = 0;
       for (std::size_t k = 0; k < n; ++k) {
         const tinyobj::index_t& ref = faces.indices[offset + k];
         const int index = ref.vertex_index;
@@ -380,6 +423,17 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
                               " out of range" + context);
         }
         face[k] = static_cast<std::size_t>(index);
+        // -1: no texture coordinate referenced (v or v//vn).
+        if (ref.texcoord_index != -1) {
+          if (ref.texcoord_index < 0 ||
+              static_cast<std::size_t>(ref.texcoord_index) >= texcoordCount) {
+            throwInputError(file, "",
+                            "tinyobjloader produced texture coordinate index " +
+                                std::to_string(ref.texcoord_index) + " out of range" + context);
+          }
+          faceUvs[k] = texcoords[static_cast<std::size_t>(ref.texcoord_index)];
+          ++withUv;
+        }
         // -1: no normal referenced (v or v/vt).
         if (ref.normal_index == -1) continue;
         if (ref.normal_index < 0 || static_cast<std::size_t>(ref.normal_index) >= normalCount) {
@@ -395,10 +449,20 @@ ObjMesh loadObjMesh(const std::string& text, const std::string& file, const std:
       // interpolated over the face: it is shaded like a face without any.
       if (withNormal != n) faceNormals.assign(n, glm::dvec3(0.0));
       if (anyNormals) mesh.normals.resize(triangles.size(), {});
+      // Likewise texture coordinates at only some corners ("f 1/1 2 3"): the face gets the
+      // defaults.
+      const bool faceHasUvs = withUv == n;
+      anyUvs = anyUvs || withUv > 0;
+      if (anyUvs) mesh.uvs.resize(triangles.size(), defaultUvs);
       for (std::size_t k = 1; k + 1 < n; ++k) {
         triangles.push_back({vertices[face[0]], vertices[face[k]], vertices[face[k + 1]]});
         if (anyNormals) {
           mesh.normals.push_back({faceNormals[0], faceNormals[k], faceNormals[k + 1]});
+        }
+        if (anyUvs) {
+          mesh.uvs.push_back(faceHasUvs
+                                 ? std::array<glm::vec2, 3>{faceUvs[0], faceUvs[k], faceUvs[k + 1]}
+                                 : defaultUvs);
         }
         mesh.material.push_back(faceMaterials[static_cast<std::size_t>(faceCount)]);
       }

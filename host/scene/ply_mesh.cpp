@@ -236,6 +236,8 @@ struct Element {
   std::array<std::size_t, 3> coords{};   // vertex: the properties x, y and z
   bool hasNormals = false;               // vertex: nx, ny and nz are all there
   std::array<std::size_t, 3> normals{};  // vertex: the properties nx, ny and nz
+  bool hasUvs = false;                   // vertex: a pair of texture coordinate properties
+  std::array<std::size_t, 2> uvs{};      // vertex: the properties u and v (or s and t, ...)
   std::size_t indexList = 0;             // face, tristrips: the vertex index list
 };
 
@@ -251,6 +253,11 @@ struct VectorKind {
 };
 const VectorKind kCoordinate{"coordinate", kCoordinateNames};
 const VectorKind kNormal{"normal", kNormalNames};
+
+// The property names of a vertex's texture coordinates that pbrt-v4's PLY reader accepts, in
+// its order of preference.
+constexpr std::array<std::array<std::string_view, 2>, 4> kUvNames{
+    {{"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}}};
 
 class PlyReader {
  public:
@@ -271,6 +278,7 @@ class PlyReader {
     if (tris_.empty()) fail("", "no faces (the 'tristrips' element holds no triangle)");
     PT_CHECK(vertices_.size() == vertexCount_, "PLY vertices not all read");
     PT_CHECK(normals_.empty() || normals_.size() == vertexCount_, "PLY normals not all read");
+    PT_CHECK(uvs_.empty() || uvs_.size() == vertexCount_, "PLY texture coordinates not all read");
     PlyMesh mesh;
     mesh.triangles.reserve(tris_.size());
     for (const IndexTri& t : tris_) {
@@ -282,6 +290,10 @@ class PlyReader {
       for (const IndexTri& t : tris_) {
         mesh.normals.push_back({normals_[t[0]], normals_[t[1]], normals_[t[2]]});
       }
+    }
+    if (!uvs_.empty()) {
+      mesh.uvs.reserve(tris_.size());
+      for (const IndexTri& t : tris_) mesh.uvs.push_back({uvs_[t[0]], uvs_[t[1]], uvs_[t[2]]});
     }
     return mesh;
   }
@@ -482,6 +494,7 @@ class PlyReader {
           e.coords[c] = j;
         }
         checkNormalProperties(e);
+        checkUvProperties(e);
       } else if (e.role == Role::kFace || e.role == Role::kTristrips) {
         const std::size_t j = e.role == Role::kFace
                                   ? findProperty(e, {"vertex_indices", "vertex_index"})
@@ -566,6 +579,34 @@ class PlyReader {
     for (std::size_t c = 0; c < 3; ++c) checkRealProperty(e.properties[j[c]]);
     e.normals = j;
     e.hasNormals = true;
+  }
+
+  // Texture coordinates: the first of kUvNames' pairs that the vertex element has both of.
+  // Without a whole pair, one name of a pair alone is an error, as for the normals.
+  void checkUvProperties(Element& e) const {
+    auto has = [&](std::string_view name) {
+      return std::any_of(e.properties.begin(), e.properties.end(),
+                         [&](const Property& p) { return p.name == name; });
+    };
+    for (const std::array<std::string_view, 2>& pair : kUvNames) {
+      if (!has(pair[0]) || !has(pair[1])) continue;
+      for (std::size_t c = 0; c < 2; ++c) {
+        e.uvs[c] = findProperty(e, {pair[c]});
+        checkRealProperty(e.properties[e.uvs[c]]);
+      }
+      e.hasUvs = true;
+      return;
+    }
+    for (const Property& p : e.properties) {
+      for (const std::array<std::string_view, 2>& pair : kUvNames) {
+        for (std::size_t c = 0; c < 2; ++c) {
+          if (p.name != pair[c]) continue;
+          failLine(p.line, "vertex property '" + p.name + "' without '" + std::string(pair[1 - c]) +
+                               "' (texture coordinates need both '" + std::string(pair[0]) +
+                               "' and '" + std::string(pair[1]) + "')");
+        }
+      }
+    }
   }
 
   static bool hasList(const Element& e) {
@@ -682,11 +723,33 @@ class PlyReader {
     }
   }
 
-  // One decoded vertex, with its normal where the file has normals.
+  // Texture coordinates must be finite and fit a float, as they are kept.
+  void checkUv(const Element& e, std::uint64_t entry, const glm::dvec2& uv,
+               std::size_t line) const {
+    for (std::size_t c = 0; c < 2; ++c) {
+      const double v = uv[static_cast<int>(c)];
+      if (std::fabs(v) <= std::numeric_limits<float>::max()) continue;
+      const std::string& name = e.properties[e.uvs[c]].name;
+      if (!std::isfinite(v)) {
+        failEntry(e, entry,
+                  "texture coordinate is not finite (" + name + " = " +
+                      (std::isnan(v) ? "nan" : "inf") + ")",
+                  line);
+      }
+      failEntry(e, entry,
+                "texture coordinate is too large for a 32-bit float (" + name + " = " +
+                    formatNumber(v) + ")",
+                line);
+    }
+  }
+
+  // One decoded vertex, with its normal and texture coordinates where the file has them.
   void addVertex(const Element& e, std::uint64_t entry, const glm::dvec3& point,
-                 const glm::dvec3& normal, std::size_t line) {
+                 const glm::dvec3& normal, const glm::dvec2& uv, std::size_t line) {
     checkVector(e, entry, point, kCoordinate, line);
+    if (e.hasUvs) checkUv(e, entry, uv, line);
     vertices_.push_back(point);
+    if (e.hasUvs) uvs_.push_back(glm::vec2(uv));
     if (!e.hasNormals) return;
     if (!std::isfinite(normal.x) || !std::isfinite(normal.y) || !std::isfinite(normal.z)) {
       ++nonFiniteNormals_;
@@ -739,6 +802,7 @@ class PlyReader {
     for (std::uint64_t i = 0; i < e.count; ++i) {
       glm::dvec3 point(0.0);
       glm::dvec3 normal(0.0);
+      glm::dvec2 uv(0.0);
       for (std::size_t j = 0; j < e.properties.size(); ++j) {
         const Property& p = e.properties[j];
         if (!p.isList) {
@@ -750,6 +814,7 @@ class PlyReader {
               if (e.hasNormals && e.normals[c] == j) {
                 normal[c] = loadReal(data_ + pos, p.type, swap);
               }
+              if (c < 2 && e.hasUvs && e.uvs[c] == j) uv[c] = loadReal(data_ + pos, p.type, swap);
             }
           }
           pos += bytes;
@@ -787,7 +852,7 @@ class PlyReader {
           addStrips(e, i, static_cast<std::uint64_t>(n), 0, next);
         }
       }
-      if (e.role == Role::kVertex) addVertex(e, i, point, normal, 0);
+      if (e.role == Role::kVertex) addVertex(e, i, point, normal, uv, 0);
     }
     return pos;
   }
@@ -796,16 +861,18 @@ class PlyReader {
     if (e.role != Role::kVertex) return;
     vertices_.reserve(reserveFor(e, pos));
     if (e.hasNormals) normals_.reserve(reserveFor(e, pos));
+    if (e.hasUvs) uvs_.reserve(reserveFor(e, pos));
   }
 
   void readFixedVertices(const Element& e, const unsigned char* base, std::size_t stride,
                          bool swap) {
-    // Byte offsets and types of x, y, z and then nx, ny, nz within an entry.
-    std::array<std::size_t, 6> offset{};
-    std::array<Type, 6> type{};
-    for (std::size_t c = 0; c < 6; ++c) {
-      if (c >= 3 && !e.hasNormals) break;
-      const std::size_t property = c < 3 ? e.coords[c] : e.normals[c - 3];
+    // Byte offsets and types of x, y, z, then nx, ny, nz, then u, v within an entry.
+    std::array<std::size_t, 8> offset{};
+    std::array<Type, 8> type{};
+    for (std::size_t c = 0; c < 8; ++c) {
+      if (c >= 3 && c < 6 && !e.hasNormals) continue;
+      if (c >= 6 && !e.hasUvs) continue;
+      const std::size_t property = c < 3 ? e.coords[c] : c < 6 ? e.normals[c - 3] : e.uvs[c - 6];
       for (std::size_t j = 0; j < property; ++j) offset[c] += sizeOf(e.properties[j].type);
       type[c] = e.properties[property].type;
     }
@@ -814,12 +881,18 @@ class PlyReader {
                         loadReal(entry + offset[first + 1], type[first + 1], swap),
                         loadReal(entry + offset[first + 2], type[first + 2], swap));
     };
+    auto uv = [&](const unsigned char* entry) {
+      return glm::dvec2(loadReal(entry + offset[6], type[6], swap),
+                        loadReal(entry + offset[7], type[7], swap));
+    };
     const std::size_t count = static_cast<std::size_t>(e.count);
     vertices_.reserve(count);
     if (e.hasNormals) normals_.reserve(count);
+    if (e.hasUvs) uvs_.reserve(count);
     for (std::size_t i = 0; i < count; ++i) {
       const unsigned char* entry = base + i * stride;
-      addVertex(e, i, vector(entry, 0), e.hasNormals ? vector(entry, 3) : glm::dvec3(0.0), 0);
+      addVertex(e, i, vector(entry, 0), e.hasNormals ? vector(entry, 3) : glm::dvec3(0.0),
+                e.hasUvs ? uv(entry) : glm::dvec2(0.0), 0);
     }
   }
 
@@ -890,6 +963,7 @@ class PlyReader {
       };
       glm::dvec3 point(0.0);
       glm::dvec3 normal(0.0);
+      glm::dvec2 uv(0.0);
       for (std::size_t j = 0; j < propertyCount; ++j) {
         const Property& p = e.properties[j];
         const std::size_t after = propertyCount - j - 1;
@@ -901,6 +975,10 @@ class PlyReader {
             if (e.coords[c] == j) point[c] = asciiReal(e, i, token, kCoordinate, c, p.type);
             if (e.hasNormals && e.normals[c] == j) {
               normal[c] = asciiReal(e, i, token, kNormal, c, p.type);
+            }
+            if (c < 2 && e.hasUvs && e.uvs[c] == j) {
+              uv[static_cast<int>(c)] = asciiReal(e, i, token, "texture coordinate", p.name, p.type,
+                                                  /*keepNonFinite=*/false);
             }
           }
           continue;
@@ -933,7 +1011,7 @@ class PlyReader {
                       std::to_string(consumed),
                   line_);
       }
-      if (e.role == Role::kVertex) addVertex(e, i, point, normal, line_);
+      if (e.role == Role::kVertex) addVertex(e, i, point, normal, uv, line_);
     }
   }
 
@@ -956,7 +1034,15 @@ class PlyReader {
   // Component c of a coordinate or a normal.
   double asciiReal(const Element& e, std::uint64_t entry, std::string_view token,
                    const VectorKind& kind, std::size_t c, Type type) const {
-    const std::string name(kind.names[c]);
+    // A normal that is not finite is kept as such, for addVertex to count and replace.
+    return asciiReal(e, entry, token, kind.what, kind.names[c], type, &kind == &kNormal);
+  }
+
+  // The value of property `name`, one component of a `what`.
+  double asciiReal(const Element& e, std::uint64_t entry, std::string_view token,
+                   const std::string& what, std::string_view propertyName, Type type,
+                   bool keepNonFinite) const {
+    const std::string name(propertyName);
     // Parsed at the property's own precision: a float property rounds once, straight from
     // the decimal text, exactly as a binary file of the same mesh would hold it.
     double value = 0.0;
@@ -969,22 +1055,18 @@ class PlyReader {
       ok = parseReal(token, &value);
     }
     if (!ok) {
-      failEntry(
-          e, entry,
-          std::string(kind.what) + " " + name + " " + singleQuoted(token) + " is not a number",
-          line_);
+      failEntry(e, entry, what + " " + name + " " + singleQuoted(token) + " is not a number",
+                line_);
     }
     if (std::fabs(value) <= std::numeric_limits<float>::max()) return value;
     // Too large or really infinite: the text as a double tells which (a float property's
     // overflow has already become an infinity).
     double asDouble = value;
     parseReal(token, &asDouble);
-    // A normal that is not finite is kept as such, for addVertex to count and replace.
-    if (&kind == &kNormal && !std::isfinite(asDouble)) return asDouble;
+    if (keepNonFinite && !std::isfinite(asDouble)) return asDouble;
     failEntry(
         e, entry,
-        std::string(kind.what) +
-            (std::isfinite(asDouble) ? " is too large for a 32-bit float" : " is not finite") +
+        what + (std::isfinite(asDouble) ? " is too large for a 32-bit float" : " is not finite") +
             " (" + name + " = " + singleQuoted(token) + ")",
         line_);
   }
@@ -1005,6 +1087,7 @@ class PlyReader {
 
   std::vector<glm::dvec3> vertices_;
   std::vector<glm::dvec3> normals_;   // parallel to vertices_, or empty: the file has none
+  std::vector<glm::vec2> uvs_;        // parallel to vertices_, or empty: the file has none
   std::size_t nonFiniteNormals_ = 0;  // normals read as 0 0 0 because they were not finite
   std::vector<IndexTri> tris_;
 };

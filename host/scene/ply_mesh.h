@@ -6,11 +6,13 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 namespace pt::scene_detail {
 
-// A PLY file's triangles with the vertex normals the file gives for them.
+// A PLY file's triangles with the vertex normals and texture coordinates the file gives for
+// them.
 struct PlyMesh {
   std::vector<std::array<glm::dvec3, 3>> triangles;  // file order, polygons fanned
   // The normals at the three vertices of each triangle, parallel to `triangles` (same
@@ -18,6 +20,11 @@ struct PlyMesh {
   // read: not normalized (the scene loader normalizes after transforming), and a file's
   // own 0 0 0 stays a zero vector, which the scene loader replaces by the geometric normal.
   std::vector<std::array<glm::dvec3, 3>> normals;
+  // The texture coordinates at the three vertices of each triangle, parallel to `triangles`
+  // (same fanning, same strip order), or empty when the file has none: the vertex element has
+  // no pair of texture coordinate properties (see loadPlyMesh), and then no triangle has
+  // any. As read, not flipped (the scene loader decides conventions).
+  std::vector<std::array<glm::vec2, 3>> uvs;
   // Vertex normals with a NaN or infinite component (scanned meshes and exporters write them:
   // Bitterli's lamp has 32): kept as 0 0 0, so that their triangles take the geometric normal
   // there, and counted, so that the scene loader can say so.
@@ -32,9 +39,14 @@ struct PlyMesh {
 // data (element indices count from 0, like the vertex indices of faces).
 //
 // Accepts the elements 'vertex' (float or double x, y, z and, optionally, float or double
-// nx, ny, nz: all three or none), 'face' (a 'vertex_indices' or 'vertex_index' list) and
-// 'tristrips' (a 'vertex_indices' list, -1 restarting a strip); every other element and
-// property is skipped. Normals, like coordinates, must be finite and fit a 32-bit float.
+// nx, ny, nz: all three or none; optionally, float or double texture coordinates: the first
+// pair of u and v, s and t, texture_u and texture_v, texture_s and texture_t that the element
+// has both of, as pbrt-v4 reads them, and without any whole pair, one of them alone is an
+// error), 'face' (a 'vertex_indices' or 'vertex_index' list) and 'tristrips' (a
+// 'vertex_indices' list, -1 restarting a strip); every other element and property is
+// skipped. Coordinates and texture coordinates must be finite and fit a 32-bit float;
+// normals too, except that a normal with a NaN or infinite component is counted in
+// nonFiniteNormals and kept as 0 0 0.
 PlyMesh loadPlyMesh(const std::string& bytes, const std::string& file, const std::string& context);
 
 // Just the triangles.
