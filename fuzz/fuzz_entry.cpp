@@ -85,6 +85,15 @@ void checkNormals(const Mesh& mesh) {
                "non-finite mesh normal accepted");
     }
   }
+  // Texture coordinates likewise: none, or one finite triple per triangle.
+  PT_CHECK(mesh.uvs.empty() || mesh.uvs.size() == mesh.triangles.size(),
+           "mesh texture coordinates not parallel to its triangles");
+  for (const auto& triple : mesh.uvs) {
+    for (const auto& uv : triple) {
+      PT_CHECK(std::isfinite(uv.x) && std::isfinite(uv.y),
+               "non-finite texture coordinate accepted");
+    }
+  }
 }
 
 }  // namespace

@@ -236,6 +236,10 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
       inexact = zeroEdge;
       if (inexact) break;
       bool closer = hitTriangle && isCloserHit(hit.t, tri.primitive, best.t, bestPrimitive);
+#ifdef PT_HIT_FILTER
+      // A hit the includer's filter drops (an alpha cut-out) is passed by, as if missed.
+      if (closer) closer = PT_HIT_FILTER(tri, hit, r);
+#endif
       best.t = closer ? hit.t : best.t;
       best.triangle = closer ? first : best.triangle;
       bestPrimitive = closer ? tri.primitive : bestPrimitive;

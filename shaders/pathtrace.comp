@@ -143,6 +143,14 @@ TriangleUVs uvsAt(uint primitive) {
 }
 #define PT_TEXTURE_LOOP_TICK() gLoopIterations++
 #include "texture.h"
+// Alpha cut-outs in the traversal (bvh.glsl): a hit where the surface is cut away is passed by.
+// gAlphaU is the ray's number (texture.h): set before each ray is traced (the path's ray at the
+// start of extendPath, a shadow ray by the light sample that casts it; a ray traced again in main
+// keeps the number of the ray that asked, the last one set).
+float gAlphaU = 0.0;
+#define PT_HIT_FILTER(tri, hit, r)                   \
+  (!kAlphaCutouts || params.texturesPresent == 0u || \
+   alphaKeepsHit(tri.material, tri.primitive, hit.barycentrics, gAlphaU))
 #endif
 
 // Watertight unless switched off by specialization or, unspecialized, by the parameters.
@@ -332,6 +340,9 @@ vec3 analyticLightContribution(AnalyticLightSample ls, float pmf, vec3 from, vec
 vec3 sampleDirectLight(vec3 p, vec3 n, vec3 ng, bool shadingNormals, float magnitude, vec3 beta,
                        vec3 f, vec2 uChoose, vec2 uLight, bool misOn, uint depth,
                        inout Retrace retrace) {
+#ifndef PT_NO_BSDF_MATERIALS
+  if (kAlphaCutouts) gAlphaU = shadowAlphaRandom(uLight);
+#endif
   // Pick an emitter from the alias table, then a uniform point on its triangle (or a sample of
   // an analytic light).
   Emitter emitter = pickEmitter(uChoose);
@@ -378,6 +389,7 @@ vec3 sampleDirectLightBsdf(vec3 p, vec3 ng, ShadingFrame frame, Material materia
                            float magnitude, vec3 beta, vec2 uChoose, vec2 uLight,
                            RandomStream evalStream, RandomStream pdfStream, bool misOn, uint depth,
                            inout Retrace retrace) {
+  if (kAlphaCutouts) gAlphaU = shadowAlphaRandom(uLight);
   Emitter emitter = pickEmitter(uChoose);
   if (kAnalyticLights && (emitter.triangle & kEmitterLight) != 0u) {
     AnalyticLightSample ls = sampleAnalyticLight(loadLight(emitter.triangle & ~kEmitterLight), p,
@@ -488,6 +500,9 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   bool found = path.hitFound;
   if (!path.hitReady) {
     gRays++;
+#ifndef PT_NO_BSDF_MATERIALS
+    if (kAlphaCutouts) gAlphaU = pathAlphaRandom(pixel, sampleIndex, path.depth, seed);
+#endif
     bool inexact;
     found = traceRayWith(/*exact=*/false, path.origin, path.direction, 1.0 / 0.0,
                          /*anyHit=*/false, hit, inexact);

@@ -254,6 +254,37 @@ PT_INLINE Material resolveMaterial(PT_TEXTURES_PARAM Material m, MaterialTexture
   return m;
 }
 
+// ---- Alpha cut-outs -----------------------------------------------------------------------
+
+// The number a ray's alpha tests compare alpha with, one per ray (for all the surfaces it
+// meets, as pbrt-v4's HashFloat(r.o, r.d) is). pbrt-v4 hashes the ray itself; the backends'
+// rays can differ in their last bits, which would part their decisions, so the number comes
+// from what both share exactly: for a path's ray, a hash of its pixel, sample and scattering
+// events so far; for a shadow ray, a hash of the light sample's two numbers.
+PT_INLINE float pathAlphaRandom(uvec2 pixel, uint sampleIndex, uint depth, uint seed) {
+  uvec4 h =
+      pcg4d(uvec4(pixel.x, pixel.y, sampleIndex, (0xA1FA0000u + depth) ^ (seed * 0x9E3779B9u)));
+  return float(h.x >> 8u) * (1.0f / 16777216.0f);
+}
+PT_INLINE float shadowAlphaRandom(vec2 uLight) {
+  uvec4 h = pcg4d(uvec4(floatBitsToUint(uLight.x), floatBitsToUint(uLight.y), 0xA1FAu, 0x5EEDu));
+  return float(h.x >> 8u) * (1.0f / 16777216.0f);
+}
+
+// pbrt-v4's alpha test (GeometricPrimitive::Intersect) of a hit with barycentric weights b on
+// a triangle of `material` (Triangle::primitive `primitive`) by a ray whose number is u (above):
+// the surface is there where its alpha texture is 1 or more (or it has none), missing where it
+// is 0 or less, and in between there for the rays whose number is at most alpha.
+PT_INLINE bool alphaKeepsHit(PT_TEXTURES_PARAM uint material, uint primitive, vec3 b, float u) {
+  uint alpha = materialTexturesAt(PT_TEXTURES_ARG material).alpha;
+  if (alpha == kNoTexture) return true;
+  float a =
+      evalFloatTexture(PT_TEXTURES_ARG alpha, interpolatedUV(uvsAt(PT_TEXTURES_ARG primitive), b));
+  if (a >= 1.0f) return true;
+  if (a <= 0.0f) return false;
+  return u <= a;
+}
+
 #ifdef __cplusplus
 }  // namespace pt
 #endif

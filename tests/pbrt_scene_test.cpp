@@ -21,6 +21,7 @@
 #include "scene/pbrt/spectra.h"
 #include "scene/scene.h"
 #include "test_util.h"
+#include "texture.h"
 
 namespace pt {
 namespace {
@@ -437,25 +438,29 @@ TEST(PbrtMaterials, NamedMaterialsTexturesAttributesAndMix) {
           kTriangle + "NamedMaterial \"late\"\n" + kTriangle,
       dir / "scene.pbrt");
   ASSERT_EQ(scene.triangles.size(), 6u);
-  auto material = [&](int i) { return scene.materials[scene.triangles[i].material]; };
-  EXPECT_EQ(material(0).reflectance, vec3(0.3f));
-  EXPECT_EQ(material(1).reflectance, vec3(0.7f));  // from the Attribute
+  ASSERT_EQ(scene.materialTextures.size(), scene.materials.size());
+  // Each triangle's material with its textures evaluated at (u, v) = (0.25, 0.5).
+  const TextureTables tables{scene.textureNodes.data(), scene.imageWords.data(), nullptr, nullptr};
+  auto material = [&](int i) {
+    const uint m = scene.triangles[i].material;
+    return resolveMaterial(tables, scene.materials[m], scene.materialTextures[m],
+                           vec2(0.25f, 0.5f));
+  };
+  EXPECT_NEAR(material(0).reflectance.x, 0.3f, 1e-7f);  // a constant texture
+  EXPECT_EQ(material(1).reflectance, vec3(0.7f));       // from the Attribute
   EXPECT_EQ(material(2).type, kMaterialConductor);
-  EXPECT_EQ(material(2).alphaX, 0.3f);
-  // An image texture: its mean texel, warned (until textures exist).
-  EXPECT_NEAR(material(3).reflectance.x, 0.3f, 1e-6f);
-  EXPECT_NEAR(material(3).reflectance.y, 0.5f, 1e-6f);
-  EXPECT_NEAR(material(3).reflectance.z, 0.7f, 1e-6f);
+  EXPECT_NEAR(material(2).alphaX, 0.3f, 1e-7f);  // roughness 0.09 from a texture, remapped
+  // An image texture: the left texel at u = 0.25.
+  EXPECT_NEAR(material(3).reflectance.x, 0.2f, 1e-6f);
+  EXPECT_NEAR(material(3).reflectance.y, 0.4f, 1e-6f);
+  EXPECT_NEAR(material(3).reflectance.z, 0.6f, 1e-6f);
   EXPECT_EQ(material(4).type, kMaterialConductor);  // amount 0.8: the second, mostly
   EXPECT_EQ(scene.triangles[5].material, scene.triangles[0].material);  // one slot per name
   EXPECT_EQ(scene.materials.size(), 5u);  // "both" shares metal's definition but not its slot
   EXPECT_EQ(scene.materialNames[scene.triangles[0].material], "late");
   std::string joined;
   for (const std::string& w : scene.warnings) joined += w + "\n";
-  EXPECT_NE(joined.find("scene.pbrt:13: textures of class 'imagemap' are not simulated yet: "
-                        "parameters that use one take its mean value (an image's mean texel)"),
-            std::string::npos)
-      << joined;
+  EXPECT_EQ(joined.find("not simulated"), std::string::npos) << joined;
   EXPECT_NE(joined.find("Material \"mix\" is rendered as the one of its two materials"),
             std::string::npos);
 }
@@ -950,48 +955,70 @@ TEST(PbrtCameraFilm, StrictMakesEveryWarningAnError) {
   EXPECT_NO_THROW(loadScene(test::kConfigs / "cornell-box.pbrt", SceneLoadOptions{.strict = true}));
 }
 
-TEST(PbrtMaterials, TexturesStandInByTheirMeans) {
-  // Until textures exist (issue 25) a texture is its mean over the (u, v) square.
+TEST(PbrtMaterials, TexturesBecomeTheirPrograms) {
   const test::TempDir dir;
-  Image image(2, 2);  // mean 0.25 in every channel
+  Image image(2, 2);
   image.pixels = {vec3(0.0f), vec3(0.5f), vec3(0.25f), vec3(0.25f)};
   writeImage(image, dir / "g.pfm");
-  dir.write("photo.jpg", "not read yet");
-  const auto reflectance = [&](const std::string& textures) {
+  dir.write("photo.jpg", "not a JPEG");
+  std::vector<std::string> warnings;
+  // The reflectance that texture "t" gives at (u, v).
+  const auto reflectance = [&](const std::string& textures, vec2 uv) {
     const Scene scene = load(std::string(kUnmirrored) + textures +
                                  "Material \"diffuse\" \"texture reflectance\" \"t\"\n" + kTriangle,
                              dir / "scene.pbrt");
-    return scene.materials[scene.triangles[0].material].reflectance;
+    warnings = scene.warnings;
+    const uint m = scene.triangles[0].material;
+    const TextureTables tables{scene.textureNodes.data(), scene.imageWords.data(), nullptr,
+                               nullptr};
+    if (scene.materialTextures.empty()) return scene.materials[m].reflectance;
+    return resolveMaterial(tables, scene.materials[m], scene.materialTextures[m], uv).reflectance;
   };
-  // A checkerboard: each texture covers half.
-  EXPECT_EQ(reflectance("Texture \"t\" \"spectrum\" \"checkerboard\" \"rgb tex1\" [0.2 0.4 0.6] "
-                        "\"rgb tex2\" [0.6 0.4 0.2]\n"),
-            vec3(0.4f));
-  // scale x an image, nested; mix by a constant amount; invert.
-  EXPECT_NEAR(reflectance("Texture \"g\" \"spectrum\" \"imagemap\" \"string filename\" \"g.pfm\"\n"
+  // A checkerboard: tex1 on even squares, tex2 on odd ones.
+  const std::string board =
+      "Texture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [0.2 0.4 0.6] "
+      "\"rgb tex2\" [0.6 0.4 0.2]\n";
+  EXPECT_EQ(reflectance(board, vec2(0.25f, 0.5f)), vec3(0.2f, 0.4f, 0.6f));
+  EXPECT_EQ(reflectance(board, vec2(0.75f, 0.5f)), vec3(0.6f, 0.4f, 0.2f));
+  // scale x an image, nested: the bottom-left texel (t = 0.25 is row 1) doubled.
+  EXPECT_NEAR(reflectance("Texture \"g\" \"spectrum\" \"imagemap\" \"string filename\" \"g.pfm\" "
+                          "\"string filter\" \"point\"\n"
                           "Texture \"t\" \"spectrum\" \"scale\" \"texture tex\" \"g\" "
-                          "\"float scale\" 2\n")
+                          "\"float scale\" 2\n",
+                          vec2(0.25f, 0.25f))
                   .x,
               0.5f, 1e-6f);
   EXPECT_NEAR(
       reflectance("Texture \"t\" \"spectrum\" \"mix\" \"rgb tex1\" [0 0 0] \"rgb tex2\" [1 1 1] "
-                  "\"float amount\" 0.25\n")
+                  "\"float amount\" 0.25\n",
+                  vec2(0.5f))
           .y,
       0.25f, 1e-6f);
   EXPECT_NEAR(reflectance("Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"g.pfm\" "
-                          "\"bool invert\" true\n")
+                          "\"bool invert\" true \"string filter\" \"point\"\n",
+                          vec2(0.75f, 0.75f))
                   .z,
-              0.75f, 1e-6f);
-  // An image format not read yet: the parameter's default, warned.
-  EXPECT_EQ(
-      reflectance("Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"photo.jpg\"\n"),
-      vec3(0.5f));
-  // A missing image is an error naming it, as in pbrt-v4.
-  try {
-    reflectance("Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"none.pfm\"\n");
-    ADD_FAILURE() << "expected an error";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("none.pfm"), std::string::npos) << e.what();
+              0.5f, 1e-6f);
+  // A class not simulated (bilerp) takes its mean, warned.
+  EXPECT_NEAR(reflectance("Texture \"t\" \"spectrum\" \"bilerp\" \"rgb v00\" [0 0 0] \"rgb v01\" "
+                          "[1 1 1] \"rgb v10\" [1 1 1] \"rgb v11\" [0 0 0]\n",
+                          vec2(0.0f))
+                  .x,
+              0.5f, 1e-6f);
+  ASSERT_FALSE(warnings.empty());
+  EXPECT_NE(warnings[0].find("textures of class 'bilerp' are not simulated"), std::string::npos)
+      << warnings[0];
+  // A missing or malformed image is an error naming it, as in pbrt-v4.
+  for (const char* file : {"none.pfm", "photo.jpg"}) {
+    try {
+      reflectance(std::string("Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"") +
+                      file + "\"\n",
+                  vec2(0.0f));
+      ADD_FAILURE() << "expected an error for " << file;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+    }
   }
 }
 

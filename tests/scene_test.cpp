@@ -380,7 +380,8 @@ TEST(SceneMaterials, BadMaterials) {
   };
   EXPECT_CONTAINS(
       withMaterials(R"([{"name": "white"}, {"name": "a"}, {"name": "b", "reflectance": "red"}])"),
-      "materials[2].reflectance: expected an array of 3 numbers, got a string");
+      "materials[2].reflectance: unknown texture 'red' (a string names one of the scene's "
+      "\"textures\"; a value is a number or an array of 3 numbers)");
   EXPECT_CONTAINS(withMaterials(R"([{"name": "white", "reflectance": [0.5, 1.5, 0]}])"),
                   "materials[0].reflectance[1]: expected a number in [0, 1], got the number 1.5");
   EXPECT_CONTAINS(withMaterials(R"([{"name": "white", "reflectance": [0.5, -0.1, 0]}])"),
@@ -609,16 +610,17 @@ TEST(SceneMaterials, BadParametersOfTheNewTypes) {
             file +
                 ": materials[0].k: not a parameter of 'dielectric' (a 'dielectric' material "
                 "takes 'eta', 'roughness', 'uroughness', 'vroughness', 'remaproughness', "
-                "'emission' and 'twoSided')");
+                "'emission', 'twoSided', 'alpha' and 'displacement')");
   EXPECT_EQ(withMaterial(R"({"name": "white", "roughness": 0.1})"),
             file +
                 ": materials[0].roughness: not a parameter of 'diffuse' (a 'diffuse' material "
-                "takes 'reflectance', 'emission' and 'twoSided')");
+                "takes 'reflectance', 'emission', 'twoSided', 'alpha' and 'displacement')");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "mirror", "eta": 1.5})"),
                   "materials[0].eta: not a parameter of 'mirror'");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "thindielectric", "roughness": 0})"),
                   "materials[0].roughness: not a parameter of 'thindielectric' (a "
-                  "'thindielectric' material takes 'eta', 'emission' and 'twoSided')");
+                  "'thindielectric' material takes 'eta', 'emission', 'twoSided', 'alpha' and "
+                  "'displacement')");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "conductor", "albedo": [0, 0, 0]})"),
                   "materials[0].albedo: not a parameter of 'conductor'");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "diffusetransmission", "g": 0})"),
@@ -630,10 +632,10 @@ TEST(SceneMaterials, BadParametersOfTheNewTypes) {
   // A key no type takes: unknown, with a suggestion among the type's keys.
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "dielectric", "rougness": 0.1})"),
                   "materials[0].rougness: unknown key (did you mean 'roughness'?)");
-  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "conductor", "displacement": 1})"),
-                  "materials[0].displacement: unknown key (expected 'name', 'type', 'eta', 'k', "
+  EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "conductor", "normalmap": 1})"),
+                  "materials[0].normalmap: unknown key (expected 'name', 'type', 'eta', 'k', "
                   "'reflectance', 'roughness', 'uroughness', 'vroughness', 'remaproughness', "
-                  "'emission' or 'twoSided')");
+                  "'emission', 'twoSided', 'alpha' or 'displacement')");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "metal"})"),
                   "materials[0].type: unknown material type 'metal' (expected 'diffuse', "
                   "'mirror', 'conductor', 'dielectric', 'thindielectric', 'diffusetransmission' "
@@ -661,8 +663,7 @@ TEST(SceneMaterials, BadParametersOfTheNewTypes) {
                   "materials[0].k: expected a number or an array of 3 numbers, got an array of 2 "
                   "elements");
   EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "k": "gold"})"),
-                  "materials[0].k: expected a number or an array of 3 numbers, got the string "
-                  "'gold'");
+                  "materials[0].k: unknown texture 'gold'");
   EXPECT_CONTAINS(withMaterial(R"({"name": "w", "type": "conductor", "eta": [1, 1e300, 1]})"),
                   "materials[0].eta[1]: number 1e+300 is too large");
   // Roughness.

@@ -440,3 +440,89 @@ TEST(Textures, JsonTextureErrorsNameTheField) {
 
 }  // namespace
 }  // namespace pt
+
+namespace pt {
+namespace {
+
+// A plane of albedo 0.8 at y = 0 under a distant light straight above (irradiance pi), seen
+// from 10 above through a black quad at y = 5 whose alpha is `alpha` (a texture's name or a
+// number): camera rays see the plane through the cut-outs, and the plane is lit where the
+// light comes through them.
+std::string cutoutScene(const std::string& textures, const std::string& alpha, int spp) {
+  return R"({"camera": {"position": [0, 10, 0], "target": [0, 0, 0], "up": [0, 0, 1],
+    "vfov": 60, "width": 40, "height": 40},
+    "integrator": {"spp": )" +
+         std::to_string(spp) + R"(, "maxDepth": 1},
+    "textures": [)" +
+         textures + R"(],
+    "materials": [{"name": "plane", "type": "diffuse", "reflectance": [0.8, 0.8, 0.8]},
+      {"name": "screen", "type": "diffuse", "reflectance": [0, 0, 0], "alpha": )" +
+         alpha + R"(}],
+    "shapes": [{"type": "quad", "material": "plane",
+      "vertices": [[20, 0, -20], [-20, 0, -20], [-20, 0, 20], [20, 0, 20]]},
+      {"type": "quad", "material": "screen",
+      "vertices": [[10, 5, -10], [-10, 5, -10], [-10, 5, 10], [10, 5, 10]]}],
+    "lights": [{"type": "distant", "direction": [0, 1, 0],
+      "radiance": [3.14159265, 3.14159265, 3.14159265]}]})";
+}
+
+// A checkerboard alpha (4 x 4 squares over the screen, holes on the odd ones): the camera
+// sees the plane through a hole, lit where the hole straight above it lets the light through,
+// on both backends, against the same geometry worked out here.
+TEST(Textures, AlphaCutoutsPassRaysAndCastTheirShadow) {
+  const test::TempDir dir;
+  const Scene scene = loadScene(
+      dir.write("cutout.json",
+                cutoutScene(R"({"name": "holes", "type": "checkerboard", "uscale": 4, "vscale": 4,
+                      "tex1": 1, "tex2": 0})",
+                            R"("holes")", 64)));
+  const SceneData data = prepareScene(scene, RenderSettings{});
+  EXPECT_TRUE(data.effects.alphaCutouts);
+  // Whether the screen has a hole above (x, z): u = (10 - x) / 20, v = (z + 10) / 20.
+  const auto hole = [](double x, double z) {
+    const double u = (10.0 - x) / 20.0, v = (z + 10.0) / 20.0;
+    if (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) return true;  // beyond the screen
+    return (int(std::floor(4.0 * u)) + int(std::floor(4.0 * v))) % 2 != 0;
+  };
+  const Image expected = pixelAverages(data.params.camera, [&](const Ray& ray) {
+    const glm::dvec3 o(ray.origin), d(ray.direction);
+    const glm::dvec3 onScreen = o + d * ((5.0 - o.y) / d.y);
+    if (!hole(onScreen.x, onScreen.z)) return glm::dvec3(0.0);  // the black screen
+    const glm::dvec3 onPlane = o + d * (-o.y / d.y);
+    return hole(onPlane.x, onPlane.z) ? glm::dvec3(0.8) : glm::dvec3(0.0);
+  });
+  const Comparison cmp = renderBoth(data, data.spp);
+  EXPECT_EQ(cmp.gpu.validationErrors, 0u);
+  EXPECT_LE(double(cmp.diff.pixelsOverThreshold), 0.005 * double(cmp.diff.pixelCount));
+  for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+    size_t off = 0, lit = 0, dark = 0;
+    for (size_t i = 0; i < expected.pixels.size(); ++i) {
+      const double e = expected.pixels[i].x;
+      if (std::fabs(double(image->pixels[i].x) - e) > 0.06) ++off;
+      lit += e > 0.79 ? 1 : 0;
+      dark += e < 0.01 ? 1 : 0;
+    }
+    // Whole pixels of each kind: lit plane through a hole, shadow, the screen.
+    EXPECT_GT(lit, 100u);
+    EXPECT_GT(dark, 400u);
+    EXPECT_EQ(off, 0u) << (image == &cmp.cpuImage ? "cpu" : "vulkan");
+  }
+}
+
+// pbrt-v4's stochastic alpha: a screen of alpha 0.5 passes half the camera rays and half the
+// light, so the plane behind it averages 0.8 / 4.
+TEST(Textures, PartialAlphaPassesThatFractionOfRays) {
+  const test::TempDir dir;
+  const Scene scene = loadScene(dir.write("half.json", cutoutScene("", "0.5", 256)));
+  const SceneData data = prepareScene(scene, RenderSettings{});
+  const Comparison cmp = renderBoth(data, data.spp);
+  EXPECT_LE(double(cmp.diff.pixelsOverThreshold), 0.005 * double(cmp.diff.pixelCount));
+  for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+    double sum = 0.0;
+    for (const vec3& p : image->pixels) sum += p.x;
+    EXPECT_NEAR(sum / double(image->pixels.size()), 0.2, 0.004);
+  }
+}
+
+}  // namespace
+}  // namespace pt

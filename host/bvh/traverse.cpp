@@ -105,7 +105,7 @@ namespace {
 // nearer is visited next and the farther pushed. A popped node is visited without
 // re-testing its box (it was hit when pushed).
 template <bool kAnyHit, bool kWatertight>
-bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best) {
+bool traverse(const Bvh& bvh, const Ray& ray, float tMax, const HitFilter* filter, Hit& best) {
   const RayPrecomputed r(ray);
   float tNear = 0.0f;
   const BvhNode& root = bvh.nodes[0];
@@ -113,7 +113,7 @@ bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best) {
   uint32_t stack[kBvhStackSize];
   uint32_t stackSize = 0;
   uint32_t nodeIndex = 0;
-  HitSearch search(tMax);
+  HitSearch search(tMax, filter);
   for (;;) {
     const BvhNode& node = bvh.nodes[nodeIndex];
     if (node.count > 0) {
@@ -157,19 +157,22 @@ bool traverse(const Bvh& bvh, const Ray& ray, float tMax, Hit& best) {
 
 }  // namespace
 
-std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax, Intersection test) {
+std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax, Intersection test,
+                              const HitFilter* filter) {
   Hit hit;
   const bool found = test == Intersection::kWatertight
-                         ? traverse</*kAnyHit=*/false, true>(bvh, ray, tMax, hit)
-                         : traverse</*kAnyHit=*/false, false>(bvh, ray, tMax, hit);
+                         ? traverse</*kAnyHit=*/false, true>(bvh, ray, tMax, filter, hit)
+                         : traverse</*kAnyHit=*/false, false>(bvh, ray, tMax, filter, hit);
   if (found) return hit;
   return std::nullopt;
 }
 
-bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, Intersection test) {
+bool anyHit(const Bvh& bvh, const Ray& ray, float tMax, Intersection test,
+            const HitFilter* filter) {
   Hit hit;
-  return test == Intersection::kWatertight ? traverse</*kAnyHit=*/true, true>(bvh, ray, tMax, hit)
-                                           : traverse</*kAnyHit=*/true, false>(bvh, ray, tMax, hit);
+  return test == Intersection::kWatertight
+             ? traverse</*kAnyHit=*/true, true>(bvh, ray, tMax, filter, hit)
+             : traverse</*kAnyHit=*/true, false>(bvh, ray, tMax, filter, hit);
 }
 
 }  // namespace pt

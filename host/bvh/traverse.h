@@ -34,6 +34,14 @@ struct Hit {
   uint triangle = 0;        // index into Bvh::triangles
 };
 
+// Decides, for a query, whether a hit on Bvh::triangles[triangle] counts: false drops it, as if
+// the ray had passed that triangle (alpha cut-outs: any-hit semantics within the traversal,
+// for closest-hit and any-hit queries alike). Called only for hits that would be taken.
+struct HitFilter {
+  bool (*accept)(const void* context, uint32_t triangle, const Hit& hit);
+  const void* context;
+};
+
 // A query's state as its triangle tests update it, for the CPU traversals: the closest hit
 // by the rule every traversal follows (isCloserHit in sampling.h: the answer does not depend
 // on the tree or the visiting order), and the range that boxes and triangles are tested
@@ -44,11 +52,16 @@ struct HitSearch {
   Hit best;                               // the closest hit so far (t = tMax before the first)
   uint32_t bestPrimitive = kNoPrimitive;  // its Triangle::primitive
   bool found = false;
-  explicit HitSearch(float queryTMax) : tMax(queryTMax), range(queryTMax) { best.t = queryTMax; }
+  const HitFilter* filter = nullptr;  // none: every hit counts
+  explicit HitSearch(float queryTMax, const HitFilter* hitFilter = nullptr)
+      : tMax(queryTMax), range(queryTMax), filter(hitFilter) {
+    best.t = queryTMax;
+  }
   // Offers a hit on Bvh::triangles[index], whose Triangle::primitive is `primitive`; takes it
   // and returns true if isCloserHit prefers it to the closest so far.
   bool offer(const Hit& hit, uint32_t index, uint32_t primitive) {
     if (!isCloserHit(hit.t, primitive, best.t, bestPrimitive)) return false;
+    if (filter != nullptr && !filter->accept(filter->context, index, hit)) return false;
     best = hit;
     best.triangle = index;
     bestPrimitive = primitive;
@@ -71,10 +84,11 @@ enum class Intersection { kWatertight, kFast };
 bool intersectBox(const RayPrecomputed& ray, vec3 lo, vec3 hi, float tMax, float& tNear);
 
 std::optional<Hit> closestHit(const Bvh& bvh, const Ray& ray, float tMax = INFINITY,
-                              Intersection test = Intersection::kWatertight);
+                              Intersection test = Intersection::kWatertight,
+                              const HitFilter* filter = nullptr);
 
 // True if anything lies on the ray with 0 < t < tMax. Stops at the first hit found.
 bool anyHit(const Bvh& bvh, const Ray& ray, float tMax,
-            Intersection test = Intersection::kWatertight);
+            Intersection test = Intersection::kWatertight, const HitFilter* filter = nullptr);
 
 }  // namespace pt

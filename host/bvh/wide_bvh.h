@@ -118,9 +118,10 @@ bool intersectLeafLaneByLane(const WideBvh& bvh, uint32_t firstPacket, uint32_t 
 // chosen at run time (AVX2, else SSE4 or SSSE3 in halves, else Highway's portable code);
 // Moller-Trumbore runs lane by lane.
 std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax = INFINITY,
-                              Intersection test = Intersection::kWatertight);
+                              Intersection test = Intersection::kWatertight,
+                              const HitFilter* filter = nullptr);
 bool anyHit(const WideBvh& bvh, const Ray& ray, float tMax,
-            Intersection test = Intersection::kWatertight);
+            Intersection test = Intersection::kWatertight, const HitFilter* filter = nullptr);
 
 // (Code compiled per Highway target can call the queries after their first steps, without
 // dispatching: wide_traversal::closestHitFromRoot and anyHitFromRoot in wide_traverse-inl.h.)

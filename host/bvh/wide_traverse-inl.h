@@ -244,7 +244,10 @@ HWY_INLINE bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket
                hn::Or(hn::And(detPositive, outPositive), hn::AndNot(detPositive, outNegative)));
     const uint32_t accepted = laneBits(d, hn::Not(reject)) & ((1u << packet.count) - 1u);
     if (accepted == 0) continue;
-    if constexpr (kAnyHit) return true;
+    // Any hit will do, unless a filter may drop it (then the hits are offered to it).
+    if constexpr (kAnyHit) {
+      if (search.filter == nullptr) return true;
+    }
     alignas(16) float tl[kPacketLanes], dl[kPacketLanes], ul[kPacketLanes], vl[kPacketLanes],
         wl[kPacketLanes];
     hn::Store(t, d, tl);
@@ -258,7 +261,10 @@ HWY_INLINE bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket
       Hit hit;
       hit.t = tl[i] * invDet;
       hit.barycentrics = vec3(ul[i], vl[i], wl[i]) * invDet;
-      if (search.offer(hit, packet.first + uint32_t(i), packet.primitive[i])) found = true;
+      if (search.offer(hit, packet.first + uint32_t(i), packet.primitive[i])) {
+        if constexpr (kAnyHit) return true;
+        found = true;
+      }
     }
   }
   return found;
@@ -312,7 +318,8 @@ HWY_INLINE int visitOrder(const ChildLanes& box, uint8_t (&byOrder)[kWideLanes])
 // shrunk since its box was tested: a box test now would miss it.
 // For a ray that enters the root's box (the caller has tested it).
 template <bool kAnyHit, bool kWatertight>
-bool traverseFromRoot(const WideBvh& bvh, const RayPrecomputed& r, float tMax, Hit& best) {
+bool traverseFromRoot(const WideBvh& bvh, const RayPrecomputed& r, float tMax, Hit& best,
+                      const HitFilter* filter = nullptr) {
   const RayLanes lanes(r);
   struct Entry {
     uint32_t child, packetCount;
@@ -320,7 +327,7 @@ bool traverseFromRoot(const WideBvh& bvh, const RayPrecomputed& r, float tMax, H
   };
   Entry stack[kWideStackSize];
   uint32_t stackSize = 0;
-  HitSearch search(tMax);
+  HitSearch search(tMax, filter);
   float cull = tMax * kFarScale;  // entry distances beyond it: a box test would miss
   Entry next{0u, 0u, 0.0f};       // the root node (never on the stack: its entry unused)
   for (;;) {

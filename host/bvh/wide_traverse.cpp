@@ -27,25 +27,28 @@ namespace HWY_NAMESPACE {
 using wide_traversal::traverseFromRoot;
 
 template <bool kAnyHit, bool kWatertight>
-bool traverse(const WideBvh& bvh, const Ray& ray, float tMax, Hit& best) {
+bool traverse(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter, Hit& best) {
   // The root's box first, as traverse.cpp tests it (the rays that miss it miss every box).
   const RayPrecomputed r(ray);
   float rootEnter = 0.0f;
   if (!intersectBox(r, bvh.rootMin, bvh.rootMax, tMax, rootEnter)) return false;
-  return traverseFromRoot<kAnyHit, kWatertight>(bvh, r, tMax, best);
+  return traverseFromRoot<kAnyHit, kWatertight>(bvh, r, tMax, best, filter);
 }
 
-bool closestHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, Hit& hit) {
-  return traverse</*kAnyHit=*/false, true>(bvh, ray, tMax, hit);
+bool closestHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter,
+                          Hit& hit) {
+  return traverse</*kAnyHit=*/false, true>(bvh, ray, tMax, filter, hit);
 }
-bool closestHitFast(const WideBvh& bvh, const Ray& ray, float tMax, Hit& hit) {
-  return traverse</*kAnyHit=*/false, false>(bvh, ray, tMax, hit);
+bool closestHitFast(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter,
+                    Hit& hit) {
+  return traverse</*kAnyHit=*/false, false>(bvh, ray, tMax, filter, hit);
 }
-bool anyHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, Hit& hit) {
-  return traverse</*kAnyHit=*/true, true>(bvh, ray, tMax, hit);
+bool anyHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter,
+                      Hit& hit) {
+  return traverse</*kAnyHit=*/true, true>(bvh, ray, tMax, filter, hit);
 }
-bool anyHitFast(const WideBvh& bvh, const Ray& ray, float tMax, Hit& hit) {
-  return traverse</*kAnyHit=*/true, false>(bvh, ray, tMax, hit);
+bool anyHitFast(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter, Hit& hit) {
+  return traverse</*kAnyHit=*/true, false>(bvh, ray, tMax, filter, hit);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -111,14 +114,14 @@ bool intersectBinaryNode(const WideBvh& bvh, const RayPrecomputed& r, BinaryNode
 
 template <bool kAnyHit>
 bool traverseAsBinary(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test,
-                      Hit& best) {
+                      const HitFilter* filter, Hit& best) {
   const RayPrecomputed r(ray);
   float tNear = 0.0f;
   if (!intersectBox(r, bvh.rootMin, bvh.rootMax, tMax, tNear)) return false;
   BinaryNode stack[kBvhStackSize];
   uint32_t stackSize = 0;
   BinaryNode node = resolve(bvh, BinaryNode{0, 0, kWideLanes});
-  HitSearch search(tMax);
+  HitSearch search(tMax, filter);
   for (;;) {
     if (node.isLeaf(bvh)) {
       const uint32_t first = bvh.nodes[node.node].child[node.first] & ~kWideLeaf;
@@ -160,23 +163,27 @@ HWY_EXPORT(closestHitFast);
 HWY_EXPORT(anyHitWatertight);
 HWY_EXPORT(anyHitFast);
 
-std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test) {
+std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test,
+                              const HitFilter* filter) {
   Hit hit;
   const bool found = degenerateRay(ray)
-                         ? traverseAsBinary</*kAnyHit=*/false>(bvh, ray, tMax, test, hit)
+                         ? traverseAsBinary</*kAnyHit=*/false>(bvh, ray, tMax, test, filter, hit)
                      : test == Intersection::kWatertight
-                         ? HWY_DYNAMIC_DISPATCH(closestHitWatertight)(bvh, ray, tMax, hit)
-                         : HWY_DYNAMIC_DISPATCH(closestHitFast)(bvh, ray, tMax, hit);
+                         ? HWY_DYNAMIC_DISPATCH(closestHitWatertight)(bvh, ray, tMax, filter, hit)
+                         : HWY_DYNAMIC_DISPATCH(closestHitFast)(bvh, ray, tMax, filter, hit);
   if (found) return hit;
   return std::nullopt;
 }
 
-bool anyHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test) {
+bool anyHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test,
+            const HitFilter* filter) {
   Hit hit;
-  if (degenerateRay(ray)) return traverseAsBinary</*kAnyHit=*/true>(bvh, ray, tMax, test, hit);
+  if (degenerateRay(ray)) {
+    return traverseAsBinary</*kAnyHit=*/true>(bvh, ray, tMax, test, filter, hit);
+  }
   return test == Intersection::kWatertight
-             ? HWY_DYNAMIC_DISPATCH(anyHitWatertight)(bvh, ray, tMax, hit)
-             : HWY_DYNAMIC_DISPATCH(anyHitFast)(bvh, ray, tMax, hit);
+             ? HWY_DYNAMIC_DISPATCH(anyHitWatertight)(bvh, ray, tMax, filter, hit)
+             : HWY_DYNAMIC_DISPATCH(anyHitFast)(bvh, ray, tMax, filter, hit);
 }
 
 std::vector<int64_t> wideTraversalTargets() {

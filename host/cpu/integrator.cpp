@@ -102,6 +102,37 @@ void printLightSample(const SceneData& scene, const LightPoint& light, float lig
   }
 }
 
+// Alpha cut-outs (texture.h's alphaKeepsHit) as the traversal's filter of one ray's hits;
+// u is the ray's number (pathAlphaRandom, shadowAlphaRandom).
+struct AlphaCutouts {
+  const SceneData* scene;
+  TextureTables tables;
+  float u;
+  static bool accept(const void* context, uint32_t triangle, const Hit& hit) {
+    const AlphaCutouts& a = *static_cast<const AlphaCutouts*>(context);
+    const Triangle& tri = a.scene->bvh.triangles[triangle];
+    return alphaKeepsHit(a.tables, tri.material, tri.primitive, hit.barycentrics, a.u);
+  }
+};
+
+// The scene's ray queries: the closest hit along a path's `ray`, and whether anything lies on a
+// shadow ray's segment t in [0, 1) whose light sample drew uLight, cut-outs passed by where the
+// scene has them.
+std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Intersection test,
+                                  uvec2 pixel, uint32_t sampleIndex, uint depth) {
+  if (!scene.effects.alphaCutouts) return closestHit(scene.wideBvh(), ray, INFINITY, test);
+  const AlphaCutouts cutouts{&scene, scene.textureTables(),
+                             pathAlphaRandom(pixel, sampleIndex, depth, scene.params.seed)};
+  const HitFilter filter{AlphaCutouts::accept, &cutouts};
+  return closestHit(scene.wideBvh(), ray, INFINITY, test, &filter);
+}
+bool occluded(const SceneData& scene, const Ray& ray, Intersection test, vec2 uLight) {
+  if (!scene.effects.alphaCutouts) return anyHit(scene.wideBvh(), ray, 1.0f, test);
+  const AlphaCutouts cutouts{&scene, scene.textureTables(), shadowAlphaRandom(uLight)};
+  const HitFilter filter{AlphaCutouts::accept, &cutouts};
+  return anyHit(scene.wideBvh(), ray, 1.0f, test, &filter);
+}
+
 // The analytic light (lights.h) an emitter names, or null for an emissive triangle.
 const Light* analyticLight(const SceneData& scene, const Emitter& emitter) {
   if ((emitter.triangle & kEmitterLight) == 0u) return nullptr;
@@ -112,12 +143,12 @@ const Light* analyticLight(const SceneData& scene, const Emitter& emitter) {
 // f * |cos| towards it (fCos) and its density (bsdfDensity, read only for MIS): traces the
 // shadow ray from `from` and returns the contribution, weighed by the power heuristic unless
 // the light is a delta (which BSDF sampling never finds).
-vec3 analyticLightContribution(const CpuSceneCopies& copies, const AnalyticLightSample& ls,
+vec3 analyticLightContribution(const SceneData& scene, const AnalyticLightSample& ls, vec2 uLight,
                                float pmf, vec3 from, vec3 beta, vec3 fCos, float bsdfDensity,
                                bool misOn, Intersection test, uint64_t& rays, bool debugPrint,
                                uint depth) {
   ++rays;
-  if (anyHit(copies.wide, Ray{from, ls.target - from}, 1.0f, test)) return vec3(0.0f);
+  if (occluded(scene, Ray{from, ls.target - from}, test, uLight)) return vec3(0.0f);
   const float lightPdf = pmf * ls.pdf;
   const float weight = (misOn && !ls.delta) ? powerHeuristic(lightPdf, bsdfDensity) : 1.0f;
   if (debugPrint) {
@@ -157,7 +188,7 @@ vec3 sampleDirectLight(const SceneData& scene, const CpuSceneCopies& copies, vec
   const vec3 from = offsetRayOrigin(p, side, magnitude);
   const vec3 to = offsetRayOrigin(light.point, light.normal, light.magnitude);
   ++rays;
-  if (anyHit(copies.wide, Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
+  if (occluded(scene, Ray{from, to - from}, test, uLight)) return vec3(0.0f);
 
   const float lightPdf = light.pmf * toward.dist2 / (toward.cosLight * light.area);
   const float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0f;
@@ -184,8 +215,8 @@ vec3 sampleDirectLightBsdf(const SceneData& scene, const CpuSceneCopies& copies,
     if (!(maxComponent(fCos) > 0.0f)) return vec3(0.0f);
     const float density = (misOn && !ls.delta) ? bsdfPdf(material, wo, wi, pdfStream) : 0.0f;
     const vec3 from = offsetRayOrigin(p, dot(ng, ls.wi) > 0.0f ? ng : -ng, magnitude);
-    return analyticLightContribution(copies, ls, emitter.pmf, from, beta, fCos, density, misOn,
-                                     test, rays, debugPrint, depth);
+    return analyticLightContribution(scene, ls, uLight, emitter.pmf, from, beta, fCos, density,
+                                     misOn, test, rays, debugPrint, depth);
   }
   LightPoint light = pointOnEmitter(scene, copies, emitter, uLight);
   ToLight toward = towardsLight(light, p);
@@ -198,7 +229,7 @@ vec3 sampleDirectLightBsdf(const SceneData& scene, const CpuSceneCopies& copies,
   const vec3 from = offsetRayOrigin(p, dot(ng, toward.wl) > 0.0f ? ng : -ng, magnitude);
   const vec3 to = offsetRayOrigin(light.point, light.normal, light.magnitude);
   ++rays;
-  if (anyHit(copies.wide, Ray{from, to - from}, 1.0f, test)) return vec3(0.0f);
+  if (occluded(scene, Ray{from, to - from}, test, uLight)) return vec3(0.0f);
 
   const float lightPdf = light.pmf * toward.dist2 / (toward.cosLight * light.area);
   const float weight =
@@ -218,7 +249,7 @@ vec3 sampleAnalyticLightDiffuse(const SceneData& scene, const Emitter& emitter, 
   const float cosWi = dot(n, ls.wi);
   if (!(cosWi > 0.0f) || !(maxComponent(ls.Li) > 0.0f)) return vec3(0.0f);
   const vec3 side = shadingNormals ? (dot(ng, ls.wi) > 0.0f ? ng : -ng) : n;
-  return analyticLightContribution(scene.cpuCopies(), ls, emitter.pmf,
+  return analyticLightContribution(scene, ls, uLight, emitter.pmf,
                                    offsetRayOrigin(p, side, magnitude), beta, f * cosWi,
                                    cosWi * kInvPi, misOn, test, rays, debugPrint, depth);
 }
@@ -310,7 +341,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
   for (uint depth = 0;;) {
     // Find the closest surface along the ray; the background is black.
     ++rays;
-    const std::optional<Hit> hit = closestHit(copies.wide, ray, INFINITY, test);
+    const std::optional<Hit> hit = closestSurface(scene, ray, test, pixel, sampleIndex, depth);
     if (!hit) {
       // The ray leaves the scene: the infinite light's radiance, weighed as an emitter's.
       L += environmentSeen(scene, beta, specularBounce, bsdfPdf);

@@ -87,7 +87,11 @@ uint JsonTextures::named(const JsonNode& value, bool isFloat, int depth) {
   if (def == defs_.end()) {
     std::vector<std::string_view> names;
     for (const auto& [n, d] : defs_) names.push_back(n);
-    value.fail("unknown texture " + singleQuoted(name) + didYouMean(name, names));
+    const std::string hint = didYouMean(name, names);
+    value.fail("unknown texture " + singleQuoted(name) +
+               (hint.empty() ? " (a string names one of the scene's \"textures\"; a value is a "
+                               "number or an array of 3 numbers)"
+                             : hint));
   }
   const auto key = std::make_pair(name, isFloat);
   if (auto found = built_.find(key); found != built_.end()) return found->second;

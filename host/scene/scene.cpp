@@ -723,6 +723,7 @@ ShapeTriangles readObjWithMtl(const JsonNode& shape, const MeshFile& file,
   ShapeTriangles out;
   out.triangles = std::move(obj.triangles);
   out.normals = std::move(obj.normals);
+  out.uvs = std::move(obj.uvs);
   out.materials.reserve(obj.material.size());
   for (std::size_t t = 0; t < obj.material.size(); ++t) {
     if (obj.material[t] < 0) {
@@ -884,6 +885,7 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
               scene_detail::loadObjMesh(file.bytes, file.path.string(), file.context);
           triangles.triangles = std::move(obj.triangles);
           triangles.normals = std::move(obj.normals);
+          triangles.uvs = std::move(obj.uvs);
         }
         break;
       }
@@ -893,6 +895,7 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
             scene_detail::loadPlyMesh(file.bytes, file.path.string(), file.context);
         triangles.triangles = std::move(ply.triangles);
         triangles.normals = std::move(ply.normals);
+        triangles.uvs = std::move(ply.uvs);
         if (ply.nonFiniteNormals > 0) {
           scene.warnings.push_back(file.path.string() + ": " +
                                    std::to_string(ply.nonFiniteNormals) +

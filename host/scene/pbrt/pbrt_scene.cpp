@@ -31,6 +31,7 @@
 #include "scene/pbrt/pbrt_parser.h"
 #include "scene/pbrt/spectra.h"
 #include "scene/ply_mesh.h"
+#include "scene/textures.h"
 
 namespace pt {
 
@@ -160,15 +161,19 @@ glm::dvec3 transformPoint(const glm::dmat4& m, glm::dvec3 p) {
 // Triangles with, optionally, the vertex normals of each (parallel to `triangles`). Once
 // oriented (orient below), a triangle's front side is the side of its winding's normal
 // (v1 - v0) x (v2 - v0), or, where it has vertex normals, the side they point to.
+using UVs = std::array<glm::vec2, 3>;
+
 struct Mesh {
   std::vector<Tri> triangles;
   std::vector<Tri> normals;
+  std::vector<UVs> uvs;  // per triangle, or empty: the mesh has none
 };
 
 // ReverseOrientation in object space, as pbrt-v4 does it: the front becomes the back, which
 // here means the other winding (and negated vertex normals).
 void reverseMesh(Mesh& mesh) {
   for (Tri& t : mesh.triangles) std::swap(t[1], t[2]);
+  for (UVs& uv : mesh.uvs) std::swap(uv[1], uv[2]);
   for (Tri& n : mesh.normals) {
     std::swap(n[1], n[2]);
     for (glm::dvec3& v : n) v = -v;
@@ -190,10 +195,15 @@ Mesh transformMesh(const Mesh& mesh, const glm::dmat4& m) {
   Mesh out;
   out.triangles.reserve(mesh.triangles.size());
   out.normals.reserve(mesh.normals.size());
+  out.uvs.reserve(mesh.uvs.size());
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
     Tri t = mesh.triangles[i];
+    UVs uv = mesh.uvs.empty() ? UVs{} : mesh.uvs[i];
     for (glm::dvec3& p : t) p = transformPoint(m, p);
-    if (swap) std::swap(t[1], t[2]);
+    if (swap) {
+      std::swap(t[1], t[2]);
+      std::swap(uv[1], uv[2]);
+    }
     if (!mesh.normals.empty()) {
       Tri n = mesh.normals[i];
       for (glm::dvec3& v : n) v = normalMatrix * v;  // zero where singular: see emit
@@ -206,10 +216,12 @@ Mesh transformMesh(const Mesh& mesh, const glm::dmat4& m) {
       if (glm::dot(glm::cross(t[1] - t[0], t[2] - t[0]), sum) < 0.0) {
         std::swap(t[1], t[2]);
         std::swap(n[1], n[2]);
+        std::swap(uv[1], uv[2]);
       }
       out.normals.push_back(n);
     }
     out.triangles.push_back(t);
+    if (!mesh.uvs.empty()) out.uvs.push_back(uv);
   }
   return out;
 }
@@ -373,9 +385,10 @@ struct MaterialDef {
   Material material{};
   std::string label;
   Location location;
-  std::array<std::string, 2> mix;  // kMix: the named materials
-  Location mixLocation;            // of "string materials"
-  double amount = 0.5;             // kMix: pbrt-v4's probability of the second
+  std::array<std::string, 2> mix;                    // kMix: the named materials
+  Location mixLocation;                              // of "string materials"
+  double amount = 0.5;                               // kMix: pbrt-v4's probability of the second
+  MaterialTextures textures = noMaterialTextures();  // parameters given by textures
 };
 
 // A scene material: a reference to a definition, with an area light's emission for the
@@ -384,7 +397,8 @@ struct Slot {
   MaterialRef ref;
   std::optional<vec3> emission;
   std::string lightLabel;
-  bool twoSided = false;  // the emission leaves both sides
+  bool twoSided = false;    // the emission leaves both sides
+  uint alpha = kNoTexture;  // the shapes' "alpha" (a cut-out), a texture
 };
 
 struct Texture {
@@ -477,9 +491,18 @@ class Builder {
   std::optional<vec3> textureMean(const Texture& t, bool isFloat, const Location& use, int depth);
   std::optional<vec3> textureParamMean(const Texture& t, const char* name, bool isFloat,
                                        vec3 fallback, int depth);
-  void readRoughness(const Params& p, Material& m, const std::string& prefix = "");
+  // Textures (shaders/texture.h) from the Texture directives that materials and shapes use:
+  // a texture's program, built once per texture and kind (float or spectrum); nullopt for the
+  // classes not simulated (a parameter then takes the texture's mean, textureMean).
+  std::optional<uint> buildTexture(Texture& t, bool isFloat, const Location& use, int depth);
+  // An operand of a composite texture: a value, or a texture (its mean where not simulated).
+  uint textureOperand(Texture& t, const char* name, bool isFloat, vec3 fallback, int depth);
+  // The texture a parameter names (a "texture" parameter of a simulated class), or kNoTexture
+  // where it has a value (or is absent).
+  uint textureParam(const Params& p, std::string_view name, bool isFloat);
+  void readRoughness(const Params& p, MaterialDef& def, const std::string& prefix = "");
 
-  uint slotFor(const MaterialRef& ref);
+  uint slotFor(const MaterialRef& ref, uint alpha = kNoTexture);
   const MaterialDef& resolve(const MaterialRef& ref);
   const MaterialDef& followMix(const MaterialDef& def);
   bool isKnownInterface(const MaterialRef& ref) const;
@@ -524,6 +547,8 @@ class Builder {
   std::vector<Slot> slots_;
   std::map<std::string, uint> slotIndex_;  // non-emissive slots by reference
   std::map<std::string, Texture> floatTextures_, spectrumTextures_;
+  TextureBuilder textures_{scene_};
+  std::map<std::pair<const Texture*, bool>, uint> builtTextures_;
 
   std::map<std::string, Instance> instances_;
   std::string activeInstance_;  // empty: not inside ObjectBegin
@@ -1098,18 +1123,31 @@ MaterialDef Builder::makeMaterial(const std::string& type, const Params& p, cons
              "more likely (pbrt-v4 picks one at random per point)");
     return def;
   }
+  MaterialTextures& tex = def.textures;
   const auto commonParams = [&] {
-    for (const char* name : {"displacement", "normalmap"}) {
-      if (p.find(name)) {
-        warnOnce(name, p.find(name)->location,
-                 std::string("\"") + name + "\" ignored: surfaces are not displaced or bumped");
+    // pbrt-v4's bump map: a float texture (or a number, which bumps nothing).
+    if (const Param* d = p.find("displacement", {ParamType::kFloat, ParamType::kTexture})) {
+      tex.displacement = textureParam(p, "displacement", true);
+      if (tex.displacement == kNoTexture && d->type == ParamType::kTexture) {
+        warnOnce("displacement", d->location,
+                 "\"displacement\" of a texture class that is not simulated is ignored");
       }
     }
+    if (p.find("normalmap")) {
+      warnOnce("normalmap", p.find("normalmap")->location,
+               "\"normalmap\" ignored: normal maps are not simulated");
+    }
+  };
+  // A colour parameter: its texture where it names one, else its value.
+  const auto colour = [&](const char* name, uint& slot, vec3& value) {
+    slot = textureParam(p, name, false);
+    if (slot != kNoTexture) return;
+    if (auto v = spectrum(p, name, Use::kAlbedo)) value = *v;
   };
   if (type == "diffuse") {
     m = defaultMaterial(kMaterialDiffuse);
     m.reflectance = vec3(kDefaultDiffuseReflectance);
-    if (auto r = spectrum(p, "reflectance", Use::kAlbedo)) m.reflectance = *r;
+    colour("reflectance", tex.reflectance, m.reflectance);
   } else if (type == "conductor" || type == "coatedconductor") {
     // coatedconductor: its conductor alone, the coat left out (warned).
     const std::string prefix = type == "coatedconductor" ? "conductor." : "";
@@ -1119,7 +1157,10 @@ MaterialDef Builder::makeMaterial(const std::string& type, const Params& p, cons
     PT_CHECK(copper != nullptr, "the named metal table has copper");
     m.eta = copper->eta;
     m.k = copper->k;
-    const auto reflectance = spectrum(p, "reflectance", Use::kAlbedo);
+    tex.reflectance = textureParam(p, "reflectance", false);
+    const auto reflectance = tex.reflectance != kNoTexture
+                                 ? std::optional<vec3>(vec3(0.5f))
+                                 : spectrum(p, "reflectance", Use::kAlbedo);
     const Param* etaParam = p.find(prefix + "eta");
     const Param* kParam = p.find(prefix + "k");
     if (reflectance && (etaParam || kParam)) {
@@ -1128,14 +1169,20 @@ MaterialDef Builder::makeMaterial(const std::string& type, const Params& p, cons
            "pbrt-v4)");
     }
     if (reflectance) setConductorReflectance(m, *reflectance);
-    if (auto eta = spectrum(p, prefix + "eta", Use::kUnbounded, true)) {
+    tex.eta = textureParam(p, prefix + "eta", false);
+    tex.k = textureParam(p, prefix + "k", false);
+    if (tex.eta != kNoTexture) {
+      // (the texture gives eta at each hit)
+    } else if (auto eta = spectrum(p, prefix + "eta", Use::kUnbounded, true)) {
       for (int c = 0; c < 3; ++c) {
         p.checkBounded(*etaParam, (*eta)[c], 0.0, true, 3.4e38, false, "a positive index");
       }
       m.eta = *eta;
     }
-    if (auto k = spectrum(p, prefix + "k", Use::kUnbounded, true)) m.k = *k;
-    readRoughness(p, m, prefix);
+    if (tex.k == kNoTexture) {
+      if (auto k = spectrum(p, prefix + "k", Use::kUnbounded, true)) m.k = *k;
+    }
+    readRoughness(p, def, prefix);
     if (type == "coatedconductor") {
       warnOnce("coatedconductor", where,
                "Material \"coatedconductor\" is rendered as its conductor without the coat "
@@ -1155,18 +1202,19 @@ MaterialDef Builder::makeMaterial(const std::string& type, const Params& p, cons
       p.checkBounded(*e, index, 0.0, true, 3.4e38, false, "a positive index");
       m.eta = vec3(index, 0.0f, 0.0f);
     }
-    if (type == "dielectric") readRoughness(p, m);
+    if (type == "dielectric") readRoughness(p, def);
   } else if (type == "diffusetransmission") {
     m = defaultMaterial(kMaterialDiffuseTransmission);
-    if (auto r = spectrum(p, "reflectance", Use::kAlbedo)) m.reflectance = *r;
-    if (auto t = spectrum(p, "transmittance", Use::kAlbedo)) m.transmittance = *t;
+    colour("reflectance", tex.reflectance, m.reflectance);
+    colour("transmittance", tex.transmittance, m.transmittance);
     if (auto v = p.bounded("scale", 0.0, false, 3.4e38, false, "a non-negative number")) {
       scaleDiffuseTransmission(m, static_cast<float>(*v));
+      tex.scale = static_cast<float>(*v);  // textured colours are scaled at each hit
     }
   } else if (type == "coateddiffuse") {
     m = defaultMaterial(kMaterialCoatedDiffuse);
-    if (auto r = spectrum(p, "reflectance", Use::kAlbedo)) m.reflectance = *r;
-    readRoughness(p, m);
+    colour("reflectance", tex.reflectance, m.reflectance);
+    readRoughness(p, def);
     if (auto v = floatOrTexture(p, "thickness")) {
       p.checkBounded(*p.find("thickness"), *v, 0.0, true, 3.4e38, false, "a positive number");
       m.thickness = static_cast<float>(*v);
@@ -1176,7 +1224,7 @@ MaterialDef Builder::makeMaterial(const std::string& type, const Params& p, cons
       p.checkBounded(*p.find("eta"), index, 0.0, true, 3.4e38, false, "a positive index");
       m.eta = vec3(index, 0.0f, 0.0f);
     }
-    if (auto a = spectrum(p, "albedo", Use::kAlbedo)) m.transmittance = *a;
+    colour("albedo", tex.transmittance, m.transmittance);
     if (auto g = floatOrTexture(p, "g")) {
       p.checkBounded(*p.find("g"), *g, -1.0, true, 1.0, true, "a number strictly between -1 and 1");
       m.g = static_cast<float>(*g);
@@ -1210,8 +1258,21 @@ MaterialDef Builder::makeMaterial(const std::string& type, const Params& p, cons
 }
 
 // pbrt-v4's roughness parameters: u and v default to "roughness" (0), remapped by default.
-void Builder::readRoughness(const Params& p, Material& m, const std::string& prefix) {
+void Builder::readRoughness(const Params& p, MaterialDef& def, const std::string& prefix) {
+  Material& m = def.material;
+  MaterialTextures& tex = def.textures;
+  // Textures first: "roughness" gives u and v unless they are given themselves.
+  const uint both = textureParam(p, prefix + "roughness", true);
+  tex.uRoughness = textureParam(p, prefix + "uroughness", true);
+  tex.vRoughness = textureParam(p, prefix + "vroughness", true);
+  if (tex.uRoughness == kNoTexture && !p.find(prefix + "uroughness")) tex.uRoughness = both;
+  if (tex.vRoughness == kNoTexture && !p.find(prefix + "vroughness")) tex.vRoughness = both;
   auto read = [&](const std::string& name, double fallback) {
+    const Param* t = p.find(name);
+    if (t != nullptr && t->type == ParamType::kTexture &&
+        textureParam(p, name, true) != kNoTexture) {
+      return fallback;  // the texture gives it at each hit
+    }
     const std::optional<double> v = floatOrTexture(p, name);
     if (!v) return fallback;
     p.checkBounded(*p.find(name), *v, 0.0, false, 3.4e38, false, "a non-negative number");
@@ -1222,6 +1283,7 @@ void Builder::readRoughness(const Params& p, Material& m, const std::string& pre
   const double v = read(prefix + "vroughness", roughness);
   const bool remap = p.boolean("remaproughness").value_or(true);
   setRoughness(m, static_cast<float>(u), static_cast<float>(v), remap);
+  if (remap) tex.flags |= kRemapRoughness;
 }
 
 std::optional<double> Builder::floatOrTexture(const Params& p, std::string_view name) {
@@ -1236,6 +1298,162 @@ std::optional<double> Builder::floatOrTexture(const Params& p, std::string_view 
   }
   if (auto mean = textureMean(it->second, /*isFloat=*/true, q->location, 0)) return (*mean).x;
   return std::nullopt;
+}
+
+uint Builder::textureParam(const Params& p, std::string_view name, bool isFloat) {
+  const Param* q = p.find(name);
+  if (q == nullptr || q->type != ParamType::kTexture) return kNoTexture;
+  p.expectCount(*q, 1);
+  auto& table = isFloat ? floatTextures_ : spectrumTextures_;
+  const auto it = table.find(q->strings[0]);
+  if (it == table.end()) {
+    fail(q->location, "unknown " + std::string(isFloat ? "float" : "spectrum") + " texture " +
+                          singleQuoted(q->strings[0]) + " for " + singleQuoted(q->name));
+  }
+  return buildTexture(it->second, isFloat, q->location, 0).value_or(kNoTexture);
+}
+
+namespace {
+
+// The last parameter of texture t named `name` of type `type`, marked used; or null.
+Param* textureParamOf(Texture& t, std::string_view name, ParamType type) {
+  for (auto v = t.params.rbegin(); v != t.params.rend(); ++v) {
+    if (v->name == name && v->type == type) {
+      v->used = true;
+      return &*v;
+    }
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+uint Builder::textureOperand(Texture& t, const char* name, bool isFloat, vec3 fallback, int depth) {
+  for (auto v = t.params.rbegin(); v != t.params.rend(); ++v) {
+    if (v->name != name || v->type != ParamType::kTexture || v->strings.empty()) continue;
+    v->used = true;
+    auto& table = isFloat ? floatTextures_ : spectrumTextures_;
+    const auto it = table.find(v->strings[0]);
+    if (it == table.end()) {
+      fail(v->location, "unknown " + std::string(isFloat ? "float" : "spectrum") + " texture " +
+                            singleQuoted(v->strings[0]));
+    }
+    if (auto built = buildTexture(it->second, isFloat, v->location, depth + 1)) return *built;
+    // A class not simulated: its mean (textureMean warns).
+    return textures_.constant(
+        textureMean(it->second, isFloat, v->location, depth + 1).value_or(fallback));
+  }
+  return textures_.constant(textureParamMean(t, name, isFloat, fallback, depth).value_or(fallback));
+}
+
+std::optional<uint> Builder::buildTexture(Texture& t, bool isFloat, const Location& use,
+                                          int depth) {
+  const auto key = std::make_pair(static_cast<const Texture*>(&t), isFloat);
+  if (const auto it = builtTextures_.find(key); it != builtTextures_.end()) return it->second;
+  if (depth > 16) fail(use, "textures nested more than 16 deep (a cycle?)");
+  const std::string& c = t.className;
+  // The (u, v) mapping of imagemap and checkerboard: pbrt-v4's "uv" only.
+  const auto mapping = [&]() -> std::optional<vec4> {
+    if (const Param* m = textureParamOf(t, "mapping", ParamType::kString)) {
+      if (!m->strings.empty() && m->strings[0] != "uv") {
+        warnOnce("mapping " + m->strings[0], m->location,
+                 "texture mapping " + singleQuoted(m->strings[0]) +
+                     " is not simulated: textures that use it take their mean value");
+        return std::nullopt;
+      }
+    }
+    vec4 uv(1.0f, 1.0f, 0.0f, 0.0f);
+    const char* names[] = {"uscale", "vscale", "udelta", "vdelta"};
+    for (int i = 0; i < 4; ++i) {
+      if (const Param* v = textureParamOf(t, names[i], ParamType::kFloat)) {
+        if (!v->numbers.empty()) uv[i] = static_cast<float>(v->numbers[0]);
+      }
+    }
+    return uv;
+  };
+  std::optional<uint> built;
+  try {
+    if (c == "constant") {
+      built = textureOperand(t, "value", isFloat, vec3(1.0f), depth);
+    } else if (c == "scale") {
+      const uint tex = textureOperand(t, "tex", isFloat, vec3(1.0f), depth);
+      built = textures_.scale(tex, textureOperand(t, "scale", true, vec3(1.0f), depth));
+    } else if (c == "mix") {
+      const uint a = textureOperand(t, "tex1", isFloat, vec3(0.0f), depth);
+      const uint b = textureOperand(t, "tex2", isFloat, vec3(1.0f), depth);
+      built = textures_.mix(a, b, textureOperand(t, "amount", true, vec3(0.5f), depth));
+    } else if (c == "checkerboard") {
+      const Param* dimension = textureParamOf(t, "dimension", ParamType::kInteger);
+      const bool twoD =
+          dimension == nullptr || dimension->numbers.empty() || dimension->numbers[0] == 2.0;
+      if (twoD) {
+        if (const std::optional<vec4> uv = mapping()) {
+          const uint a = textureOperand(t, "tex1", isFloat, vec3(1.0f), depth);
+          const uint b = textureOperand(t, "tex2", isFloat, vec3(0.0f), depth);
+          built = textures_.checkerboard(*uv, a, b);
+        }
+      }
+    } else if (c == "imagemap") {
+      const Param* file = textureParamOf(t, "filename", ParamType::kString);
+      if (file == nullptr || file->strings.empty() || file->strings[0].empty()) {
+        fail(t.location, "Texture \"imagemap\" without a \"filename\"");
+      }
+      if (const std::optional<vec4> uv = mapping()) {
+        ImageTextureDesc desc;
+        desc.filename = resolvePath(file->strings[0], file->location, mainFile_);
+        desc.mapping = *uv;
+        if (const Param* e = textureParamOf(t, "encoding", ParamType::kString)) {
+          double gamma = 0.0;
+          if (e->strings.empty() || !parseColorEncoding(e->strings[0], gamma)) {
+            fail(e->location, "Texture \"imagemap\": unknown \"encoding\" " +
+                                  singleQuoted(e->strings.empty() ? "" : e->strings[0]) +
+                                  " (expected \"sRGB\", \"linear\" or \"gamma <g>\")");
+          }
+          desc.encoding = e->strings[0];
+        }
+        if (const Param* w = textureParamOf(t, "wrap", ParamType::kString)) {
+          if (w->strings.empty() || !parseWrapMode(w->strings[0], desc.wrap)) {
+            fail(w->location, "Texture \"imagemap\": unknown \"wrap\" " +
+                                  singleQuoted(w->strings.empty() ? "" : w->strings[0]) +
+                                  " (expected \"repeat\", \"clamp\" or \"black\")");
+          }
+        }
+        if (const Param* f = textureParamOf(t, "filter", ParamType::kString)) {
+          const std::string name = f->strings.empty() ? "" : f->strings[0];
+          if (name == "point") {
+            desc.filter = kTexturePoint;
+          } else if (name == "bilinear" || name == "trilinear" || name == "ewa" || name == "EWA") {
+            desc.filter = kTextureBilinear;  // MIP maps are not kept: docs/pbrt-format.md
+          } else {
+            fail(f->location, "Texture \"imagemap\": unknown \"filter\" " + singleQuoted(name) +
+                                  " (expected \"point\", \"bilinear\", \"trilinear\" or "
+                                  "\"ewa\")");
+          }
+        }
+        textureParamOf(t, "maxanisotropy", ParamType::kFloat);
+        if (const Param* v = textureParamOf(t, "scale", ParamType::kFloat)) {
+          if (!v->numbers.empty()) desc.scale = static_cast<float>(v->numbers[0]);
+        }
+        if (const Param* v = textureParamOf(t, "invert", ParamType::kBool)) {
+          if (!v->bools.empty()) desc.invert = v->bools[0];
+        }
+        try {
+          built = textures_.image(desc, isFloat);
+        } catch (const InputError& e) {
+          fail(file->location, std::string("Texture \"imagemap\": ") + e.what());
+        }
+      }
+    }
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    // Already located (file:line:column); else the builder's (nesting) about this texture.
+    if (what.rfind(t.location.fileLine(), 0) == 0 || what.find(".pbrt:") != std::string::npos) {
+      throw;
+    }
+    fail(t.location, "Texture: " + what);
+  }
+  if (built) builtTextures_.emplace(key, *built);
+  return built;
 }
 
 // What each texture class averages to over the (u, v) square: a constant its value, an image
@@ -1558,12 +1776,13 @@ vec3 Builder::spectrumValue(const Params& p, const Param& q, Use use, int depth)
   return convert(spectra::piecewiseLinear(pairs), "spectrum");
 }
 
-uint Builder::slotFor(const MaterialRef& ref) {
-  const std::string key = ref.named ? "n" + ref.name : "i" + std::to_string(ref.inlineIndex);
+uint Builder::slotFor(const MaterialRef& ref, uint alpha) {
+  std::string key = ref.named ? "n" + ref.name : "i" + std::to_string(ref.inlineIndex);
+  if (alpha != kNoTexture) key += " alpha " + std::to_string(alpha);
   const auto it = slotIndex_.find(key);
   if (it != slotIndex_.end()) return it->second;
   const uint index = static_cast<uint>(slots_.size());
-  slots_.push_back(Slot{ref, std::nullopt, ""});
+  slots_.push_back(Slot{ref, std::nullopt, "", false, alpha});
   slotIndex_.emplace(key, index);
   return index;
 }
@@ -1798,9 +2017,20 @@ void Builder::shape(Statement& s) {
   Params p(*this, s, &gs_.shapeAttributes, context);
   Mesh mesh;
   const bool built = buildShape(type, p, s, mesh);
-  if (const Param* alpha = p.find("alpha", {ParamType::kFloat, ParamType::kTexture})) {
-    if (alpha->type == ParamType::kTexture || alpha->numbers.at(0) != 1.0) {
-      warnOnce("alpha", alpha->location, "\"alpha\" ignored: shapes are opaque");
+  // pbrt-v4's "alpha": the shape is cut away where it is 0 (a texture or a number).
+  uint alpha = kNoTexture;
+  if (const Param* a = p.find("alpha", {ParamType::kFloat, ParamType::kTexture})) {
+    if (a->type == ParamType::kTexture) {
+      alpha = textureParam(p, "alpha", true);
+      if (alpha == kNoTexture) {
+        warnOnce("alpha", a->location,
+                 "\"alpha\" of a texture class that is not simulated is ignored: the shape is "
+                 "opaque");
+      }
+    } else {
+      p.expectCount(*a, 1);
+      p.checkBounded(*a, a->numbers[0], 0.0, false, 1.0, false, "a number in [0, 1]");
+      if (a->numbers[0] != 1.0) alpha = textures_.constant(vec3(float(a->numbers[0])));
     }
   }
   p.reportUnused();
@@ -1822,7 +2052,7 @@ void Builder::shape(Statement& s) {
                "area lights in object instances are ignored, as pbrt-v4 ignores them");
     }
     instances_[activeInstance_].shapes.push_back(
-        InstanceShape{std::move(world), slotFor(gs_.material), s.location, context});
+        InstanceShape{std::move(world), slotFor(gs_.material, alpha), s.location, context});
     return;
   }
   uint slot;
@@ -1847,7 +2077,8 @@ void Builder::shape(Statement& s) {
     }
     slot = static_cast<uint>(slots_.size());
     slots_.push_back(Slot{gs_.material, vec3(emission),
-                          "AreaLightSource at " + light.location.fileLine(), light.twoSided});
+                          "AreaLightSource at " + light.location.fileLine(), light.twoSided,
+                          alpha});
     // A sphere that stays a sphere (a rotation and a uniform scale, no mirror) and emits
     // outwards on one side: light sampling takes the cone it subtends, as pbrt-v4's does.
     const glm::dmat3 m(gs_.ctm.m);
@@ -1868,7 +2099,7 @@ void Builder::shape(Statement& s) {
       sphereLights_.emplace_back(sphere, slot);
     }
   } else {
-    slot = slotFor(gs_.material);
+    slot = slotFor(gs_.material, alpha);
   }
   emit(world, slot, s.location, context);
 }
@@ -1914,12 +2145,20 @@ bool Builder::buildShape(const std::string& type, const Params& p, const Stateme
       fail(N->location, "\"N\" of " + context + " has " + std::to_string(N->numbers.size() / 3) +
                             " normals for " + std::to_string(points) + " points");
     }
-    // Texture coordinates and tangents are read (and checked) but not used yet.
-    if (const Param* uv = p.find("uv", {ParamType::kPoint2, ParamType::kFloat})) {
+    // Texture coordinates are kept; tangents are read (and checked) but not used.
+    const Param* uv = p.find("uv", {ParamType::kPoint2, ParamType::kFloat});
+    if (uv != nullptr) {
       if (uv->numbers.size() != 2 * points) {
         fail(uv->location, "\"uv\" of " + context + " has " +
                                std::to_string(uv->numbers.size() / 2) + " pairs for " +
                                std::to_string(points) + " points");
+      }
+      for (double v : uv->numbers) {
+        if (!(std::fabs(v) <= double(std::numeric_limits<float>::max()))) {
+          fail(uv->location, "\"uv\" of " + context +
+                                 " has a value that is not finite or "
+                                 "does not fit a 32-bit float");
+        }
       }
     }
     p.find("S");
@@ -1935,6 +2174,13 @@ bool Builder::buildShape(const std::string& type, const Params& p, const Stateme
       if (N != nullptr) {
         mesh.normals.push_back(Tri{point(N->numbers, indices[t]), point(N->numbers, indices[t + 1]),
                                    point(N->numbers, indices[t + 2])});
+      }
+      if (uv != nullptr) {
+        const auto at = [&](double i) {
+          const std::size_t k = static_cast<std::size_t>(i) * 2;
+          return glm::vec2(float(uv->numbers[k]), float(uv->numbers[k + 1]));
+        };
+        mesh.uvs.push_back(UVs{at(indices[t]), at(indices[t + 1]), at(indices[t + 2])});
       }
     }
     return true;
@@ -1956,6 +2202,7 @@ bool Builder::buildShape(const std::string& type, const Params& p, const Stateme
         bytes, path.string(), " (referenced by " + f->location.fileLine() + ")");
     mesh.triangles = std::move(ply.triangles);
     mesh.normals = std::move(ply.normals);
+    mesh.uvs = std::move(ply.uvs);
     if (ply.nonFiniteNormals > 0) {
       warnOnce("non-finite normals", f->location,
                context + ": " + std::to_string(ply.nonFiniteNormals) + " vertex normals of " +
@@ -2096,12 +2343,14 @@ void Builder::emit(const Mesh& mesh, uint slot, const Location& where, const std
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
     Tri t = mesh.triangles[i];
     Tri n = mesh.normals.empty() ? Tri{} : mesh.normals[i];
+    UVs uv = mesh.uvs.empty() ? UVs{} : mesh.uvs[i];
     if (mirrored_) {
       // x -> -x reverses the winding, and the swap restores the front.
       for (glm::dvec3& v : t) v.x = -v.x;
       for (glm::dvec3& v : n) v.x = -v.x;
       std::swap(t[1], t[2]);
       std::swap(n[1], n[2]);
+      std::swap(uv[1], uv[2]);
     }
     Triangle out{};
     glm::vec3* corners[3] = {&out.v0, &out.v1, &out.v2};
@@ -2114,7 +2363,8 @@ void Builder::emit(const Mesh& mesh, uint slot, const Location& where, const std
     }
     // Zero-area triangles dropped, normals made unit, as the JSON reader does.
     out.material = slot;
-    const Appended appended = appendTriangle(scene, out, mesh.normals.empty() ? nullptr : &n);
+    const Appended appended = appendTriangle(scene, out, mesh.normals.empty() ? nullptr : &n,
+                                             mesh.uvs.empty() ? nullptr : &uv);
     if (appended == Appended::kZeroArea) ++dropped;
     if (appended == Appended::kTooMany) {
       fail(where, "too many triangles in the scene (at most 4294967295)");
@@ -2189,16 +2439,21 @@ Scene Builder::finish(const Location& end) {
     t.primitive = static_cast<uint>(kept);
     scene_.triangles[kept] = t;
     if (!scene_.normals.empty()) scene_.normals[kept] = scene_.normals[i];
+    if (!scene_.uvs.empty()) scene_.uvs[kept] = scene_.uvs[i];
     ++kept;
   }
   scene_.triangles.resize(kept);
   if (!scene_.normals.empty()) scene_.normals.resize(kept);
+  if (!scene_.uvs.empty()) scene_.uvs.resize(kept);
   std::vector<uint> remap(slots_.size(), 0);
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     if (!used[i]) continue;
     remap[i] = static_cast<uint>(scene_.materials.size());
     scene_.materials.push_back(materials[i]);
     scene_.materialNames.push_back(names[i]);
+    MaterialTextures textures = resolve(slots_[i].ref).textures;
+    textures.alpha = slots_[i].alpha;
+    setMaterialTextures(scene_, scene_.materials.size() - 1, textures);
   }
   for (Triangle& t : scene_.triangles) t.material = remap[t.material];
   for (auto& [sphere, slot] : sphereLights_) {
