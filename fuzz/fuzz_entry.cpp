@@ -7,12 +7,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <unistd.h>
 
 #include "common/check.h"
 #include "image/image.h"
+#include "image/texture_image.h"
 #include "scene/mtl_materials.h"
 #include "scene/obj_mesh.h"
 #include "scene/ply_mesh.h"
@@ -162,10 +164,39 @@ Outcome fuzzPbrt(const std::uint8_t* data, std::size_t size) {
   });
 }
 
+const char* textureExtension(std::uint8_t selector) {
+  static constexpr const char* kExtensions[] = {".png", ".jpg", ".tga", ".bmp",
+                                                ".hdr", ".exr", ".pfm"};
+  return kExtensions[selector % std::size(kExtensions)];
+}
+
+// Every texture format, the decoder picked by the first byte as a file's extension picks it,
+// so that inputs of one format also reach the others' decoders (as misnamed files would). An
+// accepted image must keep TextureImage's promises.
+Outcome fuzzTexture(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return Outcome::kInputError;
+  const fs::path path = workDir() / (std::string("texture") + textureExtension(data[0]));
+  writeFile(path, data + 1, size - 1);
+  return guarded([&] {
+    const TextureImage image = readTextureImage(path);
+    PT_CHECK(image.width > 0 && image.height > 0 &&
+                 int64_t(image.width) * image.height <= kMaxTextureTexels,
+             "texture: bad size accepted");
+    PT_CHECK(image.channels == 1 || image.channels == 3 || image.channels == 4,
+             "texture: bad channel count");
+    const std::size_t count =
+        std::size_t(image.width) * std::size_t(image.height) * std::size_t(image.channels);
+    PT_CHECK(image.eightBit() ? image.bytes.size() == count && image.floats.empty()
+                              : image.floats.size() == count && image.bytes.empty(),
+             "texture: texel count does not match the size");
+    PT_CHECK(!image.floatsEncoded || !image.eightBit(), "texture: encoded bytes flagged");
+  });
+}
+
 const std::vector<Target>& targets() {
-  static const std::vector<Target> all = {{"scene", fuzzScene}, {"obj", fuzzObj},
-                                          {"mtl", fuzzMtl},     {"ply", fuzzPly},
-                                          {"image", fuzzImage}, {"pbrt", fuzzPbrt}};
+  static const std::vector<Target> all = {
+      {"scene", fuzzScene}, {"obj", fuzzObj},   {"mtl", fuzzMtl},        {"ply", fuzzPly},
+      {"image", fuzzImage}, {"pbrt", fuzzPbrt}, {"texture", fuzzTexture}};
   return all;
 }
 

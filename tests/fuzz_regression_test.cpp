@@ -9,9 +9,12 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "common/check.h"
 #include "fuzz/fuzz_entry.h"
 #include "image/image.h"
+#include "image/texture_image.h"
 
 namespace pt {
 namespace {
@@ -57,6 +60,30 @@ TEST(FuzzRegressions, PngChunkLongerThanTheFileIsRefusedBeforeDecoding) {
     const std::string m = e.what();
     EXPECT_NE(m.find("idat-length-2gib.png: PNG chunk '"), std::string::npos) << m;
     EXPECT_NE(m.find("bytes, but the file ends at byte 102"), std::string::npos) << m;
+  }
+}
+
+// The texture fuzzer's first findings: JPEG Huffman tables of more than 256 codes made
+// stb_image write past its 257-byte code-size array, in stbi_info as well as when decoding.
+// The table check refuses them first. (The inputs' first byte picks the format.)
+TEST(FuzzRegressions, JpegHuffmanTableOfMoreThan256CodesIsRefused) {
+  for (const char* name :
+       {"jpeg-huffman-table-of-257-codes", "jpeg-huffman-table-before-the-frame"}) {
+    SCOPED_TRACE(name);
+    std::ifstream in(kSource / "tests/data/fuzz-regressions/texture" / name, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_GT(bytes.size(), 1u);
+    const fs::path jpeg = fs::temp_directory_path() /
+                          ("pt-" + std::string(name) + "-" + std::to_string(::getpid()) + ".jpg");
+    std::ofstream(jpeg, std::ios::binary) << bytes.substr(1);
+    try {
+      readTextureImage(jpeg);
+      ADD_FAILURE() << "expected an InputError";
+    } catch (const InputError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind(jpeg.string() + ": bad JPEG Huffman table: ", 0), 0u) << m;
+    }
+    fs::remove(jpeg);
   }
 }
 

@@ -1,4 +1,6 @@
-// Image files as textures read them (PLACEHOLDER until the texture-images branch lands).
+// Image files as textures and environment maps need them: the texels as stored (8-bit, still
+// encoded) or as floats, with the file's channel count. readImage (image.h) reads the same
+// files as linear RGB.
 #pragma once
 
 #include <cstdint>
@@ -19,6 +21,9 @@ struct TextureImage {
   bool eightBit() const { return !bytes.empty(); }
 };
 
+// Reads by extension (any case): .png, .jpg/.jpeg, .tga, .bmp, .hdr, .exr, .pfm. InputError
+// "<path>: <reason>" (one line) for an unknown extension, a missing, truncated or malformed
+// file, or one larger than kMaxTextureTexels texels (checked from the header before decoding).
 TextureImage readTextureImage(const std::filesystem::path& path);
 inline constexpr int64_t kMaxTextureTexels = int64_t(1) << 28;
 
