@@ -535,9 +535,12 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   vec3 b = hitBarycentrics(path.origin, path.direction, tri);
 #ifndef PT_NO_BSDF_MATERIALS
   // The parameters that textures give, at the hit's texture coordinates.
-  if (kTextures && params.texturesPresent != 0u) {
-    vec2 uv = interpolatedUV(uvsAt(tri.primitive), b);
-    material = resolveMaterial(material, materialTexturesAt(tri.material), uv);
+  vec2 uv = vec2(0.0);
+  MaterialTextures textures;
+  if ((kTextures || kBumpMaps) && params.texturesPresent != 0u) {
+    uv = interpolatedUV(uvsAt(tri.primitive), b);
+    textures = materialTexturesAt(tri.material);
+    if (kTextures) material = resolveMaterial(material, textures, uv);
   }
 #endif
   vec3 p = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
@@ -591,10 +594,23 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   vec3 n = cosOut >= 0.0 ? ng : -ng;
   // With vertex normals, shaded about the interpolated normal (integrator.cpp says more).
   vec3 ns = ng;
+  bool shaded = kShadingNormals && params.normalsPresent != 0u;  // ns may differ from ng
 #ifndef PT_NO_BSDF_MATERIALS
-  if (kShadingNormals && params.normalsPresent != 0u) {
-    ns = interpolatedNormal(loadNormals(tri.primitive), b, ng);
+  TriangleNormals normals;
+  if (shaded) {
+    normals = loadNormals(tri.primitive);
+    ns = interpolatedNormal(normals, b, ng);
     n = dot(ns, wo) >= 0.0 ? ns : -ns;
+  }
+  // A bump map moves the shading normal (texture.h).
+  if (kBumpMaps && params.texturesPresent != 0u && textures.displacement != kNoTexture) {
+    vec3 bumped =
+        bumpedNormal(textures.displacement, tri, uvsAt(tri.primitive), uv, ng, ns, shaded, normals);
+    if (bumped != ns) {
+      ns = bumped;
+      shaded = true;
+      n = dot(ns, wo) >= 0.0 ? ns : -ns;
+    }
   }
 #endif
   vec3 wi;
@@ -640,8 +656,7 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
     vec3 f = material.reflectance * kInvPi;
     // Sample direct illumination from an emitter (next-event estimation).
     if (neeOn() && material.reflectance != vec3(0.0)) {
-      path.L += sampleDirectLight(p, n, ng, kShadingNormals && params.normalsPresent != 0u,
-                                  magnitude, path.beta, f,
+      path.L += sampleDirectLight(p, n, ng, shaded, magnitude, path.beta, f,
                                   random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
                                   random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
                                   misOn(), path.depth, retrace);
@@ -665,7 +680,7 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   }
 
   // Leave the surface on the side of the new direction.
-  if (kShadingNormals && params.normalsPresent != 0u) n = dot(ng, wi) > 0.0 ? ng : -ng;
+  if (shaded) n = dot(ng, wi) > 0.0 ? ng : -ng;
   path.origin = offsetRayOrigin(p, n, magnitude);
   path.direction = wi;
   return false;

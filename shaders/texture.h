@@ -22,6 +22,8 @@
 #ifdef __cplusplus
 namespace pt {
 
+#define PT_TEX_OUT(T) T&
+
 struct TextureTables {
   const TextureNode* nodes = nullptr;
   const uint* words = nullptr;  // the image buffer: texels and decoding tables
@@ -45,6 +47,7 @@ inline TriangleUVs uvsAt(const TextureTables& tables, uint i) {
 #else
 #define PT_TEXTURES_PARAM
 #define PT_TEXTURES_ARG
+#define PT_TEX_OUT(T) out T
 #endif
 
 #ifndef PT_TEXTURE_LOOP_TICK
@@ -252,6 +255,87 @@ PT_INLINE Material resolveMaterial(PT_TEXTURES_PARAM Material m, MaterialTexture
     m.alphaY = remap ? sqrt(r) : r;
   }
   return m;
+}
+
+// ---- Bump maps ---------------------------------------------------------------------------
+
+// Two unit vectors completing v (unit) to an orthonormal basis (pbrt-v4's CoordinateSystem).
+PT_INLINE void coordinateSystem(vec3 v, PT_TEX_OUT(vec3) a, PT_TEX_OUT(vec3) b) {
+  float sign = v.z >= 0.0f ? 1.0f : -1.0f;
+  float k = -1.0f / (sign + v.z);
+  float c = v.x * v.y * k;
+  a = vec3(1.0f + sign * v.x * v.x * k, sign * c, -sign * v.x);
+  b = vec3(c, sign + v.y * v.y * k, -v.y);
+}
+
+// The shading normal that pbrt-v4's BumpMap gives a triangle (vertices of tri, texture
+// coordinates t, the hit's uv) whose displacement is the float texture `displacement`: the
+// surface's partial derivatives dp/du and dp/dv (pbrt-v4's Triangle: from the vertices and
+// their (u, v), a coordinate system about the normal where (u, v) are degenerate) and, with
+// vertex normals (hasNormals, the normals at the vertices and ns interpolated), the shading
+// frame's tangents and dn/du, dn/dv as pbrt-v4 derives them; then the displacement's finite
+// differences along u and v move them, and the normal of the moved pair, turned to the side of
+// ng (pbrt-v4's FaceForward), is the bumped one. pbrt-v4 steps by half the ray footprint's
+// extent in (u, v); we have no ray differentials and step by its fallback, 0.0005. Where both
+// differences are exactly zero (a constant displacement) the surface is left as it is.
+PT_INLINE vec3 bumpedNormal(PT_TEXTURES_PARAM uint displacement, Triangle tri, TriangleUVs t,
+                            vec2 uv, vec3 ng, vec3 ns, bool hasNormals, TriangleNormals normals) {
+  const float kStep = 0.0005f;
+  float displace = evalFloatTexture(PT_TEXTURES_ARG displacement, uv);
+  float uDisplace = evalFloatTexture(PT_TEXTURES_ARG displacement, uv + vec2(kStep, 0.0f));
+  float vDisplace = evalFloatTexture(PT_TEXTURES_ARG displacement, uv + vec2(0.0f, kStep));
+  if (uDisplace == displace && vDisplace == displace) return ns;
+  // dp/du and dp/dv (pbrt-v4's Triangle::InteractionFromIntersection).
+  vec2 duv02 = t.uv0 - t.uv2;
+  vec2 duv12 = t.uv1 - t.uv2;
+  vec3 dp02 = tri.v0 - tri.v2;
+  vec3 dp12 = tri.v1 - tri.v2;
+  float determinant = duv02.x * duv12.y - duv02.y * duv12.x;
+  vec3 dpdu = vec3(0.0f);
+  vec3 dpdv = vec3(0.0f);
+  bool degenerate = abs(determinant) < 1e-9f;
+  if (!degenerate) {
+    float invDet = 1.0f / determinant;
+    dpdu = (duv12.y * dp02 - duv02.y * dp12) * invDet;
+    dpdv = (duv02.x * dp12 - duv12.x * dp02) * invDet;
+  }
+  vec3 c = cross(dpdu, dpdv);
+  if (degenerate || dot(c, c) == 0.0f) {
+    coordinateSystem(normalize(cross(tri.v2 - tri.v0, tri.v1 - tri.v0)), dpdu, dpdv);
+  }
+  // The shading frame: ns with the tangent dp/du made perpendicular, and dn/du, dn/dv.
+  vec3 n = ng;
+  vec3 dndu = vec3(0.0f);
+  vec3 dndv = vec3(0.0f);
+  if (hasNormals) {
+    n = ns;
+    vec3 ss = dpdu;
+    vec3 ts = cross(ns, ss);
+    if (dot(ts, ts) > 0.0f) {
+      ss = cross(ts, ns);
+    } else {
+      coordinateSystem(ns, ss, ts);
+    }
+    dpdu = ss;
+    dpdv = ts;
+    vec3 dn1 = normals.n0 - normals.n2;
+    vec3 dn2 = normals.n1 - normals.n2;
+    if (abs(determinant) < 1e-32f) {
+      vec3 dn = cross(normals.n2 - normals.n0, normals.n1 - normals.n0);
+      if (dot(dn, dn) != 0.0f) coordinateSystem(normalize(dn), dndu, dndv);
+    } else {
+      float invDet = 1.0f / determinant;
+      dndu = (duv12.y * dn1 - duv02.y * dn2) * invDet;
+      dndv = (duv02.x * dn2 - duv12.x * dn1) * invDet;
+    }
+  }
+  vec3 bumpedU = dpdu + ((uDisplace - displace) / kStep) * n + displace * dndu;
+  vec3 bumpedV = dpdv + ((vDisplace - displace) / kStep) * n + displace * dndv;
+  vec3 bumped = cross(bumpedU, bumpedV);
+  float len2 = dot(bumped, bumped);
+  if (!(len2 > 0.0f) || !(len2 < 3.0e38f)) return ns;
+  bumped = bumped / sqrt(len2);
+  return dot(bumped, ng) < 0.0f ? -bumped : bumped;
 }
 
 // ---- Alpha cut-outs -----------------------------------------------------------------------

@@ -526,3 +526,69 @@ TEST(Textures, PartialAlphaPassesThatFractionOfRays) {
 
 }  // namespace
 }  // namespace pt
+
+namespace pt {
+namespace {
+
+// A bump map of a constant leaves the surface as it is: the same image, bit for bit, on both
+// backends, as without one.
+TEST(Textures, ConstantBumpMapLeavesTheImageUnchanged) {
+  const test::TempDir dir;
+  const auto render = [&](const std::string& displacement) {
+    const Scene scene = loadScene(dir.write(
+        "bump.json",
+        planeScene(R"({"name": "d", "type": "constant", "value": 0.25})",
+                   R"({"name": "plane", "type": "diffuse", "reflectance": [0.5, 0.6, 0.7])" +
+                       displacement + "}",
+                   4)));
+    return renderBoth(prepareScene(scene, RenderSettings{}), 4);
+  };
+  const Comparison plain = render("");
+  const Comparison bumped = render(R"(, "displacement": "d")");
+  EXPECT_EQ(plain.cpuImage.pixels, bumped.cpuImage.pixels);
+  EXPECT_EQ(plain.gpuImage.pixels, bumped.gpuImage.pixels);
+}
+
+// A displacement rising linearly along u (a 2 x 1 image of 0 and 1, bilinear between the texel
+// centres, scaled by 5: dD/du = 10) tilts the plane's shading normal by atan(10 / |dp/du|) =
+// atan(0.5) about v: under light from straight above the diffuse plane shows 0.8 cos(tilt).
+TEST(Textures, LinearBumpTiltsTheNormalAsPbrtsBumpMap) {
+  const test::TempDir dir;
+  TextureImage ramp;
+  Image twoTexels(2, 1);
+  twoTexels.pixels = {vec3(0.0f), vec3(1.0f)};
+  writeImage(twoTexels, dir / "ramp.pfm");
+  const Scene scene = loadScene(dir.write(
+      "bump.json",
+      planeScene(R"({"name": "ramp", "type": "imagemap", "filename": "ramp.pfm", "wrap": "clamp",
+                     "encoding": "linear"},
+                    {"name": "d", "type": "scale", "tex": "ramp", "scale": 5})",
+                 R"({"name": "plane", "type": "diffuse", "reflectance": [0.8, 0.8, 0.8],
+                     "displacement": "d"})",
+                 16)));
+  const SceneData data = prepareScene(scene, RenderSettings{});
+  EXPECT_TRUE(data.effects.bumpMaps);
+  const Comparison cmp = renderBoth(data, data.spp);
+  expectAgreement(cmp);
+  const double expected = 0.8 / std::sqrt(1.0 + 0.25);
+  // The pixels whose every camera ray lands in 0.3 < u < 0.7 (the ramp's linear part).
+  const Image u = pixelAverages(data.params.camera, [](const Ray& ray) {
+    const glm::dvec3 o(ray.origin), d(ray.direction);
+    const double x = (o + d * (-o.y / d.y)).x;
+    const double uu = (10.0 - x) / 20.0;
+    return glm::dvec3(uu > 0.3 && uu < 0.7 ? 1.0 : 0.0);
+  });
+  for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+    size_t checked = 0, off = 0;
+    for (size_t i = 0; i < u.pixels.size(); ++i) {
+      if (u.pixels[i].x != 1.0f) continue;
+      ++checked;
+      if (std::fabs(double(image->pixels[i].y) - expected) > 2e-3) ++off;
+    }
+    EXPECT_GT(checked, 500u);
+    EXPECT_EQ(off, 0u) << (image == &cmp.cpuImage ? "cpu" : "vulkan");
+  }
+}
+
+}  // namespace
+}  // namespace pt

@@ -350,13 +350,15 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
     const Triangle& tri = bvh.triangles[hit->triangle];
     // The parameters that textures give, at the hit's texture coordinates.
     const Material* untextured = &scene.materials[tri.material];
+    const bool textures = scene.params.texturesPresent != 0u;
     Material textured;
-    if (scene.params.texturesPresent != 0u) {
-      textured =
-          resolveMaterial(scene.textureTables(), *untextured, scene.materialTextures[tri.material],
-                          interpolatedUV(scene.uvs[tri.primitive], hit->barycentrics));
+    vec2 uv(0.0f);
+    if (textures) {
+      uv = interpolatedUV(scene.uvs[tri.primitive], hit->barycentrics);
+      textured = resolveMaterial(scene.textureTables(), *untextured,
+                                 scene.materialTextures[tri.material], uv);
     }
-    const Material& material = scene.params.texturesPresent != 0u ? textured : *untextured;
+    const Material& material = textures ? textured : *untextured;
     // Hit point from barycentrics (more accurate than origin + t * direction).
     const vec3 p =
         hit->barycentrics.x * tri.v0 + hit->barycentrics.y * tri.v1 + hit->barycentrics.z * tri.v2;
@@ -408,10 +410,21 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
     // (pbrt-v4 does not guard against the light leaks a shading normal can cause, and nor do
     // we: BSDFs are evaluated about ns whichever side of the geometric surface wi is on; rays
     // leave on the side of ng they go to.)
-    const bool shadingNormals = !scene.normals.empty();
-    const vec3 ns = shadingNormals
-                        ? interpolatedNormal(scene.normals[tri.primitive], hit->barycentrics, ng)
-                        : ng;
+    bool shadingNormals = !scene.normals.empty();  // ns may differ from ng
+    vec3 ns = shadingNormals
+                  ? interpolatedNormal(scene.normals[tri.primitive], hit->barycentrics, ng)
+                  : ng;
+    // A bump map moves the shading normal (texture.h).
+    if (textures && scene.materialTextures[tri.material].displacement != kNoTexture) {
+      const vec3 bumped =
+          bumpedNormal(scene.textureTables(), scene.materialTextures[tri.material].displacement,
+                       tri, scene.uvs[tri.primitive], uv, ng, ns, shadingNormals,
+                       shadingNormals ? scene.normals[tri.primitive] : TriangleNormals{});
+      if (bumped != ns) {
+        ns = bumped;
+        shadingNormals = true;
+      }
+    }
     // Diffuse and mirror surfaces are two-sided: shaded with the normal facing the ray.
     vec3 n = cosOut >= 0.0f ? ng : -ng;
     if (shadingNormals) n = dot(ns, wo) >= 0.0f ? ns : -ns;

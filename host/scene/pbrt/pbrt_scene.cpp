@@ -2242,18 +2242,27 @@ bool Builder::buildShape(const std::string& type, const Params& p, const Stateme
           cosSinDegrees(360.0 * (segment % kSphereSegments) / kSphereSegments);
       return glm::dvec3(sinTheta * cosPhi, sinTheta * sinPhi, cosTheta);
     };
+    // pbrt-v4's (u, v) on a sphere: u = phi / 2 pi, v = 1 - theta / pi (theta from +z).
+    const auto uvAt = [](int ring, int segment) {
+      return glm::vec2(float(double(segment) / kSphereSegments),
+                       float(1.0 - double(ring) / kSphereRings));
+    };
     for (int i = 0; i < kSphereRings; ++i) {
       for (int j = 0; j < kSphereSegments; ++j) {
         const glm::dvec3 a = direction(i, j), b = direction(i, j + 1);
         const glm::dvec3 c = direction(i + 1, j), d = direction(i + 1, j + 1);
+        const glm::vec2 ua = uvAt(i, j), ub = uvAt(i, j + 1), uc = uvAt(i + 1, j),
+                        ud = uvAt(i + 1, j + 1);
         // (a, c, b) and (b, c, d): the winding's normal points outwards, pbrt's front.
         if (i != 0) {
           mesh.triangles.push_back(Tri{a * radius, c * radius, b * radius});
           mesh.normals.push_back(Tri{a, c, b});
+          mesh.uvs.push_back(UVs{ua, uc, ub});
         }
         if (i != kSphereRings - 1) {
           mesh.triangles.push_back(Tri{b * radius, c * radius, d * radius});
           mesh.normals.push_back(Tri{b, c, d});
+          mesh.uvs.push_back(UVs{ub, uc, ud});
         }
       }
     }
@@ -2281,13 +2290,21 @@ bool Builder::buildShape(const std::string& type, const Params& p, const Stateme
       return glm::dvec3(r * c, r * sn, height);
     };
     const glm::dvec3 center(0.0, 0.0, height);
+    // pbrt-v4's (u, v) on a disk: u = phi / phimax, v = (radius - r) / (radius - inner); the
+    // centre takes its segment's middle u.
+    const auto uvAt = [&](double r, double j) {
+      return glm::vec2(float(j / segments), float((radius - r) / (radius - inner)));
+    };
     // Counter-clockwise about +z: the winding's normal is +z, pbrt's front of a disk.
     for (int j = 0; j < segments; ++j) {
       if (inner == 0.0) {
         mesh.triangles.push_back(Tri{center, at(radius, j), at(radius, j + 1)});
+        mesh.uvs.push_back(UVs{uvAt(0.0, j + 0.5), uvAt(radius, j), uvAt(radius, j + 1)});
       } else {
         mesh.triangles.push_back(Tri{at(inner, j), at(radius, j), at(radius, j + 1)});
         mesh.triangles.push_back(Tri{at(inner, j), at(radius, j + 1), at(inner, j + 1)});
+        mesh.uvs.push_back(UVs{uvAt(inner, j), uvAt(radius, j), uvAt(radius, j + 1)});
+        mesh.uvs.push_back(UVs{uvAt(inner, j), uvAt(radius, j + 1), uvAt(inner, j + 1)});
       }
     }
     return true;
