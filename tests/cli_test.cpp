@@ -65,6 +65,22 @@ TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
   dir.write("typo.json", R"({"materials": [{"name": "m"}],
     "shapes": [{"type": "quad", "material": "m", "vertices": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]}],
     "camera": {"widht": 10}})");
+  // Scenes whose texture is a bad image: cut short, not what its extension says, a header
+  // larger than its data, an unknown format.
+  const auto textured = [&](const std::string& name, const std::string& image) {
+    dir.write(name, R"({"textures": [{"name": "t", "type": "imagemap", "filename": ")" + image +
+                        R"("}], "materials": [{"name": "m", "reflectance": "t"}],
+      "shapes": [{"type": "quad", "material": "m", "vertices": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]}]})");
+    return (dir / name).string();
+  };
+  dir.write("cut.png", std::string("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\0\x10", 20));
+  dir.write("text.jpg", "this is not a JPEG");
+  dir.write("short.pfm", "PF\n64 64\n-1.0\n0123456789");
+  dir.write("image.xyz", "xyz");
+  const std::string cutPng = textured("cut.json", "cut.png");
+  const std::string textJpg = textured("jpg.json", "text.jpg");
+  const std::string shortPfm = textured("pfm.json", "short.pfm");
+  const std::string unknown = textured("xyz.json", "image.xyz");
   const std::string out = " --out " + (dir / "out.png").string();
   const std::string box = config("cornell-box.json");
   const std::vector<BadCase> cases = {
@@ -84,6 +100,10 @@ TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
        "out.bmp"},
       {"missing image", "diff " + (dir / "x.exr").string() + " " + (dir / "y.exr").string(),
        "x.exr"},
+      {"truncated texture", "render " + cutPng + out, "cut.png"},
+      {"texture not of its format", "render " + textJpg + out, "text.jpg"},
+      {"texture smaller than its header", "render " + shortPfm + out, "short.pfm"},
+      {"texture of an unknown format", "render " + unknown + out, "image.xyz"},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.name);
@@ -95,7 +115,10 @@ TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
     EXPECT_FALSE(std::filesystem::exists(dir / "out.bmp"));
   }
   // Nothing but the inputs is left in the directory (no temporary files).
-  EXPECT_EQ(dir.listing(), (std::vector<std::string>{"broken.json", "typo.json"}));
+  EXPECT_EQ(dir.listing(), (std::vector<std::string>{"broken.json", "cut.json", "cut.png",
+                                                      "image.xyz", "jpg.json", "pfm.json",
+                                                      "short.pfm", "text.jpg", "typo.json",
+                                                      "xyz.json"}));
 }
 
 TEST(CliVulkan, RendersOnTheDefaultBackendWithValidation) {
