@@ -195,5 +195,35 @@ TEST(VulkanLimits, BuffersBeyondMaxStorageBufferRangeFailClearly) {
   }
 }
 
+// Textures larger than the device can hold are refused before anything is allocated, in one
+// line naming the texture buffer and the limit. (The image buffer is filled here directly, as
+// a scene of that many texels would fill it.)
+TEST(VulkanLimits, TexturesBeyondTheBufferLimitFailClearly) {
+  SceneData data = prepare("cornell-box.json", 16);
+  VulkanContext ctx(ContextOptions{});
+  const uint64_t limit = std::min<uint64_t>(ctx.limits.maxStorageBufferRange,
+                                            16ull * ctx.limits.maxTexelBufferElements);
+  if (limit >= (1ull << 31)) GTEST_SKIP() << "device allows " << limit << " bytes";
+  data.materialTextures.assign(data.materials.size(), MaterialTextures{});
+  for (MaterialTextures& t : data.materialTextures) {
+    t = MaterialTextures{kNoTexture, kNoTexture, kNoTexture, kNoTexture, kNoTexture, kNoTexture,
+                         kNoTexture, kNoTexture, 0u,         1.0f,       0u,         0u};
+  }
+  data.uvs.assign(data.bvh.triangles.size(), TriangleUVs{});
+  data.textureNodes.assign(1, TextureNode{});
+  data.imageWords.assign(limit / sizeof(uint32_t) + 4, 0u);
+  data.params.texturesPresent = 1u;
+  data.effects.textures = true;
+  Film film(16, 16);
+  try {
+    renderVulkan(data, validatedOptions(1), film);
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("texture image buffer"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
 }  // namespace
 }  // namespace pt
