@@ -47,6 +47,9 @@ struct RenderSettings {
   int maxLeafSize = kDefaultLeafSizeCpu;
   BvhBuilder builder = kDefaultBuilder;
   bool fastIntersection = false;  // Moller-Trumbore instead of the watertight test
+  // MIS renders of an environment image: light sampling from pbrt-v4's compensated
+  // distribution (render/environment_map.h); unset: kEnvironmentCompensationDefault.
+  std::optional<bool> environmentCompensation;
 };
 
 // Which effects the scene calls for; the rest are compiled or switched out.
@@ -62,6 +65,7 @@ struct EffectSet {
   bool shadingNormals = false;    // some mesh has vertex normals: shading normals interpolated
   bool deltaLights = false;       // point, spot or distant lights (sampled, never hit)
   bool environment = false;       // an infinite light: rays that leave the scene see it
+  bool environmentImage = false;  // that light is an image (shaders/environment.h)
   bool twoSidedEmitters = false;  // some emissive triangle emits on both sides
   bool sphereLights = false;      // sphere area lights, sampled by the cone they subtend
   bool lightSampling = false;     // next-event estimation (needs emitters, a diffuse surface)
@@ -133,6 +137,10 @@ struct SceneData {
   std::vector<Light> lights;      // the analytic lights the emitters beyond the triangles name
   // Vertex normals by Triangle::primitive (load order), or empty when no mesh has any.
   std::vector<TriangleNormals> normals;
+  // The environment image's texels and sampling distribution (shaders/environment.h), empty
+  // without one, and its file (for messages).
+  std::vector<vec4> environmentTexels;
+  std::string environmentFile;
   RenderParams params{};
   int spp = 0;
   EffectSet effects;

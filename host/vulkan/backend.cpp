@@ -52,6 +52,11 @@ struct RenderBuffers {
 RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
                           const vk::raii::CommandBuffer& cmd, Buffer& staging) {
   const Camera& cam = scene.params.camera;
+  // The environment image against the device's texel limit first, naming its file.
+  checkEnvironmentTexels(ctx.info().name, ctx.limits.maxTexelBufferElements, scene.environmentFile,
+                         scene.environmentTexels.size());
+  const std::vector<vec4> environment =
+      scene.environmentTexels.empty() ? std::vector<vec4>{vec4(0.0f)} : scene.environmentTexels;
   // An empty emitter table still needs a valid binding: one zeroed entry the shader never reads.
   const std::vector<Emitter> emitters =
       scene.emitters.empty() ? std::vector<Emitter>{Emitter{}} : scene.emitters;
@@ -70,10 +75,12 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       {"emitter", emitters.data(), emitters.size() * sizeof(Emitter), true},
       {"vertex normal", normals.data(), normals.size() * sizeof(TriangleNormals), true},
       {"light", lights.data(), lights.size() * sizeof(Light), true},
+      {"environment", environment.data(), environment.size() * sizeof(vec4), true},
   };
   static_assert(PT_BINDING_PARAMS == 0 && PT_BINDING_NODES == 1 && PT_BINDING_TRIANGLES == 2 &&
                 PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 && PT_BINDING_NORMALS == 5 &&
-                PT_BINDING_LIGHTS == 6 && PT_BINDING_ACCUM == 7 && PT_BINDING_COUNTERS == 8);
+                PT_BINDING_LIGHTS == 6 && PT_BINDING_ACCUM == 7 && PT_BINDING_COUNTERS == 8 &&
+                PT_BINDING_ENVIRONMENT == 9);
   static_assert(std::size(uploads) + 2 == PT_BINDING_COUNT, "every binding is a buffer");
 
   // Every size is checked before anything is allocated: a scene too large for the device is
@@ -87,10 +94,13 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   checkUploads(ctx, uploads);
   buffers.bound = recordUploads(ctx, cmd, uploads, staging);
   for (const Upload& u : uploads) buffers.texels.push_back(u.texels);
+  // The accumulation and the counters take their bindings, before the environment's.
   const auto readWrite = U::eStorageBuffer | U::eTransferSrc | U::eTransferDst;
-  buffers.bound.push_back(makeBuffer(ctx, buffers.accumSize, readWrite, false));
-  buffers.bound.push_back(makeBuffer(ctx, sizeof(DeviceCounters), readWrite, false));
-  buffers.texels.resize(buffers.bound.size(), false);
+  const auto at = [&](int binding) { return buffers.bound.begin() + binding; };
+  buffers.bound.insert(at(PT_BINDING_ACCUM), makeBuffer(ctx, buffers.accumSize, readWrite, false));
+  buffers.bound.insert(at(PT_BINDING_COUNTERS),
+                       makeBuffer(ctx, sizeof(DeviceCounters), readWrite, false));
+  buffers.texels.insert(buffers.texels.begin() + PT_BINDING_ACCUM, 2, false);
   buffers.readback =
       makeBuffer(ctx, buffers.accumSize + sizeof(DeviceCounters), U::eTransferDst, true);
   return buffers;
@@ -104,21 +114,35 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
   const EffectSet& fx = scene.effects;
   const bool all = !options.specialize;
   const RenderParams& params = scene.params;
-  const SpecData spec{
-      {all || fx.diffuse, all || fx.mirror, all || fx.lightSampling, all || fx.bsdfEmission,
-       all || fx.mis, all || fx.russianRoulette, all ? kSpecAtRunTime : params.fastIntersection,
-       all ? kSpecAtRunTime : params.samplerType, buffers.stackRows, all || fx.conductor,
-       all || fx.dielectric, all || fx.thinDielectric, all || fx.diffuseTransmission,
-       all || fx.coatedDiffuse, all || fx.shadingNormals, all || fx.deltaLights,
-       all || fx.environment, all || fx.twoSidedEmitters, all || fx.sphereLights}};
-  static_assert(
-      PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
-      PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
-      PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
-      PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 && PT_SPEC_THIN_DIELECTRIC == 11 &&
-      PT_SPEC_DIFFUSE_TRANSMISSION == 12 && PT_SPEC_COATED_DIFFUSE == 13 &&
-      PT_SPEC_SHADING_NORMALS == 14 && PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
-      PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_SPHERE_LIGHTS == 18 && PT_SPEC_COUNT == 19);
+  const SpecData spec{{all || fx.diffuse,
+                       all || fx.mirror,
+                       all || fx.lightSampling,
+                       all || fx.bsdfEmission,
+                       all || fx.mis,
+                       all || fx.russianRoulette,
+                       all ? kSpecAtRunTime : params.fastIntersection,
+                       all ? kSpecAtRunTime : params.samplerType,
+                       buffers.stackRows,
+                       all || fx.conductor,
+                       all || fx.dielectric,
+                       all || fx.thinDielectric,
+                       all || fx.diffuseTransmission,
+                       all || fx.coatedDiffuse,
+                       all || fx.shadingNormals,
+                       all || fx.deltaLights,
+                       all || fx.environment,
+                       all || fx.twoSidedEmitters,
+                       all || fx.sphereLights,
+                       all || fx.environmentImage}};
+  static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
+                PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
+                PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
+                PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 &&
+                PT_SPEC_THIN_DIELECTRIC == 11 && PT_SPEC_DIFFUSE_TRANSMISSION == 12 &&
+                PT_SPEC_COATED_DIFFUSE == 13 && PT_SPEC_SHADING_NORMALS == 14 &&
+                PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
+                PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_SPHERE_LIGHTS == 18 &&
+                PT_SPEC_ENVIRONMENT_IMAGE == 19 && PT_SPEC_COUNT == 20);
   std::vector<vk::SpecializationMapEntry> entries;
   for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));
