@@ -41,6 +41,7 @@ const bool kSphereLights = false;
 const bool kTextures = false;
 const bool kAlphaCutouts = false;
 const bool kBumpMaps = false;
+const bool kEnvironmentImage = false;
 #else
 layout(constant_id = PT_SPEC_CONDUCTOR) const bool kConductor = true;
 layout(constant_id = PT_SPEC_DIELECTRIC) const bool kDielectric = true;
@@ -55,6 +56,7 @@ layout(constant_id = PT_SPEC_SPHERE_LIGHTS) const bool kSphereLights = true;
 layout(constant_id = PT_SPEC_TEXTURES) const bool kTextures = true;
 layout(constant_id = PT_SPEC_ALPHA) const bool kAlphaCutouts = true;
 layout(constant_id = PT_SPEC_BUMP) const bool kBumpMaps = true;
+layout(constant_id = PT_SPEC_ENVIRONMENT_IMAGE) const bool kEnvironmentImage = true;
 #endif
 // Some emitter is one of lights.h's (not a triangle).
 const bool kAnalyticLights = kDeltaLights || kEnvironment || kSphereLights;
@@ -83,6 +85,9 @@ layout(set = 0, binding = PT_BINDING_TEXTURES) uniform usamplerBuffer textureTex
 layout(set = 0, binding = PT_BINDING_IMAGES) uniform usamplerBuffer imageTexels;
 layout(set = 0,
        binding = PT_BINDING_MATERIAL_TEXTURES) uniform usamplerBuffer materialTextureTexels;
+#ifndef PT_NO_BSDF_MATERIALS
+layout(set = 0, binding = PT_BINDING_ENVIRONMENT) uniform usamplerBuffer environmentTexels;
+#endif
 layout(std430, set = 0, binding = PT_BINDING_ACCUM) buffer AccumBuffer {
   AccumPixel accum[];
 };
@@ -151,6 +156,12 @@ float gAlphaU = 0.0;
 #define PT_HIT_FILTER(tri, hit, r)                   \
   (!kAlphaCutouts || params.texturesPresent == 0u || \
    alphaKeepsHit(tri.material, tri.primitive, hit.barycentrics, gAlphaU))
+// The environment image (environment.h reads its texels through environmentTexel).
+vec4 environmentTexel(uint i) {
+  return uintBitsToFloat(texelFetch(environmentTexels, int(i)));
+}
+#define PT_ENVIRONMENT_LOOP_TICK() gLoopIterations++
+#include "environment.h"
 #endif
 
 // Watertight unless switched off by specialization or, unspecialized, by the parameters.
@@ -201,6 +212,12 @@ Emitter loadEmitter(uint i) {
 }
 
 #ifndef PT_NO_BSDF_MATERIALS
+EnvironmentMap environmentMap() {
+  return EnvironmentMap(params.environmentX, params.environmentY, params.environmentZ,
+                        params.environmentWidth, params.environmentHeight,
+                        params.environmentMapping);
+}
+
 Light loadLight(uint i) {
   int at = int(kLightTexels * i);
   uvec4 a = texelFetch(lightTexels, at);
@@ -328,6 +345,16 @@ vec3 analyticLightContribution(AnalyticLightSample ls, float pmf, vec3 from, vec
   vec3 contribution = beta * fCos * ls.Li * (weight / lightPdf);
   return addOrDefer(shadow, from, direction, contribution, retrace);
 }
+
+// A sample of the analytic light an emitter names, from p: the environment image's for an
+// infinite light that has one (integrator.cpp's sampleLight).
+AnalyticLightSample sampleLight(Emitter emitter, vec3 p, vec2 u) {
+  Light light = loadLight(emitter.triangle & ~kEmitterLight);
+  if (kEnvironmentImage && light.type == kLightInfinite && params.environmentWidth != 0u) {
+    return sampleEnvironmentLight(environmentMap(), p, u, params.sceneRadius);
+  }
+  return sampleAnalyticLight(light, p, u, params.sceneRadius);
+}
 #endif
 
 // Samples direct illumination at diffuse vertex p with shading normal n (next-event
@@ -348,8 +375,7 @@ vec3 sampleDirectLight(vec3 p, vec3 n, vec3 ng, bool shadingNormals, float magni
   Emitter emitter = pickEmitter(uChoose);
 #ifndef PT_NO_BSDF_MATERIALS
   if (kAnalyticLights && (emitter.triangle & kEmitterLight) != 0u) {
-    AnalyticLightSample ls = sampleAnalyticLight(loadLight(emitter.triangle & ~kEmitterLight), p,
-                                                 uLight, params.sceneRadius);
+    AnalyticLightSample ls = sampleLight(emitter, p, uLight);
     float cosWi = dot(n, ls.wi);
     if (!(cosWi > 0.0) || !(maxComponent(ls.Li) > 0.0)) return vec3(0.0);
     vec3 from =
@@ -392,8 +418,7 @@ vec3 sampleDirectLightBsdf(vec3 p, vec3 ng, ShadingFrame frame, Material materia
   if (kAlphaCutouts) gAlphaU = shadowAlphaRandom(uLight);
   Emitter emitter = pickEmitter(uChoose);
   if (kAnalyticLights && (emitter.triangle & kEmitterLight) != 0u) {
-    AnalyticLightSample ls = sampleAnalyticLight(loadLight(emitter.triangle & ~kEmitterLight), p,
-                                                 uLight, params.sceneRadius);
+    AnalyticLightSample ls = sampleLight(emitter, p, uLight);
     if (!(maxComponent(ls.Li) > 0.0)) return vec3(0.0);
     vec3 wiLocal = toLocal(frame, ls.wi);
     vec3 fCos = bsdfF(material, wo, wiLocal, evalStream) * absCosTheta(wiLocal);
@@ -516,14 +541,22 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
 #ifndef PT_NO_BSDF_MATERIALS
     // The ray leaves the scene: the infinite light's radiance, weighed as an emitter's.
     if (kEnvironment && params.environmentEmitter != kNoEmitter) {
+      vec3 Le = params.environment;
+      float lightPdf = params.environmentPdf;
+      if (kEnvironmentImage && params.environmentWidth != 0u) {
+        // The image: the direction's texel, and its density times the light's pmf.
+        EnvironmentLookup e = environmentLookup(environmentMap(), path.direction);
+        Le = e.Le;
+        lightPdf = params.environmentPdf * e.pdf;
+      }
       if (path.specularBounce) {
-        path.L += path.beta * params.environment;
+        path.L += path.beta * Le;
       } else if (bsdfEmissionOn()) {
         float weight = 1.0;
         if (misOn()) {
-          weight = powerHeuristic(path.bsdfPdf, params.environmentPdf);
+          weight = powerHeuristic(path.bsdfPdf, lightPdf);
         }
-        path.L += path.beta * weight * params.environment;
+        path.L += path.beta * weight * Le;
       }
     }
 #endif

@@ -325,10 +325,26 @@ struct RenderParams {
   float sceneRadius;        //  4 bytes: radius of a sphere about sceneCenter holding the scene
   vec3 environment;         // 12 bytes: radiance of the infinite light (zero when none)
   float environmentPdf;     //  4 bytes: its light-sampling density, environmentLightPdf of
-                            //           its Emitter's pmf (for MIS where rays leave the scene)
+                            //           its Emitter's pmf (for MIS where rays leave the scene);
+                            //           with an image: that pmf alone (environment.h gives the
+                            //           density of each direction)
   vec3 sceneCenter;         // 12 bytes: centre of the scene's bounding box
   uint texturesPresent;     //  4 bytes: 1 when the texture buffers hold the scene's textures
-};                          // 240 bytes
+  // The infinite light's image, when it has one (environment.h; its texels and sampling
+  // distribution are PT_BINDING_ENVIRONMENT): the image's frame in world space, its size and
+  // how its (u, v) square maps to directions. environmentWidth 0: no image (the constant
+  // `environment` radiance, if any).
+  vec3 environmentX;        // 12 bytes: the image frame's x axis in world space (unit)
+  uint environmentWidth;    //  4 bytes: texels per row, 0 without an image
+  vec3 environmentY;        // 12 bytes: its y axis
+  uint environmentHeight;   //  4 bytes: rows
+  vec3 environmentZ;        // 12 bytes: its z axis
+  uint environmentMapping;  //  4 bytes: kEnvironmentOctahedral or kEnvironmentLatLong
+};                          // 288 bytes
+
+// How an environment image's (u, v) square maps to directions in its frame (environment.h).
+PT_CONST uint kEnvironmentOctahedral = 0u;  // pbrt-v4's equal-area octahedral square, +z up
+PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v = theta / pi, +y up
 
 // ---- Compute pipeline interface (Vulkan backend) ----------------------------------------
 
@@ -349,7 +365,9 @@ struct RenderParams {
 #define PT_BINDING_LIGHTS 6       // Light[], texels (one dummy entry when the scene has none)
 #define PT_BINDING_ACCUM 7        // AccumPixel[width * height]
 #define PT_BINDING_COUNTERS 8     // DeviceCounters
-#define PT_BINDING_ENVIRONMENT 9  // the environment image and its sampling distribution
+// The environment image's texels and sampling distribution (environment.h), as float texels
+// (one dummy texel when the scene has no image).
+#define PT_BINDING_ENVIRONMENT 9
 // Textures: one dummy entry each where no material has a texture.
 #define PT_BINDING_UVS 10                // TriangleUVs[], texels
 #define PT_BINDING_TEXTURES 11           // TextureNode[], texels
@@ -381,7 +399,7 @@ struct RenderParams {
 #define PT_SPEC_ENVIRONMENT 16         // bool: an infinite light occurs
 #define PT_SPEC_TWO_SIDED_EMITTERS 17  // bool: some emissive triangle emits on both sides
 #define PT_SPEC_SPHERE_LIGHTS 18       // bool: some sphere area light is sampled by solid angle
-#define PT_SPEC_ENVIRONMENT_IMAGE 19   // bool: the infinite light is an image
+#define PT_SPEC_ENVIRONMENT_IMAGE 19   // bool: the infinite light is an image (environment.h)
 #define PT_SPEC_TEXTURES 20            // bool: some material parameter is a texture
 #define PT_SPEC_ALPHA 21               // bool: some material has an alpha cut-out
 #define PT_SPEC_BUMP 22                // bool: some material has a bump map

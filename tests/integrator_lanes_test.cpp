@@ -22,9 +22,32 @@ using test::kConfigs;
 struct Case {
   std::string config;
   RenderSettings settings;
+  bool latLong = false;  // the environment image read as a lat-long map
 };
 
-std::vector<Case> cases() {
+// lanes-shading-normals.pbrt with its constant environment replaced by a rotated image
+// (environment.h), written into `dir`, and its lat-long variant (scene files take only one).
+std::string environmentImageScene(const test::TempDir& dir) {
+  Image sky(16, 16);
+  for (int y = 0; y < 16; ++y) {
+    for (int x = 0; x < 16; ++x) {
+      sky.at(x, y) = vec3(0.1f + 0.05f * float(x), 0.2f + 0.03f * float(y), 0.3f);
+    }
+  }
+  sky.at(9, 4) = vec3(30.0f, 25.0f, 20.0f);
+  writeImage(sky, dir / "sky.pfm");
+  std::string text = test::readFile(std::filesystem::path(PT_SOURCE_DIR) /
+                                    "tests/data/lanes-shading-normals.pbrt");
+  const std::string constant = "LightSource \"infinite\" \"rgb L\" [0.2 0.25 0.3]\n";
+  const size_t at = text.find(constant);
+  EXPECT_NE(at, std::string::npos);
+  text.replace(at, constant.size(),
+               "AttributeBegin\nRotate 35 1 0.5 0\nLightSource \"infinite\" \"string filename\" "
+               "\"sky.pfm\"\nAttributeEnd\n");
+  return dir.write("lanes-environment.pbrt", text).string();
+}
+
+std::vector<Case> cases(const test::TempDir& dir) {
   const RenderSettings small{.width = 20, .height = 14};
   std::vector<Case> list;
   for (const char* config : {"cornell-box.json", "cornell-mirror.json", "bunny-box.json",
@@ -45,6 +68,14 @@ std::vector<Case> cases() {
     RenderSettings s = small;
     s.strategy = strategy;
     list.push_back({normals, s});
+  }
+  // An environment image, octahedral (the pbrt file's) and lat-long, with each strategy.
+  const std::string environment = environmentImageScene(dir);
+  for (uint strategy : {kStrategyMis, kStrategyNee, kStrategyBsdf}) {
+    RenderSettings s = small;
+    s.strategy = strategy;
+    list.push_back({environment, s});
+    list.push_back({environment, s, true});
   }
   auto variant = [&](auto&& change) {
     RenderSettings s = small;
@@ -69,9 +100,15 @@ uint32_t bitsOf(float x) {
 }
 
 TEST(CpuLanes, EqualsTheReferenceBitForBit) {
-  for (const Case& c : cases()) {
-    SCOPED_TRACE(c.config);
-    const SceneData data = prepareScene(loadScene(kConfigs / c.config), c.settings);
+  const test::TempDir dir;
+  for (const Case& c : cases(dir)) {
+    SCOPED_TRACE(c.config + (c.latLong ? " (lat-long)" : ""));
+    Scene scene = loadScene(kConfigs / c.config);
+    if (c.latLong) scene.environment->mapping = kEnvironmentLatLong;
+    const SceneData data = prepareScene(std::move(scene), c.settings);
+    if (c.config.find("lanes-environment") != std::string::npos) {
+      ASSERT_TRUE(data.effects.environmentImage) << data.effects.toString();
+    }
     if (c.config.find("shading-normals") != std::string::npos) {
       ASSERT_TRUE(data.effects.shadingNormals) << data.effects.toString();
     }

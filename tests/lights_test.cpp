@@ -488,26 +488,6 @@ TEST(AnalyticLights, JsonLights) {
             std::string::npos);
 }
 
-TEST(AnalyticLights, ImageEnvironmentFallsBackToItsMean) {
-  // Until image lights exist, an infinite light's image becomes its mean radiance.
-  const test::TempDir dir;
-  Image image(2, 2);
-  image.pixels = {vec3(1, 0, 0), vec3(0, 1, 0), vec3(0, 0, 1), vec3(1, 1, 1)};
-  writeImage(image, dir / "sky.pfm");
-  const std::filesystem::path scene =
-      dir.write("env.pbrt", header(8, 1, 1) +
-                                "LightSource \"infinite\" \"string filename\" [\"sky.pfm\"] "
-                                "\"float scale\" [2]\n" +
-                                kPlane);
-  const Scene loaded = loadPbrtScene(scene);
-  ASSERT_EQ(loaded.lights.size(), 1u);
-  EXPECT_EQ(loaded.lights[0].radiance, vec3(1.0f));  // 2 x (0.5, 0.5, 0.5)
-  bool warned = false;
-  for (const std::string& w : loaded.warnings)
-    warned |= w.find("mean radiance") != std::string::npos;
-  EXPECT_TRUE(warned);
-}
-
 // Pearson's chi-square test of a light's sampled directions (seen from `p`) against `pdf`
 // (tests/chi2.h, as the BSDF tests use it): a grid focused where pilot samples fall, each
 // cell's expected count the pdf's integral over it.

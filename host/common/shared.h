@@ -55,7 +55,7 @@ static_assert(offsetof(Camera, filterRootsFar) == 144 && offsetof(Camera, filter
 // RenderParams after its Camera, whatever the Camera's size (a multiple of 16 bytes).
 inline constexpr std::size_t kParamsBase = sizeof(Camera);
 static_assert(kParamsBase % 16 == 0);
-static_assert(sizeof(RenderParams) == kParamsBase + 80);
+static_assert(sizeof(RenderParams) == kParamsBase + 128);
 static_assert(offsetof(RenderParams, maxDepth) == kParamsBase);
 static_assert(offsetof(RenderParams, seed) == kParamsBase + 12);
 static_assert(offsetof(RenderParams, russianRoulette) == kParamsBase + 20);
@@ -64,6 +64,10 @@ static_assert(offsetof(RenderParams, sceneRadius) == kParamsBase + 44);
 static_assert(offsetof(RenderParams, environment) == kParamsBase + 48);
 static_assert(offsetof(RenderParams, environmentPdf) == kParamsBase + 60);
 static_assert(offsetof(RenderParams, sceneCenter) == kParamsBase + 64);
+static_assert(offsetof(RenderParams, environmentX) == kParamsBase + 80);
+static_assert(offsetof(RenderParams, environmentWidth) == kParamsBase + 92);
+static_assert(offsetof(RenderParams, environmentHeight) == kParamsBase + 108);
+static_assert(offsetof(RenderParams, environmentMapping) == kParamsBase + 124);
 
 static_assert(sizeof(TextureNode) == 16 * kTextureNodeTexels);
 static_assert(offsetof(TextureNode, type) == 12 && offsetof(TextureNode, mapping) == 16);

@@ -20,8 +20,10 @@
 #include "common/check.h"
 #include "cpu/bounce_random.h"
 #include "cpu/integrator_lanes.h"
+#include "environment.h"
 #include "filter.h"
 #include "lights.h"
+#include "render/environment_map.h"
 
 namespace pt {
 namespace {
@@ -139,6 +141,17 @@ const Light* analyticLight(const SceneData& scene, const Emitter& emitter) {
   return &scene.lights[emitter.triangle & ~kEmitterLight];
 }
 
+// A sample of an analytic light from p: the environment image's (environment.h) for an infinite
+// light that has one, lights.h's otherwise.
+AnalyticLightSample sampleLight(const SceneData& scene, const Light& light, vec3 p, vec2 u) {
+  const RenderParams& params = scene.params;
+  if (light.type == kLightInfinite && params.environmentWidth != 0u) {
+    return sampleEnvironmentLight(environmentMapOf(params, scene.environmentTexels), p, u,
+                                  params.sceneRadius);
+  }
+  return sampleAnalyticLight(light, p, u, params.sceneRadius);
+}
+
 // A light sample of an analytic light (chosen with probability pmf), given the BSDF's
 // f * |cos| towards it (fCos) and its density (bsdfDensity, read only for MIS): traces the
 // shadow ray from `from` and returns the contribution, weighed by the power heuristic unless
@@ -207,8 +220,7 @@ vec3 sampleDirectLightBsdf(const SceneData& scene, const CpuSceneCopies& copies,
                            Intersection test, uint64_t& rays, bool debugPrint, uint depth) {
   const Emitter& emitter = pickEmitter(scene, uChoose);
   if (const Light* analytic = analyticLight(scene, emitter)) {
-    const AnalyticLightSample ls =
-        sampleAnalyticLight(*analytic, p, uLight, scene.params.sceneRadius);
+    const AnalyticLightSample ls = sampleLight(scene, *analytic, p, uLight);
     if (!(maxComponent(ls.Li) > 0.0f)) return vec3(0.0f);
     const vec3 wi = toLocal(frame, ls.wi);
     const vec3 fCos = bsdfF(material, wo, wi, evalStream) * absCosTheta(wi);
@@ -244,8 +256,7 @@ vec3 sampleAnalyticLightDiffuse(const SceneData& scene, const Emitter& emitter, 
                                 vec3 ng, bool shadingNormals, float magnitude, vec3 beta, vec3 f,
                                 vec2 uLight, bool misOn, Intersection test, uint64_t& rays,
                                 bool debugPrint, uint depth) {
-  const AnalyticLightSample ls =
-      sampleAnalyticLight(*analyticLight(scene, emitter), p, uLight, scene.params.sceneRadius);
+  const AnalyticLightSample ls = sampleLight(scene, *analyticLight(scene, emitter), p, uLight);
   const float cosWi = dot(n, ls.wi);
   if (!(cosWi > 0.0f) || !(maxComponent(ls.Li) > 0.0f)) return vec3(0.0f);
   const vec3 side = shadingNormals ? (dot(ng, ls.wi) > 0.0f ? ng : -ng) : n;
@@ -254,14 +265,23 @@ vec3 sampleAnalyticLightDiffuse(const SceneData& scene, const Emitter& emitter, 
                                    cosWi * kInvPi, misOn, test, rays, debugPrint, depth);
 }
 
-vec3 environmentSeen(const SceneData& scene, vec3 beta, bool specularBounce, float bsdfPdf) {
+vec3 environmentSeen(const SceneData& scene, vec3 direction, vec3 beta, bool specularBounce,
+                     float bsdfPdf) {
   const RenderParams& params = scene.params;
   if (params.environmentEmitter == kNoEmitter) return vec3(0.0f);
-  if (specularBounce) return beta * params.environment;
+  vec3 Le = params.environment;
+  float lightPdf = params.environmentPdf;
+  if (params.environmentWidth != 0u) {
+    // The image: the direction's texel, and its density times the light's pmf.
+    const EnvironmentLookup e =
+        environmentLookup(environmentMapOf(params, scene.environmentTexels), direction);
+    Le = e.Le;
+    lightPdf = params.environmentPdf * e.pdf;
+  }
+  if (specularBounce) return beta * Le;
   if (params.strategy == kStrategyNee) return vec3(0.0f);
-  const float weight =
-      params.strategy == kStrategyMis ? powerHeuristic(bsdfPdf, params.environmentPdf) : 1.0f;
-  return beta * weight * params.environment;
+  const float weight = params.strategy == kStrategyMis ? powerHeuristic(bsdfPdf, lightPdf) : 1.0f;
+  return beta * weight * Le;
 }
 
 bool scatterAtBsdfVertex(const SceneData& scene, const BsdfVertex& v, PathState& state, vec3& wi,
@@ -344,7 +364,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
     const std::optional<Hit> hit = closestSurface(scene, ray, test, pixel, sampleIndex, depth);
     if (!hit) {
       // The ray leaves the scene: the infinite light's radiance, weighed as an emitter's.
-      L += environmentSeen(scene, beta, specularBounce, bsdfPdf);
+      L += environmentSeen(scene, ray.direction, beta, specularBounce, bsdfPdf);
       break;
     }
     const Triangle& tri = bvh.triangles[hit->triangle];

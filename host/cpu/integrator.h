@@ -82,10 +82,12 @@ vec3 sampleAnalyticLightDiffuse(const SceneData& scene, const Emitter& emitter, 
                                 vec2 uLight, bool misOn, Intersection test, uint64_t& rays,
                                 bool debugPrint = false, uint depth = 0);
 
-// The radiance a path gathers when its ray leaves the scene: the infinite light's (none without
-// one), at full weight after a specular bounce (or from the camera), else weighed as
-// BSDF-sampled emission is (MIS, or nothing with light sampling alone).
-vec3 environmentSeen(const SceneData& scene, vec3 beta, bool specularBounce, float bsdfPdf);
+// The radiance a path gathers when its ray leaves the scene along `direction`: the infinite
+// light's (none without one; an image's by direction), at full weight after a specular bounce
+// (or from the camera), else weighed as BSDF-sampled emission is (MIS, or nothing with light
+// sampling alone).
+vec3 environmentSeen(const SceneData& scene, vec3 direction, vec3 beta, bool specularBounce,
+                     float bsdfPdf);
 
 // Renders into film (which must have the camera's resolution), adding spp samples per pixel
 // in passes of one sample index each; stopped early (options.stop), it adds whole passes

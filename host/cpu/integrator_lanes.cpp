@@ -464,9 +464,9 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
         // The ray leaves the scene: the infinite light's radiance (environmentSeen, the
         // reference's own function).
         if (environment) {
-          path.L.set(i, path.L.get(i) + environmentSeen(scene, path.beta.get(i),
-                                                        (path.specular >> i & 1u) != 0u,
-                                                        path.bsdfPdf.v[i]));
+          path.L.set(i, path.L.get(i) +
+                            environmentSeen(scene, path.direction.get(i), path.beta.get(i),
+                                            (path.specular >> i & 1u) != 0u, path.bsdfPdf.v[i]));
         }
         return;
       }

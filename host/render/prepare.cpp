@@ -7,6 +7,7 @@
 #include "bsdf.h"
 #include "common/check.h"
 #include "lights.h"
+#include "render/environment_map.h"
 
 namespace pt {
 
@@ -46,6 +47,7 @@ std::string EffectSet::toString() const {
   add(shadingNormals, "shading-normals");
   add(deltaLights, "delta-lights");
   add(environment, "environment");
+  add(environmentImage, "environment-image");
   add(twoSidedEmitters, "two-sided-emitters");
   add(sphereLights, "sphere-lights");
   add(textures, "textures");
@@ -249,7 +251,26 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
 
   std::vector<Triangle> triangles = std::move(scene.triangles);
   CameraDesc camera = scene.camera;
-  std::vector<Light> lights = mergeInfiniteLights(std::move(scene.lights));
+  std::vector<Light> lights = std::move(scene.lights);
+  if (scene.environment) {
+    // The image is the infinite light; constant ones add their radiance to its texels (pbrt-v4
+    // sums what the infinite lights emit).
+    EnvironmentImage& env = *scene.environment;
+    vec3 constant(0.0f);
+    std::erase_if(lights, [&](const Light& light) {
+      if (light.type != kLightInfinite) return false;
+      constant += light.radiance;
+      return true;
+    });
+    if (constant != vec3(0.0f)) {
+      for (vec3& c : env.image.pixels) c += constant;
+    }
+    Light light{};
+    light.type = kLightInfinite;
+    light.radiance = environmentMeanRadiance(env.image, env.mapping);
+    lights.push_back(light);
+  }
+  lights = mergeInfiniteLights(std::move(lights));
   data.shift = recentre(triangles, camera, lights);
   data.bvh =
       buildBvh(std::move(triangles), BvhBuildOptions{settings.maxLeafSize, settings.builder});
@@ -279,7 +300,19 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     const uint32_t ref = data.emitters[i].triangle;
     if ((ref & kEmitterLight) == 0u) continue;
     const Light& light = data.lights[ref & ~kEmitterLight];
-    if (light.type == kLightInfinite) {
+    if (light.type == kLightInfinite && scene.environment) {
+      // The image: environment.h gives each direction's radiance and density.
+      p.environmentEmitter = i;
+      p.environmentPdf = data.emitters[i].pmf;
+      const EnvironmentImage& env = *scene.environment;
+      p.environmentX = env.toWorld[0];
+      p.environmentY = env.toWorld[1];
+      p.environmentZ = env.toWorld[2];
+      p.environmentWidth = uint32_t(env.image.width);
+      p.environmentHeight = uint32_t(env.image.height);
+      p.environmentMapping = env.mapping;
+      data.effects.environmentImage = true;
+    } else if (light.type == kLightInfinite) {
       p.environmentEmitter = i;
       p.environment = light.radiance;
       p.environmentPdf = environmentLightPdf(data.emitters[i].pmf);
@@ -295,6 +328,15 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   p.fastIntersection = settings.fastIntersection ? 1u : 0u;
   p.samplerType = settings.sampler.value_or(integ.sampler);
   p.russianRoulette = settings.russianRoulette.value_or(integ.russianRoulette) ? 1u : 0u;
+  if (data.effects.environmentImage) {
+    // The compensated distribution only where BSDF sampling covers what it leaves out (MIS).
+    const bool compensated =
+        p.strategy == kStrategyMis &&
+        settings.environmentCompensation.value_or(kEnvironmentCompensationDefault);
+    data.environmentTexels =
+        buildEnvironmentTexels(scene.environment->image, scene.environment->mapping, compensated);
+    data.environmentFile = scene.environment->file;
+  }
 
   // Effects: which material kinds occur on triangles, and whether light sampling can matter.
   EffectSet& fx = data.effects;

@@ -48,6 +48,9 @@ struct RenderSettings {
   int maxLeafSize = kDefaultLeafSizeCpu;
   BvhBuilder builder = kDefaultBuilder;
   bool fastIntersection = false;  // Moller-Trumbore instead of the watertight test
+  // MIS renders of an environment image: light sampling from pbrt-v4's compensated
+  // distribution (render/environment_map.h); unset: kEnvironmentCompensationDefault.
+  std::optional<bool> environmentCompensation;
 };
 
 // Which effects the scene calls for; the rest are compiled or switched out.
@@ -63,6 +66,7 @@ struct EffectSet {
   bool shadingNormals = false;    // some mesh has vertex normals: shading normals interpolated
   bool deltaLights = false;       // point, spot or distant lights (sampled, never hit)
   bool environment = false;       // an infinite light: rays that leave the scene see it
+  bool environmentImage = false;  // that light is an image (shaders/environment.h)
   bool twoSidedEmitters = false;  // some emissive triangle emits on both sides
   bool sphereLights = false;      // sphere area lights, sampled by the cone they subtend
   bool textures = false;          // some material has a parameter given by a texture
@@ -144,6 +148,10 @@ struct SceneData {
   std::vector<TextureNode> textureNodes;
   std::vector<uint32_t> imageWords;
   std::vector<MaterialTextures> materialTextures;
+  // The environment image's texels and sampling distribution (shaders/environment.h), empty
+  // without one, and its file (for messages).
+  std::vector<vec4> environmentTexels;
+  std::string environmentFile;
   RenderParams params{};
   int spp = 0;
   EffectSet effects;

@@ -1045,9 +1045,72 @@ Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3
 
 namespace {
 
+// An "environment" light with a "filename": the image (relative to the scene file), its
+// "mapping" ("latlong", the default, or "octahedral"), "scale" and "rotate" (docs/scene-format.md).
+void readEnvironmentImage(const JsonNode& l, const std::filesystem::path& sceneFile, Scene& scene) {
+  l.checkKeys({"type", "filename", "mapping", "scale", "rotate"});
+  const JsonNode fileNode = l.require("filename");
+  if (scene.environment) fileNode.fail("a second environment image (one per scene is supported)");
+  EnvironmentImage env;
+  const std::filesystem::path path = sceneFile.parent_path() / fileNode.string();
+  env.file = path.string();
+  try {
+    env.image = readImage(path);
+  } catch (const InputError& e) {
+    fileNode.fail(e.what());
+  }
+  env.mapping = kEnvironmentLatLong;
+  if (auto n = l.find("mapping")) {
+    const std::string mapping = n->string();
+    if (mapping == "octahedral") {
+      env.mapping = kEnvironmentOctahedral;
+    } else if (mapping != "latlong") {
+      n->fail("unknown mapping " + singleQuoted(mapping) +
+              " (expected \"latlong\" or \"octahedral\")");
+    }
+  }
+  if (env.mapping == kEnvironmentOctahedral && env.image.width != env.image.height) {
+    fileNode.fail(env.file + " is " + std::to_string(env.image.width) + "x" +
+                  std::to_string(env.image.height) +
+                  ", not square: an octahedral (equal-area) map is a square");
+  }
+  double scale = 1.0;
+  if (auto n = l.find("scale")) {
+    scale = n->number();
+    if (!(scale >= 0.0)) n->fail("expected a non-negative number, got " + n->describe());
+  }
+  for (vec3& c : env.image.pixels) {
+    if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) {
+      fileNode.fail(env.file + " has infinite or not-a-number pixels, no use as a light");
+    }
+    const glm::dvec3 v = glm::max(glm::dvec3(c), glm::dvec3(0.0)) * scale;
+    if (!(float(std::max(v.x, std::max(v.y, v.z))) < 3.4e38f)) {
+      l.require("scale").fail("the image's radiance times the scale does not fit a 32-bit float");
+    }
+    c = vec3(v);
+  }
+  if (auto n = l.find("rotate")) {
+    // The shapes' "rotate" (readTransform): right-handed about the axis, the image's frame into
+    // the world.
+    Transform t;
+    n->checkKeys({"axis", "degrees"});
+    const JsonNode axisNode = n->require("axis");
+    const glm::dvec3 axis = axisNode.vec3();
+    if (glm::length(axis) == 0.0) axisNode.fail("rotation axis must not be the zero vector");
+    t.axis = glm::normalize(axis);
+    std::tie(t.cosAngle, t.sinAngle) = cosSinDegrees(n->require("degrees").number());
+    for (int i = 0; i < 3; ++i) {
+      glm::dvec3 e(0.0);
+      e[i] = 1.0;
+      env.toWorld[size_t(i)] = vec3(glm::normalize(t.apply(e)));
+    }
+  }
+  scene.environment = std::move(env);
+}
+
 // "lights": pbrt-v4's point, spot, distant and infinite lights (docs/scene-format.md), in world
 // space, with their radiometric quantities given directly.
-void readLights(const JsonNode& node, Scene& scene) {
+void readLights(const JsonNode& node, const std::filesystem::path& sceneFile, Scene& scene) {
   node.expectArray();
   for (std::size_t i = 0; i < node.size(); ++i) {
     const JsonNode l = node[i];
@@ -1103,6 +1166,9 @@ void readLights(const JsonNode& node, Scene& scene) {
       const JsonNode direction = l.require("direction");
       light.direction = unit(direction, direction.vec3());
       light.radiance = colour("radiance");
+    } else if (type == "environment" && l.find("filename")) {
+      readEnvironmentImage(l, sceneFile, scene);
+      continue;
     } else if (type == "environment") {
       l.checkKeys({"type", "radiance"});
       light.type = kLightInfinite;
@@ -1138,7 +1204,7 @@ Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& optio
   if (auto n = root.find("textures")) textures.read(*n);
   readMaterials(root.require("materials"), scene, textures);
   readShapes(root.require("shapes"), path, scene);
-  if (auto n = root.find("lights")) readLights(*n, scene);
+  if (auto n = root.find("lights")) readLights(*n, path, scene);
   padMaterialTextures(scene);
   return scene;
 }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/shared.h"
+#include "image/image.h"
 
 namespace pt {
 
@@ -61,6 +62,20 @@ struct IntegratorSettings {
   uint sampler = kSamplerSobol;  // see docs/accuracy.md for what it buys
 };
 
+// An infinite light whose radiance is an image over the directions (shaders/environment.h):
+// pbrt-v4's "infinite" light with a "filename", or a JSON "environment" light with one.
+struct EnvironmentImage {
+  std::string file;  // the image file (its path resolved), for messages
+  // Radiance (its scale applied, negative values clamped to 0), row 0 at the top. Octahedral
+  // images are square.
+  Image image;
+  uint mapping = kEnvironmentOctahedral;  // kEnvironmentOctahedral or kEnvironmentLatLong
+  // The image frame's axes in world space (the columns of the light-to-world rotation; a
+  // mirror is allowed): unit and orthogonal.
+  std::array<vec3, 3> toWorld{vec3(1.0f, 0.0f, 0.0f), vec3(0.0f, 1.0f, 0.0f),
+                              vec3(0.0f, 0.0f, 1.0f)};
+};
+
 struct Scene {
   CameraDesc camera;
   IntegratorSettings integrator;
@@ -83,6 +98,9 @@ struct Scene {
   std::vector<MaterialTextures> materialTextures;
   // Lights that are not triangles (point, spot, distant, infinite), in world space.
   std::vector<Light> lights;
+  // At most one image environment (not in `lights`: prepareScene adds its Light); constant
+  // infinite lights in `lights` add to its radiance.
+  std::optional<EnvironmentImage> environment;
   std::vector<std::string> warnings;  // e.g. dropped zero-area triangles, one line each
 };
 

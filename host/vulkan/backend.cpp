@@ -52,6 +52,11 @@ struct RenderBuffers {
 RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
                           const vk::raii::CommandBuffer& cmd, Buffer& staging) {
   const Camera& cam = scene.params.camera;
+  // The environment image against the device's texel limit first, naming its file.
+  checkEnvironmentTexels(ctx.info().name, ctx.limits.maxTexelBufferElements, scene.environmentFile,
+                         scene.environmentTexels.size());
+  const std::vector<vec4> environment =
+      scene.environmentTexels.empty() ? std::vector<vec4>{vec4(0.0f)} : scene.environmentTexels;
   // An empty emitter table still needs a valid binding: one zeroed entry the shader never reads.
   const std::vector<Emitter> emitters =
       scene.emitters.empty() ? std::vector<Emitter>{Emitter{}} : scene.emitters;
@@ -70,7 +75,6 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   std::vector<uint32_t> imageWords = orDummy(scene.imageWords);
   imageWords.resize((imageWords.size() + 3) / 4 * 4, 0u);
   const std::vector<MaterialTextures> materialTextures = orDummy(scene.materialTextures);
-  const uint32_t environmentDummy[4] = {0u, 0u, 0u, 0u};
   const GpuBvh bvh = buildGpuBvh(scene.bvh);
   const std::vector<uint32_t> traversal = gpuTraversalTexels(bvh, scene.bvh.triangles);
   // In PT_BINDING_* order, followed by the accumulation and the counters.
@@ -82,7 +86,7 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       {"emitter", emitters.data(), emitters.size() * sizeof(Emitter), true},
       {"vertex normal", normals.data(), normals.size() * sizeof(TriangleNormals), true},
       {"light", lights.data(), lights.size() * sizeof(Light), true},
-      {"environment", environmentDummy, sizeof(environmentDummy), true},
+      {"environment", environment.data(), environment.size() * sizeof(vec4), true},
       {"texture coordinate", uvs.data(), uvs.size() * sizeof(TriangleUVs), true},
       {"texture", textureNodes.data(), textureNodes.size() * sizeof(TextureNode), true},
       {"texture image", imageWords.data(), imageWords.size() * sizeof(uint32_t), true},
@@ -107,11 +111,11 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   checkUploads(ctx, uploads);
   buffers.bound = recordUploads(ctx, cmd, uploads, staging);
   for (const Upload& u : uploads) buffers.texels.push_back(u.texels);
-  // The accumulation and the counters between the uploads, at their bindings.
+  // The accumulation and the counters take their bindings, between the uploads.
   const auto readWrite = U::eStorageBuffer | U::eTransferSrc | U::eTransferDst;
-  buffers.bound.insert(buffers.bound.begin() + PT_BINDING_ACCUM,
-                       makeBuffer(ctx, buffers.accumSize, readWrite, false));
-  buffers.bound.insert(buffers.bound.begin() + PT_BINDING_COUNTERS,
+  const auto at = [&](int binding) { return buffers.bound.begin() + binding; };
+  buffers.bound.insert(at(PT_BINDING_ACCUM), makeBuffer(ctx, buffers.accumSize, readWrite, false));
+  buffers.bound.insert(at(PT_BINDING_COUNTERS),
                        makeBuffer(ctx, sizeof(DeviceCounters), readWrite, false));
   buffers.texels.insert(buffers.texels.begin() + PT_BINDING_ACCUM, 2, false);
   buffers.readback =
@@ -146,7 +150,7 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
                        all || fx.environment,
                        all || fx.twoSidedEmitters,
                        all || fx.sphereLights,
-                       /*environment image*/ all,
+                       all || fx.environmentImage,
                        all || fx.textures,
                        all || fx.alphaCutouts,
                        all || fx.bumpMaps}};

@@ -2,7 +2,10 @@
 // memory, the storage-buffer size check, a memory barrier.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "vulkan/context.h"
@@ -29,6 +32,12 @@ void makeTexelView(const VulkanContext& ctx, Buffer& b);
 // A texel buffer of more 16-byte texels than the device allows is refused with the numbers
 // (InputError), like checkRange.
 void checkTexelRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size);
+
+// An environment image whose texels and sampling tables (`texels` of them) exceed the device's
+// maxTexelBufferElements (`limit`) is refused in one line naming its file (InputError), before
+// anything is uploaded.
+void checkEnvironmentTexels(const std::string& device, uint32_t limit, const std::string& file,
+                            size_t texels);
 
 // Storage buffers larger than the device allows would be silently cut short (lavapipe's
 // maxStorageBufferRange is 128 MiB): refuse them with the numbers instead (InputError).

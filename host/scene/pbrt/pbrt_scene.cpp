@@ -26,6 +26,7 @@
 #include <glm/matrix.hpp>
 
 #include "common/check.h"
+#include "environment.h"
 #include "image/image.h"
 #include "scene/json_reader.h"
 #include "scene/pbrt/pbrt_parser.h"
@@ -475,6 +476,8 @@ class Builder {
   MaterialDef makeMaterial(const std::string& type, const Params& p, const Location& where);
   void areaLightSource(Statement& s);
   void lightSource(Statement& s);
+  void imageInfiniteLight(Params& p, const std::string& file, double scale,
+                          std::optional<double> wanted, const std::string& context);
   void texture(Statement& s);
   void shape(Statement& s);
   bool buildShape(const std::string& type, const Params& p, const Statement& s, Mesh& mesh);
@@ -1947,29 +1950,6 @@ void Builder::lightSource(Statement& s) {
   } else {
     light.type = kLightInfinite;
     if (auto L = spectrum(p, "L", Use::kIlluminant)) emitted = *L;
-    if (auto file = p.string("filename")) {
-      if (p.find("L")) {
-        fail(p.find("L")->location, context + ": \"L\" and \"filename\" exclude each other");
-      }
-      const Param* f = p.find("filename");
-      const fs::path path = resolvePath(*file, f->location, mainFile_);
-      Image image;
-      try {
-        image = readImage(path);
-      } catch (const InputError& e) {
-        fail(f->location, context + ": " + e.what());
-      }
-      // pbrt-v4's environment images are equal-area (octahedral) squares, so every pixel
-      // covers the same solid angle: the mean is the mean radiance over the sphere. (Lat-long
-      // images, which it does not read, would need cos-weighting.)
-      glm::dvec3 sum(0.0);
-      for (const vec3& c : image.pixels) sum += glm::dvec3(c);
-      emitted = image.pixels.empty() ? vec3(0.0f) : vec3(sum / double(image.pixels.size()));
-      warnOnce("infinite image", f->location,
-               context + ": the image " + singleQuoted(*file) +
-                   " is taken as its mean radiance, a constant environment (image lights are "
-                   "later work)");
-    }
     if (const Param* portal = p.find("portal")) {
       warnOnce("portal", portal->location,
                context +
@@ -1978,6 +1958,14 @@ void Builder::lightSource(Statement& s) {
     }
     wanted = target("illuminance");
     k = kPi;
+    if (auto file = p.string("filename")) {
+      if (p.find("L")) {
+        fail(p.find("L")->location, context + ": \"L\" and \"filename\" exclude each other");
+      }
+      imageInfiniteLight(p, *file, scale, wanted, context);
+      p.reportUnused();
+      return;
+    }
   }
   if (wanted) scale *= *wanted / k;
   const glm::dvec3 radiance = glm::dvec3(emitted) * scale;
@@ -1989,6 +1977,91 @@ void Builder::lightSource(Statement& s) {
   light.radiance = vec3(radiance);
   p.reportUnused();
   scene_.lights.push_back(light);
+}
+
+// pbrt-v4's ImageInfiniteLight: an equal-area octahedral square image (its frame the CTM's
+// rotation, +z in the image's centre), its radiance the nearest texel times `scale`, or scaled
+// so that the upper hemisphere's illuminance (`wanted`) comes out as pbrt-v4 computes it.
+void Builder::imageInfiniteLight(Params& p, const std::string& file, double scale,
+                                 std::optional<double> wanted, const std::string& context) {
+  const Param* f = p.find("filename");
+  if (scene_.environment) {
+    fail(f->location, context + ": a second image infinite light (one per scene is supported)");
+  }
+  const fs::path path = resolvePath(file, f->location, mainFile_);
+  EnvironmentImage env;
+  env.file = path.string();
+  try {
+    env.image = readImage(path);
+  } catch (const InputError& e) {
+    fail(f->location, context + ": " + e.what());
+  }
+  const Image& image = env.image;
+  if (image.width != image.height) {
+    fail(f->location, context + ": " + singleQuoted(file) + " is " + std::to_string(image.width) +
+                          "x" + std::to_string(image.height) +
+                          ", not square: pbrt-v4 takes only equal-area octahedral (square) "
+                          "environment images");
+  }
+  for (const vec3& c : image.pixels) {
+    if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) {
+      fail(f->location, context + ": " + singleQuoted(file) +
+                            " has infinite or not-a-number pixels, no use as a light");
+    }
+  }
+  if (wanted) {
+    // pbrt-v4's illuminance of the map over its upper hemisphere (z > 0 in the light's frame),
+    // its texels' luminance times cos theta, times 2 pi / (texel count) as it writes it (a
+    // texel's solid angle is 4 pi / count: pbrt-v4's own factor is kept, so that the same
+    // parameter gives the same image).
+    double illuminance = 0.0;
+    const int n = image.width;
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const vec3 w = equalAreaSquareToSphere(
+            vec2((float(x) + 0.5f) / float(n), (float(y) + 0.5f) / float(n)));
+        if (w.z <= 0.0f) continue;
+        const vec3 c = image.at(x, y);
+        illuminance +=
+            (0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z)) * double(w.z);
+      }
+    }
+    illuminance *= 2.0 * 3.14159265358979323846 / (double(n) * double(n));
+    if (illuminance > 0.0) scale *= *wanted / illuminance;
+  }
+  for (vec3& c : env.image.pixels) {
+    const glm::dvec3 v = glm::max(glm::dvec3(c), glm::dvec3(0.0)) * scale;
+    if (!(float(std::max(v.x, std::max(v.y, v.z))) < std::numeric_limits<float>::infinity())) {
+      fail(f->location, context +
+                            ": the image's radiance (times its scale) does not fit a 32-bit "
+                            "float");
+    }
+    c = vec3(v);
+  }
+  // The light's frame: the CTM's rotation, through the camera's mirror. pbrt-v4 assumes a
+  // rigid transform here; a uniform scale is harmless (the axes are normalized), anything else
+  // has no direction-to-direction meaning and is refused.
+  const glm::dmat3 m(gs_.ctm.m);
+  glm::dvec3 axes[3];
+  for (int i = 0; i < 3; ++i) {
+    axes[i] = m[i];
+    if (mirrored_) axes[i].x = -axes[i].x;
+    const double length = glm::length(axes[i]);
+    if (!(length > 0.0) || !std::isfinite(length)) {
+      fail(f->location, context + ": the light's transform is singular");
+    }
+    axes[i] /= length;
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (std::fabs(glm::dot(axes[i], axes[(i + 1) % 3])) > 1e-4) {
+      fail(f->location, context +
+                            ": the light's transform is not a rotation (times a uniform "
+                            "scale)");
+    }
+  }
+  for (int i = 0; i < 3; ++i) env.toWorld[size_t(i)] = vec3(axes[i]);
+  env.mapping = kEnvironmentOctahedral;
+  scene_.environment = std::move(env);
 }
 
 void Builder::texture(Statement& s) {
