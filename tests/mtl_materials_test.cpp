@@ -9,9 +9,15 @@
 #include <vector>
 
 #include "common/check.h"
+#include "image/image.h"
+#include "image/texture_image.h"
+#include "render/prepare.h"
+#include "render_compare.h"
 #include "scene/mtl_materials.h"
 #include "scene/scene.h"
+#include "scene/textures.h"
 #include "test_util.h"
+#include "texture.h"
 
 namespace pt {
 namespace {
@@ -245,12 +251,14 @@ TEST(MtlMapping, WarningsForTransparencyOutsideGlassAndTextures) {
   const MtlMaterial metal = onlyMaterial("newmtl metal\nKs 0.9 0.9 0.9\nNs 30\nd 0.9\n");
   ASSERT_EQ(metal.warnings.size(), 1u);
   EXPECT_NE(metal.warnings[0].find("rendered as an opaque rough conductor"), std::string::npos);
-  const MtlMaterial textured =
-      onlyMaterial("newmtl wood\nKd 0.5 0.3 0.1\nKs 0.2 0.2 0.2\nmap_Kd wood.png\n");
+  // map_Kd is simulated now (mtl_materials_test's map tests); map_Ka is not.
+  const MtlMaterial textured = onlyMaterial(
+      "newmtl wood\nKd 0.5 0.3 0.1\nKs 0.2 0.2 0.2\nmap_Kd wood.png\nmap_Ka amb.png\n");
   EXPECT_EQ(textured.material.type, kMaterialCoatedDiffuse);
+  ASSERT_EQ(textured.maps.size(), 1u);
   ASSERT_EQ(textured.warnings.size(), 1u);
   EXPECT_EQ(textured.warnings[0],
-            "m.mtl: material 'wood': texture maps are not simulated; the constant colours are "
+            "m.mtl: material 'wood': map_Ka 'amb.png' is not simulated; the constant values are "
             "used");
 }
 
@@ -382,6 +390,314 @@ TEST(ScenePly, MalformedPlyNamesTheSceneEntry) {
   EXPECT_NE(m.find("m.ply: face 0"), std::string::npos) << m;
   EXPECT_NE(m.find("out of range"), std::string::npos) << m;
   EXPECT_NE(m.find("s.json: shapes[0].file"), std::string::npos) << m;
+}
+
+// ---- texture maps ---------------------------------------------------------------------------
+
+// A 4 x 2 image whose texels all differ, every value in (0, 1).
+Image mapImage() {
+  Image image(4, 2);
+  for (int y = 0; y < 2; ++y) {
+    for (int x = 0; x < 4; ++x) {
+      image.at(x, y) =
+          vec3(0.1f + 0.2f * float(x), 0.2f + 0.5f * float(y), 0.05f + 0.1f * float(x + 4 * y));
+    }
+  }
+  return image;
+}
+
+// Texel (x, y) of an image file as a texture reads it: floats as stored, bytes decoded from
+// sRGB or linearly.
+glm::dvec3 fileTexel(const std::filesystem::path& path, int x, int y, bool srgb) {
+  const TextureImage image = readTextureImage(path);
+  const std::size_t c = std::size_t(image.channels);
+  const std::size_t at = c * (std::size_t(y) * std::size_t(image.width) + std::size_t(x));
+  glm::dvec3 v;
+  for (int i = 0; i < 3; ++i) {
+    const std::size_t k = at + (c == 1 ? 0 : std::size_t(i));
+    if (!image.eightBit()) {
+      v[i] = image.floats[k];
+    } else {
+      const double b = image.bytes[k] / 255.0;
+      v[i] = !srgb ? b : b <= 0.04045 ? b / 12.92 : std::pow((b + 0.055) / 1.055, 2.4);
+    }
+  }
+  return v;
+}
+
+// The (u, v) of texel (x, y)'s centre in a width x height image (row 0 at v = 1).
+vec2 texelCentre(int x, int y, int width, int height) {
+  return vec2((float(x) + 0.5f) / float(width), 1.0f - (float(y) + 0.5f) / float(height));
+}
+
+// A unit quad with texture coordinates (0, 0) .. (1, 1) in m.obj, its faces of material `m`
+// from m.mtl (`mtl`, written here), loaded as a scene.
+Scene loadMappedQuad(const test::TempDir& dir, const std::string& mtl) {
+  dir.write("m.mtl", mtl);
+  dir.write("m.obj",
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+            "usemtl m\nf 1/1 2/2 3/3 4/4\n");
+  return loadScene(dir.write("s.json", R"({"materials": [{"name": "w"}],
+                    "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"}]})"));
+}
+
+struct MappedMaterial {
+  const Scene& scene;
+  MaterialTextures textures;
+  Material material;
+  TextureTables tables() const {
+    return TextureTables{scene.textureNodes.data(), scene.imageWords.data(),
+                         scene.materialTextures.data(), scene.uvs.data()};
+  }
+  vec3 at(uint texture, vec2 uv) const { return evalTexture(tables(), texture, uv); }
+};
+
+MappedMaterial mtlMaterial(const Scene& scene) {
+  EXPECT_EQ(scene.materialNames.size(), 2u);
+  EXPECT_EQ(scene.materialTextures.size(), scene.materials.size());
+  if (scene.materialTextures.size() < 2) return {scene, noMaterialTextures(), Material{}};
+  return {scene, scene.materialTextures[1], scene.materials[1]};
+}
+
+void expectNear(vec3 got, glm::dvec3 want, double tolerance, const std::string& what) {
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(double(got[c]), want[c], tolerance) << what << " channel " << c;
+  }
+}
+
+TEST(SceneMtlMaps, MapKdIsTheReflectanceTimesKd) {
+  const test::TempDir dir;
+  writeImage(mapImage(), dir / "wood.exr");
+  const Scene scene = loadMappedQuad(dir, "newmtl m\nKd 0.5 0.25 1\nmap_Kd wood.exr\n");
+  EXPECT_TRUE(scene.warnings.empty());
+  const MappedMaterial m = mtlMaterial(scene);
+  EXPECT_EQ(m.material.type, kMaterialDiffuse);
+  ASSERT_NE(m.textures.reflectance, kNoTexture);
+  EXPECT_EQ(m.textures.alpha, kNoTexture);
+  EXPECT_EQ(m.textures.displacement, kNoTexture);
+  // The quad keeps the OBJ's texture coordinates.
+  ASSERT_EQ(scene.uvs.size(), scene.triangles.size());
+  EXPECT_EQ(scene.uvs[0].uv1, vec2(1.0f, 0.0f));
+  for (int y = 0; y < 2; ++y) {
+    for (int x = 0; x < 4; ++x) {
+      const vec2 uv = texelCentre(x, y, 4, 2);
+      const glm::dvec3 want = glm::dvec3(0.5, 0.25, 1.0) * fileTexel(dir / "wood.exr", x, y, false);
+      expectNear(m.at(m.textures.reflectance, uv), want, 1e-6, "texel " + std::to_string(x));
+      // The material at that point: the diffuse reflectance replaced.
+      const Material r = resolveMaterial(m.tables(), m.material, m.textures, uv);
+      expectNear(r.reflectance, want, 1e-6, "resolved");
+    }
+  }
+}
+
+TEST(SceneMtlMaps, EightBitMapKdIsDecodedFromSrgbAndUsedAloneWithoutKd) {
+  const test::TempDir dir;
+  writeImage(mapImage(), dir / "wood.png");
+  // No Kd line: the image alone (tinyobjloader's 0.6 only chooses the rule).
+  const Scene scene = loadMappedQuad(dir, "newmtl m\nmap_Kd wood.png\n");
+  const MappedMaterial m = mtlMaterial(scene);
+  EXPECT_EQ(m.material.type, kMaterialDiffuse);
+  ASSERT_NE(m.textures.reflectance, kNoTexture);
+  const glm::dvec3 want = fileTexel(dir / "wood.png", 2, 1, true);
+  expectNear(m.at(m.textures.reflectance, texelCentre(2, 1, 4, 2)), want, 1e-6, "texel (2, 1)");
+  // And close to the colour written (8-bit sRGB quantizes it).
+  expectNear(m.at(m.textures.reflectance, texelCentre(2, 1, 4, 2)), glm::dvec3(mapImage().at(2, 1)),
+             5e-3, "written");
+}
+
+TEST(SceneMtlMaps, MapKsTexturesMirrorsAndConductorsTimesKs) {
+  const test::TempDir dir;
+  writeImage(mapImage(), dir / "s.exr");
+  for (const std::string& rule : {std::string("illum 3\nKs 0.5 0.5 0.5\n"),
+                                  std::string("Kd 0 0 0\nKs 0.5 0.5 0.5\nNs 20\n")}) {
+    const Scene scene = loadMappedQuad(dir, "newmtl m\n" + rule + "map_Ks s.exr\n");
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
+    const MappedMaterial m = mtlMaterial(scene);
+    ASSERT_NE(m.textures.reflectance, kNoTexture) << rule;
+    expectNear(m.at(m.textures.reflectance, texelCentre(1, 0, 4, 2)),
+               0.5 * fileTexel(dir / "s.exr", 1, 0, false), 1e-6, rule);
+  }
+  // A mirror of black Ks has reflectance 1: its map alone.
+  const Scene black = loadMappedQuad(dir, "newmtl m\nillum 5\nmap_Ks s.exr\n");
+  const MappedMaterial m = mtlMaterial(black);
+  EXPECT_EQ(m.material.type, kMaterialMirror);
+  expectNear(m.at(m.textures.reflectance, texelCentre(3, 1, 4, 2)),
+             fileTexel(dir / "s.exr", 3, 1, false), 1e-6, "illum 5");
+}
+
+TEST(SceneMtlMaps, ScaleOffsetAndClampOptionsMapTheCoordinates) {
+  const test::TempDir dir;
+  writeImage(mapImage(), dir / "t.exr");
+  const Scene scene =
+      loadMappedQuad(dir, "newmtl m\nKd 1 1 1\nmap_Kd -s 2 3 1 -o 0.25 0.5 0 -clamp on t.exr\n");
+  const MappedMaterial m = mtlMaterial(scene);
+  ASSERT_NE(m.textures.reflectance, kNoTexture);
+  const TextureNode node = scene.textureNodes[m.textures.reflectance];
+  EXPECT_EQ(node.mapping, vec4(2.0f, 3.0f, 0.25f, 0.5f));
+  EXPECT_EQ((node.flags >> 4) & 0xFu, kWrapClamp);
+  // (s, t) = (2 u + 0.25, 3 v + 0.5) at texel (1, 0)'s centre (0.375, 0.75).
+  const vec2 uv((0.375f - 0.25f) / 2.0f, (0.75f - 0.5f) / 3.0f);
+  expectNear(m.at(m.textures.reflectance, uv), fileTexel(dir / "t.exr", 1, 0, false), 1e-5,
+             "-s -o");
+  // Beyond the image's top-right corner: clamped to its texel.
+  expectNear(m.at(m.textures.reflectance, vec2(0.6f, 0.9f)), fileTexel(dir / "t.exr", 3, 0, false),
+             1e-6, "-clamp on");
+  // Without -clamp, repeated.
+  // Without -clamp, repeated; -s with two numbers (tinyobjloader would take the file name
+  // for w and lose the map).
+  const Scene repeated = loadMappedQuad(dir, "newmtl m\nmap_Kd -s 2 3 t.exr\n");
+  const uint texture = mtlMaterial(repeated).textures.reflectance;
+  ASSERT_NE(texture, kNoTexture);
+  EXPECT_EQ(repeated.textureNodes[texture].mapping, vec4(2.0f, 3.0f, 0.0f, 0.0f));
+  EXPECT_EQ((repeated.textureNodes[texture].flags >> 4) & 0xFu, kWrapRepeat);
+}
+
+TEST(SceneMtlMaps, MapDIsALinearAlphaTimesD) {
+  const test::TempDir dir;
+  Image mask(2, 1);
+  mask.at(0, 0) = vec3(0.0f);
+  mask.at(1, 0) = vec3(0.6f);
+  writeImage(mask, dir / "mask.png");
+  const Scene scene = loadMappedQuad(dir, "newmtl m\nKd 0.5 0.5 0.5\nd 0.5\nmap_d mask.png\n");
+  // d < 1 is simulated by the alpha: no transparency warning.
+  EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
+  const MappedMaterial m = mtlMaterial(scene);
+  ASSERT_NE(m.textures.alpha, kNoTexture);
+  EXPECT_EQ(m.textures.reflectance, kNoTexture);
+  EXPECT_EQ(evalFloatTexture(m.tables(), m.textures.alpha, texelCentre(0, 0, 2, 1)), 0.0f);
+  // The PNG's byte read linearly (not sRGB-decoded), times d.
+  EXPECT_NEAR(evalFloatTexture(m.tables(), m.textures.alpha, texelCentre(1, 0, 2, 1)),
+              0.5 * fileTexel(dir / "mask.png", 1, 0, false).x, 1e-6);
+  // Where the alpha is 0 the surface is cut away: on the second triangle (corners (0, 0),
+  // (1, 1), (0, 1)) at texel (0, 0)'s centre (0.25, 0.5).
+  EXPECT_FALSE(alphaKeepsHit(m.tables(), 1, 1, vec3(0.5f, 0.25f, 0.25f), 0.0f));
+  EXPECT_TRUE(alphaKeepsHit(m.tables(), 1, 1, vec3(0.0f, 1.0f, 0.0f), 0.0f));
+}
+
+TEST(SceneMtlMaps, BumpMapsAreDisplacementScaledByBm) {
+  const test::TempDir dir;
+  writeImage(mapImage(), dir / "b.exr");
+  for (const std::string& statement : {"map_Bump", "map_bump", "bump"}) {
+    const Scene scene =
+        loadMappedQuad(dir, "newmtl m\nKd 0.5 0.5 0.5\n" + statement + " -bm 0.2 b.exr\n");
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
+    const MappedMaterial m = mtlMaterial(scene);
+    ASSERT_NE(m.textures.displacement, kNoTexture) << statement;
+    EXPECT_EQ(m.textures.reflectance, kNoTexture);
+    const glm::dvec3 t = fileTexel(dir / "b.exr", 2, 0, false);
+    EXPECT_NEAR(evalFloatTexture(m.tables(), m.textures.displacement, texelCentre(2, 0, 4, 2)),
+                0.2 * (t.x + t.y + t.z) / 3.0, 1e-6)
+        << statement;
+  }
+}
+
+TEST(SceneMtlMaps, UnreadableImageIsAOneLineErrorNamingMtlMaterialAndMap) {
+  const test::TempDir dir;
+  const std::string missing = [&] {
+    try {
+      loadMappedQuad(dir, "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  }();
+  EXPECT_EQ(missing.find('\n'), std::string::npos) << missing;
+  EXPECT_EQ(missing.rfind((dir / "m.mtl").string() + ": material 'm': map_Kd 'gone.png': " +
+                              (dir / "gone.png").string() + ": ",
+                          0),
+            0u)
+      << missing;
+  dir.write("bad.png", "not a png");
+  const std::string bad = [&] {
+    try {
+      loadMappedQuad(dir, "newmtl m\nmap_d bad.png\n");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  }();
+  EXPECT_NE(bad.find("m.mtl: material 'm': map_d 'bad.png': "), std::string::npos) << bad;
+  EXPECT_EQ(bad.find('\n'), std::string::npos) << bad;
+  // A material no face uses reads no image.
+  dir.write("m.mtl", "newmtl m\nKd 0.5 0.5 0.5\nnewmtl unused\nmap_Kd gone.png\n");
+  EXPECT_NO_THROW(loadScene(dir / "s.json"));
+}
+
+TEST(MtlMapping, MapsAndOptionsNotSimulatedAreWarnings) {
+  const MtlMaterial m = onlyMaterial(
+      "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd -mm 0.1 0.9 -imfchan r -cc on -s 2 2 d.png\n"
+      "map_Ks spec.png\nmap_Ke glow.png\nnorm n.png\ndisp h.png\nmap_Ns ns.png\n");
+  EXPECT_EQ(m.material.type, kMaterialDiffuse);
+  ASSERT_EQ(m.maps.size(), 1u);
+  // -cc is unknown to tinyobjloader; the options after it still apply.
+  EXPECT_EQ(m.maps[0].file, "d.png");
+  EXPECT_EQ(m.maps[0].desc.filename, std::filesystem::path("d.png"));
+  EXPECT_EQ(m.maps[0].desc.mapping, vec4(2.0f, 2.0f, 0.0f, 0.0f));
+  EXPECT_EQ(m.maps[0].desc.encoding, "sRGB");
+  const std::vector<std::string> want = {
+      "m.mtl: material 'm': map_Kd 'd.png': options -mm, -imfchan, -cc are not simulated; "
+      "ignored",
+      "m.mtl: material 'm': map_Ks 'spec.png' is not simulated for a diffuse surface (it has no "
+      "parameter for Ks); ignored",
+      "m.mtl: material 'm': map_Ns 'ns.png' is not simulated; the constant values are used",
+      "m.mtl: material 'm': disp 'h.png' is not simulated; the constant values are used",
+      "m.mtl: material 'm': map_Ke 'glow.png' is not simulated; the constant values are used",
+      "m.mtl: material 'm': norm 'n.png' is not simulated; the constant values are used",
+  };
+  EXPECT_EQ(m.warnings, want);
+
+  // The coat of a coated diffuse surface has no colour; glass is clear.
+  const MtlMaterial coated =
+      onlyMaterial("newmtl c\nKd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nNs 10\nmap_Ks s.png\n");
+  ASSERT_EQ(coated.warnings.size(), 1u);
+  EXPECT_NE(coated.warnings[0].find("coated diffuse surface (its coat has no colour); ignored"),
+            std::string::npos)
+      << coated.warnings[0];
+  const MtlMaterial glass = onlyMaterial("newmtl g\nillum 7\nmap_Kd k.png\nmap_d a.png\nd 0.1\n");
+  ASSERT_EQ(glass.warnings.size(), 1u);
+  EXPECT_NE(glass.warnings[0].find("map_Kd 'k.png' is not simulated for a glass"),
+            std::string::npos);
+  ASSERT_EQ(glass.maps.size(), 1u);  // the alpha, not times d (part of the glass)
+  EXPECT_EQ(glass.maps[0].target, scene_detail::MtlMap::Target::kAlpha);
+  EXPECT_EQ(glass.maps[0].factor, vec3(1.0f));
+  EXPECT_EQ(glass.maps[0].desc.encoding, "linear");
+}
+
+TEST(MtlMapping, MapPathsAreRelativeToTheMtlFileAndBadOptionsAreErrors) {
+  const std::vector<MtlMaterial> m =
+      loadMtlMaterials("newmtl m\nmap_Kd -colorspace linear tex/a b.png\n", "dir/m.mtl");
+  ASSERT_EQ(m.size(), 1u);
+  ASSERT_EQ(m[0].maps.size(), 1u);
+  EXPECT_EQ(m[0].maps[0].desc.filename, std::filesystem::path("dir/tex/a b.png"));
+  EXPECT_EQ(m[0].maps[0].desc.encoding, "linear");
+  EXPECT_EQ(mtlError("newmtl m\nmap_Kd -colorspace xyz a.png\n"),
+            "m.mtl: material 'm': map_Kd 'a.png': -colorspace: expected 'sRGB' or 'linear', got "
+            "'xyz'");
+  EXPECT_EQ(mtlError("newmtl m\nbump -bm nan a.png\n"),
+            "m.mtl: material 'm': bump 'a.png': -bm: expected a finite number, got nan");
+  EXPECT_EQ(mtlError("newmtl m\nmap_Kd -s inf 1 a.png\n"),
+            "m.mtl: material 'm': map_Kd 'a.png': -s: expected finite numbers, got inf 1");
+  EXPECT_EQ(mtlError("newmtl m\nmap_d -o 0 1e39 a.png\n"),
+            "m.mtl: material 'm': map_d 'a.png': -o: expected finite numbers, got 0 inf");
+}
+
+// An OBJ plane with map_Kd under a distant light: both backends agree.
+TEST(SceneMtlMaps, MapKdQuadRendersAlikeOnBothBackends) {
+  const test::TempDir dir;
+  writeImage(mapImage(), dir / "wood.png");
+  dir.write("p.mtl", "newmtl m\nKd 0.9 0.8 0.7\nmap_Kd -s 2 2 wood.png\n");
+  dir.write("p.obj",
+            "mtllib p.mtl\nv 10 0 -10\nv -10 0 -10\nv -10 0 10\nv 10 0 10\nvt 0 0\nvt 1 0\n"
+            "vt 1 1\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3 4/4\n");
+  const Scene scene = loadScene(dir.write("s.json", R"({"camera": {"position": [0, 10, 0],
+      "target": [0, 0, 0], "up": [0, 0, 1], "vfov": 60, "width": 32, "height": 32},
+    "integrator": {"spp": 16, "maxDepth": 2},
+    "materials": [{"name": "w"}],
+    "shapes": [{"type": "obj", "file": "p.obj", "materials": "mtl"}],
+    "lights": [{"type": "distant", "direction": [0, 1, 0], "radiance": [3, 3, 3]}]})"));
+  const SceneData data = prepareScene(scene, RenderSettings{});
+  EXPECT_TRUE(data.effects.textures);
+  expectAgreement(renderBoth(data, data.spp));
 }
 
 }  // namespace

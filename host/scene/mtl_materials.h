@@ -8,12 +8,26 @@
 #include <vector>
 
 #include "common/shared.h"
+#include "scene/textures.h"
 
 namespace pt::scene_detail {
+
+// A texture map of an MTL material that the renderer simulates, with its options applied to
+// desc (the image is read only when the material is used: buildMtlTextures).
+struct MtlMap {
+  enum class Target { kReflectance, kAlpha, kDisplacement };
+  Target target = Target::kReflectance;
+  std::string statement;  // as the file spells it in messages: "map_Kd", "map_d", "bump"
+  std::string file;       // the file name as the MTL file gives it, for messages
+  ImageTextureDesc desc;  // filename resolved against the MTL file's directory
+  vec3 factor{1.0f};      // multiplies the image's value (Kd, Ks or d)
+  bool isFloat = false;   // alpha and displacement read one channel (texture.h's float rule)
+};
 
 struct MtlMaterial {
   std::string name;
   Material material{};
+  std::vector<MtlMap> maps;
   std::vector<std::string> warnings;  // "<file>: material 'x': ... rendered as ...", one each
 };
 
@@ -36,10 +50,33 @@ float phongExponentToAlpha(float ns);
 //    coateddiffuse, base Kd, coat index 1.5, other parameters its defaults); Kd black -> a
 //    rough conductor of reflectance Ks. Both with alpha = phongExponentToAlpha(Ns).
 //  - Otherwise Lambertian with reflectance Kd.
-// Warnings: transparency (illum 9 or d < 1 outside the glass rule), a diffuse part dropped
-// from a mirror, texture maps. Throws InputError "<file>: material 'x': Kd: ..." for colours
-// outside [0, 1] (Kd, Ks), negative or non-finite emission, an Ns a glossy material uses that
-// is negative or NaN, and an Ni a glass uses that is not positive and finite.
+// Maps (file names relative to the MTL file's directory; the options before the file name
+// are read here, as tinyobjloader loses the file after `-s u v` and does not know -cc: -s, -o,
+// -clamp, -bm and -colorspace sRGB|linear honoured; -imfchan, -mm, -texres, -boost, -t,
+// -type, -blendu off, -blendv off and -cc on warned about, once per map, and ignored):
+//  - map_Kd: the reflectance where the rule uses Kd (diffuse, coated diffuse base), the image
+//    (sRGB for 8-bit images) times Kd (the image alone where the material has no Kd line).
+//  - map_Ks: the reflectance where the rule uses Ks (mirror, rough conductor), the image
+//    times the reflectance the rule chose (Ks, or 1 for a mirror whose Ks is black).
+//  - map_d: alpha, the image (linear) times d where d < 1 (not for glass, where d is part of
+//    the glass); d < 1 is then simulated, not warned about.
+//  - map_Bump, map_bump, bump: displacement, the image (linear) times -bm.
+//  A material with map_Kd and no Kd line is taken as Kd 0.6 (tinyobjloader's default) to
+//  choose its rule. A map the material's rule has no parameter for is a warning, and so is
+//  every other map (map_Ka, map_Ns, map_Ke, disp, refl, norm, map_Pr, map_Pm, map_Ps).
+// Warnings: transparency (illum 9 or d < 1 outside the glass rule, without map_d), a diffuse
+// part dropped from a mirror, maps and map options not simulated. Throws InputError "<file>:
+// material 'x': Kd: ..." for colours outside [0, 1] (Kd, Ks), negative or non-finite emission, an
+// Ns a glossy material uses that is negative or NaN, and an Ni a glass uses that is not positive
+// and finite; and
+// "<file>: material 'x': map_Kd 'f.png': ..." for a map's non-finite -s, -o or -bm, an unknown
+// -colorspace or no file name, and "...: d: ..." for a negative or NaN d beside a map_d.
 std::vector<MtlMaterial> loadMtlMaterials(const std::string& text, const std::string& file);
+
+// The textures of m's maps (m from loadMtlMaterials of `file`), their images read now through
+// builder (which builds into scene). Throws InputError "<file>: material 'x': map_Kd 'f.png':
+// <the image's own message>" for an image that cannot be read.
+MaterialTextures buildMtlTextures(const MtlMaterial& m, const std::string& file,
+                                  TextureBuilder& builder, Scene& scene);
 
 }  // namespace pt::scene_detail

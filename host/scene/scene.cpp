@@ -662,6 +662,9 @@ struct MtlLibrary {
   std::map<std::pair<std::string, std::string>, uint> sceneIndex;
   // MTL file path -> its materials, read once
   std::map<std::string, std::vector<scene_detail::MtlMaterial>> files;
+  // The textures of MTL maps, made when a material with maps is first used (each image read
+  // once per encoding).
+  std::optional<TextureBuilder> textures;
 };
 
 // An OBJ shape with "materials": "mtl": every usemtl names a material of the OBJ's mtllib
@@ -717,6 +720,14 @@ ShapeTriangles readObjWithMtl(const JsonNode& shape, const MeshFile& file,
       scene.materials.push_back(match->second->material);
       scene.materialNames.push_back(std::filesystem::path(match->first).filename().string() + ":" +
                                     name);
+      // Its maps' textures; the shape's texture coordinates are kept once some material has
+      // textures (readShapes decides after this).
+      if (!match->second->maps.empty()) {
+        if (!library.textures) library.textures.emplace(scene);
+        setMaterialTextures(
+            scene, it->second,
+            scene_detail::buildMtlTextures(*match->second, match->first, *library.textures, scene));
+      }
     }
     sceneMaterial[i] = it->second;
   }
