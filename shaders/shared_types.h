@@ -246,8 +246,8 @@ struct MaterialTextures {
   uint alpha;          // cut-out (float): the surface is missing where it is 0
   uint flags;          // kRemapRoughness
   float scale;         // diffusetransmission: pbrt-v4's "scale" of both colours
-  uint reserved0;      // zero
-  uint reserved1;      // zero
+  uint thickness;      // coateddiffuse: the medium's thickness (float)
+  uint g;              // coateddiffuse: the medium's asymmetry (float)
 };                     // 48 bytes
 PT_CONST uint kMaterialTextureTexels = 3u;
 PT_CONST uint kRemapRoughness = 1u;  // roughness textures give pbrt-v4's roughness, not alpha
@@ -356,15 +356,15 @@ PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v =
 // (Mesa 22.3 fetches these texels in a function of its own, called four times per traversal
 // step; as storage texel buffers read by imageLoad, which it inlines, they were no faster:
 // Cornell box the same, bunny box 2-4 % slower.)
-#define PT_BINDING_PARAMS 0       // RenderParams
-#define PT_BINDING_NODES 1        // GpuBvhNode[], then Triangle[] (gpuTraversalTexels), texels
-#define PT_BINDING_TRIANGLES 2    // Triangle[], texels
-#define PT_BINDING_MATERIALS 3    // Material[], texels
-#define PT_BINDING_EMITTERS 4     // Emitter[], texels (one dummy entry when the scene has none)
-#define PT_BINDING_NORMALS 5      // TriangleNormals[], texels (one dummy entry when none)
-#define PT_BINDING_LIGHTS 6       // Light[], texels (one dummy entry when the scene has none)
-#define PT_BINDING_ACCUM 7        // AccumPixel[width * height]
-#define PT_BINDING_COUNTERS 8     // DeviceCounters
+#define PT_BINDING_PARAMS 0     // RenderParams
+#define PT_BINDING_NODES 1      // GpuBvhNode[], then Triangle[] (gpuTraversalTexels), texels
+#define PT_BINDING_TRIANGLES 2  // Triangle[], texels
+#define PT_BINDING_MATERIALS 3  // Material[], texels
+#define PT_BINDING_EMITTERS 4   // Emitter[], texels (one dummy entry when the scene has none)
+#define PT_BINDING_NORMALS 5    // TriangleNormals[], texels (one dummy entry when none)
+#define PT_BINDING_LIGHTS 6     // Light[], texels (one dummy entry when the scene has none)
+#define PT_BINDING_ACCUM 7      // AccumPixel[width * height]
+#define PT_BINDING_COUNTERS 8   // DeviceCounters
 // The environment image's texels and sampling distribution (environment.h), as float texels
 // (one dummy texel when the scene has no image).
 #define PT_BINDING_ENVIRONMENT 9

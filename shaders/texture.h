@@ -254,6 +254,12 @@ PT_INLINE Material resolveMaterial(PT_TEXTURES_PARAM Material m, MaterialTexture
     float r = max(evalFloatTexture(PT_TEXTURES_ARG t.vRoughness, uv), 0.0f);
     m.alphaY = remap ? sqrt(r) : r;
   }
+  // coateddiffuse's medium: pbrt-v4 keeps the thickness at least the smallest normal float and
+  // clamps g to [-1, 1]; we keep g inside (-1, 1), where Henyey-Greenstein is not a delta.
+  if (t.thickness != kNoTexture) {
+    m.thickness = max(evalFloatTexture(PT_TEXTURES_ARG t.thickness, uv), 1.17549435e-38f);
+  }
+  if (t.g != kNoTexture) m.g = clamp(evalFloatTexture(PT_TEXTURES_ARG t.g, uv), -0.999f, 0.999f);
   return m;
 }
 

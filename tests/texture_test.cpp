@@ -288,6 +288,15 @@ TEST(Textures, MaterialParametersTakeTheirTextures) {
   Material dt =
       resolveMaterial(tables2, defaultMaterial(kMaterialDiffuseTransmission), d, vec2(0.0f));
   EXPECT_EQ(dt.reflectance, vec3(0.8f));
+  // coateddiffuse's medium: thickness and g (kept inside (-1, 1)).
+  MaterialTextures c = noMaterialTextures();
+  c.thickness = builder.constant(vec3(0.25f));
+  c.g = builder.constant(vec3(-3.0f));
+  const TextureTables tables3{scene.textureNodes.data(), scene.imageWords.data(), nullptr, nullptr};
+  Material coated =
+      resolveMaterial(tables3, defaultMaterial(kMaterialCoatedDiffuse), c, vec2(0.0f));
+  EXPECT_EQ(coated.thickness, 0.25f);
+  EXPECT_EQ(coated.g, -0.999f);
 }
 
 // ---- Rendered ------------------------------------------------------------------------------

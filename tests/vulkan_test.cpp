@@ -207,7 +207,7 @@ TEST(VulkanLimits, TexturesBeyondTheBufferLimitFailClearly) {
   data.materialTextures.assign(data.materials.size(), MaterialTextures{});
   for (MaterialTextures& t : data.materialTextures) {
     t = MaterialTextures{kNoTexture, kNoTexture, kNoTexture, kNoTexture, kNoTexture, kNoTexture,
-                         kNoTexture, kNoTexture, 0u,         1.0f,       0u,         0u};
+                         kNoTexture, kNoTexture, 0u,         1.0f,       kNoTexture, kNoTexture};
   }
   data.uvs.assign(data.bvh.triangles.size(), TriangleUVs{});
   data.textureNodes.assign(1, TextureNode{});

@@ -353,7 +353,8 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     if (t != nullptr) {
       const bool any = t->reflectance != kNoTexture || t->transmittance != kNoTexture ||
                        t->uRoughness != kNoTexture || t->vRoughness != kNoTexture ||
-                       t->eta != kNoTexture || t->k != kNoTexture;
+                       t->eta != kNoTexture || t->k != kNoTexture || t->thickness != kNoTexture ||
+                       t->g != kNoTexture;
       fx.textures = fx.textures || any;
       fx.alphaCutouts = fx.alphaCutouts || t->alpha != kNoTexture;
       fx.bumpMaps = fx.bumpMaps || t->displacement != kNoTexture;

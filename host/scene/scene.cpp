@@ -446,7 +446,11 @@ MaterialTextures readMaterialTextures(const JsonNode& m, uint type, JsonTextures
     take("reflectance", false, t.reflectance);
   }
   if (type == kMaterialDiffuseTransmission) take("transmittance", false, t.transmittance);
-  if (type == kMaterialCoatedDiffuse) take("albedo", false, t.transmittance);
+  if (type == kMaterialCoatedDiffuse) {
+    take("albedo", false, t.transmittance);
+    take("thickness", true, t.thickness);
+    take("g", true, t.g);
+  }
   if (type == kMaterialConductor) {
     take("eta", false, t.eta);
     take("k", false, t.k);

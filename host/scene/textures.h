@@ -39,7 +39,7 @@ bool parseWrapMode(const std::string& name, uint& wrap);
 inline MaterialTextures noMaterialTextures() {
   MaterialTextures t{};
   t.reflectance = t.transmittance = t.uRoughness = t.vRoughness = kNoTexture;
-  t.eta = t.k = t.displacement = t.alpha = kNoTexture;
+  t.eta = t.k = t.displacement = t.alpha = t.thickness = t.g = kNoTexture;
   t.scale = 1.0f;
   return t;
 }
@@ -48,7 +48,8 @@ inline MaterialTextures noMaterialTextures() {
 inline bool hasTextures(const MaterialTextures& t) {
   return t.reflectance != kNoTexture || t.transmittance != kNoTexture ||
          t.uRoughness != kNoTexture || t.vRoughness != kNoTexture || t.eta != kNoTexture ||
-         t.k != kNoTexture || t.displacement != kNoTexture || t.alpha != kNoTexture;
+         t.k != kNoTexture || t.displacement != kNoTexture || t.alpha != kNoTexture ||
+         t.thickness != kNoTexture || t.g != kNoTexture;
 }
 
 // Sets the textures of scene.materials[material], making scene.materialTextures parallel to

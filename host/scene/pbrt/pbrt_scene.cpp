@@ -1218,7 +1218,11 @@ MaterialDef Builder::makeMaterial(const std::string& type, const Params& p, cons
     m = defaultMaterial(kMaterialCoatedDiffuse);
     colour("reflectance", tex.reflectance, m.reflectance);
     readRoughness(p, def);
-    if (auto v = floatOrTexture(p, "thickness")) {
+    tex.thickness = textureParam(p, "thickness", true);
+    tex.g = textureParam(p, "g", true);
+    if (tex.thickness != kNoTexture) {
+      // (the texture gives it at each hit)
+    } else if (auto v = floatOrTexture(p, "thickness")) {
       p.checkBounded(*p.find("thickness"), *v, 0.0, true, 3.4e38, false, "a positive number");
       m.thickness = static_cast<float>(*v);
     }
@@ -1228,7 +1232,9 @@ MaterialDef Builder::makeMaterial(const std::string& type, const Params& p, cons
       m.eta = vec3(index, 0.0f, 0.0f);
     }
     colour("albedo", tex.transmittance, m.transmittance);
-    if (auto g = floatOrTexture(p, "g")) {
+    if (tex.g != kNoTexture) {
+      // (the texture gives it at each hit)
+    } else if (auto g = floatOrTexture(p, "g")) {
       p.checkBounded(*p.find("g"), *g, -1.0, true, 1.0, true, "a number strictly between -1 and 1");
       m.g = static_cast<float>(*g);
     }
