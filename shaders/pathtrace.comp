@@ -56,6 +56,7 @@ layout(constant_id = PT_SPEC_SPHERE_LIGHTS) const bool kSphereLights = true;
 layout(constant_id = PT_SPEC_TEXTURES) const bool kTextures = true;
 layout(constant_id = PT_SPEC_ALPHA) const bool kAlphaCutouts = true;
 layout(constant_id = PT_SPEC_BUMP) const bool kBumpMaps = true;
+layout(constant_id = PT_SPEC_TEXTURE_FEATURES) const uint kTextureFeatures = kTextureUsesAll;
 layout(constant_id = PT_SPEC_ENVIRONMENT_IMAGE) const bool kEnvironmentImage = true;
 #endif
 // Some emitter is one of lights.h's (not a triangle).
@@ -147,6 +148,7 @@ TriangleUVs uvsAt(uint primitive) {
   return TriangleUVs(a.xy, a.zw, b.xy, b.zw);
 }
 #define PT_TEXTURE_LOOP_TICK() gLoopIterations++
+#define PT_TEXTURE_FEATURES kTextureFeatures
 #include "texture.h"
 // Alpha cut-outs in the traversal (bvh.glsl): a hit where the surface is cut away is passed by.
 // gAlphaU is the ray's number (texture.h): set before each ray is traced (the path's ray at the

@@ -252,6 +252,19 @@ struct MaterialTextures {
 PT_CONST uint kMaterialTextureTexels = 3u;
 PT_CONST uint kRemapRoughness = 1u;  // roughness textures give pbrt-v4's roughness, not alpha
 
+// What a scene's textures need (PT_SPEC_TEXTURE_FEATURES): the material parameters some used
+// material takes from a texture, and whether any texture is a program of several nodes or reads
+// an image. texture.h evaluates only these, so that a scene's shader holds no code for the rest
+// (lavapipe runs both sides of a branch that its lanes take differently).
+PT_CONST uint kTextureUsesReflectance = 1u << 0u;
+PT_CONST uint kTextureUsesTransmittance = 1u << 1u;
+PT_CONST uint kTextureUsesRoughness = 1u << 2u;  // uRoughness or vRoughness
+PT_CONST uint kTextureUsesEtaK = 1u << 3u;       // a conductor's eta or k
+PT_CONST uint kTextureUsesMedium = 1u << 4u;     // coateddiffuse's thickness or g
+PT_CONST uint kTextureUsesPrograms = 1u << 8u;   // a texture of more than one node
+PT_CONST uint kTextureUsesImages = 1u << 9u;     // an image lookup
+PT_CONST uint kTextureUsesAll = 0xFFFFFFFFu;
+
 // ---- Camera and per-render parameters --------------------------------------------------
 
 // Pixel filters (pbrt-v4's, its definitions and parameters; shaders/filter.h samples them).
@@ -403,7 +416,8 @@ PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v =
 #define PT_SPEC_TEXTURES 20            // bool: some material parameter is a texture
 #define PT_SPEC_ALPHA 21               // bool: some material has an alpha cut-out
 #define PT_SPEC_BUMP 22                // bool: some material has a bump map
-#define PT_SPEC_COUNT 23
+#define PT_SPEC_TEXTURE_FEATURES 23    // uint: kTextureUses* bits of what the textures need
+#define PT_SPEC_COUNT 24
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever

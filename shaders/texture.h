@@ -53,6 +53,12 @@ inline TriangleUVs uvsAt(const TextureTables& tables, uint i) {
 #ifndef PT_TEXTURE_LOOP_TICK
 #define PT_TEXTURE_LOOP_TICK()
 #endif
+// The kTextureUses* bits of what to evaluate: the shader's specialization constant; the CPU
+// evaluates what the data says.
+#ifndef PT_TEXTURE_FEATURES
+#define PT_TEXTURE_FEATURES kTextureUsesAll
+#endif
+#define PT_TEXTURE_USES(bit) ((PT_TEXTURE_FEATURES & (bit)) != 0u)
 
 // ---- Texture coordinates ----------------------------------------------------------------
 
@@ -179,9 +185,10 @@ PT_INLINE float checkerboardWeight(vec2 st) {
 PT_INLINE vec3 evalTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
   TextureNode head = textureNodeAt(PT_TEXTURES_ARG first);
   // The common case, one leaf, without the stack.
-  if (head.count == 1u) {
-    if (head.type == kTextureImage)
+  if (head.count == 1u || !PT_TEXTURE_USES(kTextureUsesPrograms)) {
+    if (PT_TEXTURE_USES(kTextureUsesImages) && head.type == kTextureImage) {
       return imageLookup(PT_TEXTURES_ARG head, mapUV(head.mapping, uv));
+    }
     return head.value;
   }
   vec3 stack[kTextureStackSize];
@@ -192,7 +199,7 @@ PT_INLINE vec3 evalTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
     vec3 v;
     if (node.type == kTextureConstant) {
       v = node.value;
-    } else if (node.type == kTextureImage) {
+    } else if (PT_TEXTURE_USES(kTextureUsesImages) && node.type == kTextureImage) {
       v = imageLookup(PT_TEXTURES_ARG node, mapUV(node.mapping, uv));
     } else if (node.type == kTextureCheckerboard) {
       top -= 2u;
@@ -225,7 +232,7 @@ PT_INLINE float evalFloatTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
 // diffusetransmission's scale; a conductor given by its reflectance takes eta = 1 and pbrt-v4's
 // k). Parameters without a texture keep the host's values.
 PT_INLINE Material resolveMaterial(PT_TEXTURES_PARAM Material m, MaterialTextures t, vec2 uv) {
-  if (t.reflectance != kNoTexture) {
+  if (PT_TEXTURE_USES(kTextureUsesReflectance) && t.reflectance != kNoTexture) {
     vec3 r = clamp(evalTexture(PT_TEXTURES_ARG t.reflectance, uv), vec3(0.0f), vec3(1.0f));
     if (m.type == kMaterialConductor) {
       // pbrt-v4's ConductorMaterial with "reflectance": eta 1, k = 2 sqrt(r) / sqrt(1 - r).
@@ -238,28 +245,31 @@ PT_INLINE Material resolveMaterial(PT_TEXTURES_PARAM Material m, MaterialTexture
       m.reflectance = r;
     }
   }
-  if (t.transmittance != kNoTexture) {
+  if (PT_TEXTURE_USES(kTextureUsesTransmittance) && t.transmittance != kNoTexture) {
     vec3 r = clamp(evalTexture(PT_TEXTURES_ARG t.transmittance, uv), vec3(0.0f), vec3(1.0f));
     m.transmittance =
         m.type == kMaterialDiffuseTransmission ? clamp(t.scale * r, vec3(0.0f), vec3(1.0f)) : r;
   }
-  if (t.eta != kNoTexture) m.eta = evalTexture(PT_TEXTURES_ARG t.eta, uv);
-  if (t.k != kNoTexture) m.k = evalTexture(PT_TEXTURES_ARG t.k, uv);
+  if (PT_TEXTURE_USES(kTextureUsesEtaK) && t.eta != kNoTexture)
+    m.eta = evalTexture(PT_TEXTURES_ARG t.eta, uv);
+  if (PT_TEXTURE_USES(kTextureUsesEtaK) && t.k != kNoTexture)
+    m.k = evalTexture(PT_TEXTURES_ARG t.k, uv);
   bool remap = (t.flags & kRemapRoughness) != 0u;
-  if (t.uRoughness != kNoTexture) {
+  if (PT_TEXTURE_USES(kTextureUsesRoughness) && t.uRoughness != kNoTexture) {
     float r = max(evalFloatTexture(PT_TEXTURES_ARG t.uRoughness, uv), 0.0f);
     m.alphaX = remap ? sqrt(r) : r;
   }
-  if (t.vRoughness != kNoTexture) {
+  if (PT_TEXTURE_USES(kTextureUsesRoughness) && t.vRoughness != kNoTexture) {
     float r = max(evalFloatTexture(PT_TEXTURES_ARG t.vRoughness, uv), 0.0f);
     m.alphaY = remap ? sqrt(r) : r;
   }
   // coateddiffuse's medium: pbrt-v4 keeps the thickness at least the smallest normal float and
   // clamps g to [-1, 1]; we keep g inside (-1, 1), where Henyey-Greenstein is not a delta.
-  if (t.thickness != kNoTexture) {
+  if (PT_TEXTURE_USES(kTextureUsesMedium) && t.thickness != kNoTexture) {
     m.thickness = max(evalFloatTexture(PT_TEXTURES_ARG t.thickness, uv), 1.17549435e-38f);
   }
-  if (t.g != kNoTexture) m.g = clamp(evalFloatTexture(PT_TEXTURES_ARG t.g, uv), -0.999f, 0.999f);
+  if (PT_TEXTURE_USES(kTextureUsesMedium) && t.g != kNoTexture)
+    m.g = clamp(evalFloatTexture(PT_TEXTURES_ARG t.g, uv), -0.999f, 0.999f);
   return m;
 }
 

@@ -340,6 +340,15 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
 
   // Effects: which material kinds occur on triangles, and whether light sampling can matter.
   EffectSet& fx = data.effects;
+  // What evaluating a texture needs: several nodes, an image lookup.
+  const auto programFeatures = [&](uint first) {
+    const uint count = data.textureNodes[first].count;
+    uint bits = count > 1 ? kTextureUsesPrograms : 0u;
+    for (uint i = 0; i < count; ++i) {
+      if (data.textureNodes[first + i].type == kTextureImage) bits |= kTextureUsesImages;
+    }
+    return bits;
+  };
   std::vector<char> used(data.materials.size(), 0);
   for (const Triangle& tri : data.bvh.triangles) used[tri.material] = 1;
   bool lightSampled = false;  // some surface has a BSDF with a non-delta lobe
@@ -358,6 +367,19 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
       fx.textures = fx.textures || any;
       fx.alphaCutouts = fx.alphaCutouts || t->alpha != kNoTexture;
       fx.bumpMaps = fx.bumpMaps || t->displacement != kNoTexture;
+      const auto uses = [&](uint texture, uint bit) {
+        if (texture != kNoTexture) fx.textureFeatures |= bit | programFeatures(texture);
+      };
+      uses(t->reflectance, kTextureUsesReflectance);
+      uses(t->transmittance, kTextureUsesTransmittance);
+      uses(t->uRoughness, kTextureUsesRoughness);
+      uses(t->vRoughness, kTextureUsesRoughness);
+      uses(t->eta, kTextureUsesEtaK);
+      uses(t->k, kTextureUsesEtaK);
+      uses(t->thickness, kTextureUsesMedium);
+      uses(t->g, kTextureUsesMedium);
+      uses(t->displacement, 0u);
+      uses(t->alpha, 0u);
       // Roughness that a texture gives may be smooth somewhere and rough elsewhere.
       if (m.type > kMaterialMirror &&
           (t->uRoughness != kNoTexture || t->vRoughness != kNoTexture)) {

@@ -72,6 +72,7 @@ struct EffectSet {
   bool textures = false;          // some material has a parameter given by a texture
   bool alphaCutouts = false;      // some material has an alpha texture (any-hit tests)
   bool bumpMaps = false;          // some material has a displacement texture
+  uint textureFeatures = 0;       // kTextureUses*: what the used materials' textures need
   bool lightSampling = false;     // next-event estimation (needs emitters, a diffuse surface)
   bool bsdfEmission = false;      // emission found by BSDF-sampled rays is counted (MIS/BSDF)
   bool mis = false;               // both of the above, weighed by the power heuristic
