@@ -77,6 +77,16 @@ TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
   dir.write("text.jpg", "this is not a JPEG");
   dir.write("short.pfm", "PF\n64 64\n-1.0\n0123456789");
   dir.write("image.xyz", "xyz");
+  // A TGA header for 64x64 true colour with 3 bytes of data; a BMP and an HDR cut after their
+  // headers; an EXR that is only its magic number.
+  dir.write("cut.tga", std::string("\0\0\x02\0\0\0\0\0\0\0\0\0\x40\0\x40\0\x18\0abc", 21));
+  dir.write("cut.bmp", std::string("BM\x46\0\0\0\0\0\0\0\x36\0\0\0", 14));
+  dir.write("cut.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 64 +X 64\n");
+  dir.write("cut.exr", std::string("\x76\x2f\x31\x01", 4));
+  const std::string cutTga = textured("tga.json", "cut.tga");
+  const std::string cutBmp = textured("bmp.json", "cut.bmp");
+  const std::string cutHdr = textured("hdr.json", "cut.hdr");
+  const std::string cutExr = textured("exr.json", "cut.exr");
   const std::string cutPng = textured("cut.json", "cut.png");
   const std::string textJpg = textured("jpg.json", "text.jpg");
   const std::string shortPfm = textured("pfm.json", "short.pfm");
@@ -104,6 +114,10 @@ TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
       {"texture not of its format", "render " + textJpg + out, "text.jpg"},
       {"texture smaller than its header", "render " + shortPfm + out, "short.pfm"},
       {"texture of an unknown format", "render " + unknown + out, "image.xyz"},
+      {"truncated TGA texture", "render " + cutTga + out, "cut.tga"},
+      {"truncated BMP texture", "render " + cutBmp + out, "cut.bmp"},
+      {"truncated HDR texture", "render " + cutHdr + out, "cut.hdr"},
+      {"truncated EXR texture", "render " + cutExr + out, "cut.exr"},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.name);
@@ -115,10 +129,11 @@ TEST(Cli, BadInputGivesOneLineAndStatus2WithoutOutput) {
     EXPECT_FALSE(std::filesystem::exists(dir / "out.bmp"));
   }
   // Nothing but the inputs is left in the directory (no temporary files).
-  EXPECT_EQ(dir.listing(), (std::vector<std::string>{"broken.json", "cut.json", "cut.png",
-                                                      "image.xyz", "jpg.json", "pfm.json",
-                                                      "short.pfm", "text.jpg", "typo.json",
-                                                      "xyz.json"}));
+  EXPECT_EQ(dir.listing(),
+            (std::vector<std::string>{"bmp.json", "broken.json", "cut.bmp", "cut.exr", "cut.hdr",
+                                      "cut.json", "cut.png", "cut.tga", "exr.json", "hdr.json",
+                                      "image.xyz", "jpg.json", "pfm.json", "short.pfm", "text.jpg",
+                                      "tga.json", "typo.json", "xyz.json"}));
 }
 
 TEST(CliVulkan, RendersOnTheDefaultBackendWithValidation) {
