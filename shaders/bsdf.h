@@ -17,11 +17,6 @@
 
 #ifdef __cplusplus
 namespace pt {
-#define PT_INOUT(T) T&
-#define PT_OUT(T) T&
-#else
-#define PT_INOUT(T) inout T
-#define PT_OUT(T) out T
 #endif
 
 // Which material types the code is compiled for. The shader defines these as its

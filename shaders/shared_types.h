@@ -14,6 +14,9 @@ using uint = std::uint32_t;
 using namespace glm;  // so that shared code reads as GLSL: dot, cross, floatBitsToInt...
 #define PT_CONST inline constexpr
 #define PT_INLINE inline
+// Parameters a shared function writes: references in C++, inout/out in GLSL.
+#define PT_INOUT(T) T&
+#define PT_OUT(T) T&
 // For the few small functions called several times per path vertex (the random numbers):
 // inlined whatever the compiler's heuristics say, so that independent calls overlap and
 // unused results are dropped.
@@ -30,6 +33,8 @@ inline uint bitfieldReverse(uint x) {
 #else
 #define PT_CONST const
 #define PT_INLINE
+#define PT_INOUT(T) inout T
+#define PT_OUT(T) out T
 #define PT_HOT_INLINE
 #endif
 

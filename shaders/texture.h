@@ -22,8 +22,6 @@
 #ifdef __cplusplus
 namespace pt {
 
-#define PT_TEX_OUT(T) T&
-
 struct TextureTables {
   const TextureNode* nodes = nullptr;
   const uint* words = nullptr;  // the image buffer: texels and decoding tables
@@ -47,7 +45,6 @@ inline TriangleUVs uvsAt(const TextureTables& tables, uint i) {
 #else
 #define PT_TEXTURES_PARAM
 #define PT_TEXTURES_ARG
-#define PT_TEX_OUT(T) out T
 #endif
 
 #ifndef PT_TEXTURE_LOOP_TICK
@@ -276,7 +273,7 @@ PT_INLINE Material resolveMaterial(PT_TEXTURES_PARAM Material m, MaterialTexture
 // ---- Bump maps ---------------------------------------------------------------------------
 
 // Two unit vectors completing v (unit) to an orthonormal basis (pbrt-v4's CoordinateSystem).
-PT_INLINE void coordinateSystem(vec3 v, PT_TEX_OUT(vec3) a, PT_TEX_OUT(vec3) b) {
+PT_INLINE void coordinateSystem(vec3 v, PT_OUT(vec3) a, PT_OUT(vec3) b) {
   float sign = v.z >= 0.0f ? 1.0f : -1.0f;
   float k = -1.0f / (sign + v.z);
   float c = v.x * v.y * k;

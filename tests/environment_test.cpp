@@ -14,6 +14,7 @@
 #include "chi2.h"
 #include "cpu/integrator.h"
 #include "environment.h"
+#include "furnace_scene.h"
 #include "render/environment_map.h"
 #include "render/prepare.h"
 #include "render_compare.h"
@@ -220,37 +221,9 @@ TEST(EnvironmentSampling, DensityIntegratesToOne) {
 
 // ---- Rendering ------------------------------------------------------------------------------
 
-// lights_test.cpp's furnace: a convex cube of albedo 0.5 under `light`, seen from outside.
+// The cube of albedo 0.5 (furnace_scene.h).
 std::string cubeScene(int size, int spp, const std::string& light) {
-  return "Scale -1 1 1\nLookAt 3 4 5  0 0 0  0 0 1\nCamera \"perspective\" \"float fov\" [40]\n"
-         "Film \"rgb\" \"integer xresolution\" [" +
-         std::to_string(size) + "] \"integer yresolution\" [" + std::to_string(size) +
-         "]\nPixelFilter \"box\"\nSampler \"zsobol\" \"integer pixelsamples\" [" +
-         std::to_string(spp) + "]\nIntegrator \"path\" \"integer maxdepth\" [5]\nWorldBegin\n" +
-         light +
-         "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n"
-         "Shape \"trianglemesh\" \"point3 P\" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1"
-         "  1 1 1  -1 1 1]\n  \"integer indices\" [0 2 1 0 3 2  4 5 6 4 6 7  0 1 5 0 5 4"
-         "  1 2 6 1 6 5  2 3 7 2 7 6  3 0 4 3 4 7]\n";
-}
-
-// The pixels that show only the cube (no pixel within two of them saw the background, 1).
-std::vector<size_t> cubePixels(const Image& image) {
-  std::vector<size_t> inside;
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      bool clear = true;
-      for (int dy = -2; dy <= 2; ++dy) {
-        for (int dx = -2; dx <= 2; ++dx) {
-          const int u = std::clamp(x + dx, 0, image.width - 1);
-          const int v = std::clamp(y + dy, 0, image.height - 1);
-          clear &= image.at(u, v) != vec3(1.0f);
-        }
-      }
-      if (clear) inside.push_back(size_t(y) * size_t(image.width) + size_t(x));
-    }
-  }
-  return inside;
+  return test::furnaceScene(size, spp, light);
 }
 
 TEST(EnvironmentRender, FurnaceUnderAUniformImage) {
@@ -281,19 +254,7 @@ TEST(EnvironmentRender, FurnaceUnderAUniformImage) {
       const Comparison cmp = renderBoth(data, data.spp);
       if (strategy == kStrategyMis) expectAgreement(cmp);
       for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
-        const std::vector<size_t> inside = cubePixels(*image);
-        ASSERT_GT(inside.size(), 60u);
-        double sum = 0.0, sumSquares = 0.0;
-        for (size_t i : inside) {
-          const double v = image->pixels[i].y;
-          sum += v;
-          sumSquares += v * v;
-        }
-        const double n = double(inside.size());
-        const double mean = sum / n;
-        const double standardError = std::sqrt(std::max(0.0, sumSquares / n - mean * mean) / n);
-        EXPECT_LT(standardError, 0.012);
-        EXPECT_NEAR(mean, 0.5, 4.0 * standardError + 1e-4);
+        test::expectFurnaceMean(*image, 0.012);
       }
     }
   }

@@ -13,6 +13,7 @@
 
 #include "chi2.h"
 #include "cpu/integrator.h"
+#include "furnace_scene.h"
 #include "lights.h"
 #include "render/prepare.h"
 #include "render_compare.h"
@@ -65,20 +66,7 @@ void expectClosedForm(const std::string& text, const Radiance& radiance, double 
   const Image expected = expectedImage(data, radiance);
   const Comparison cmp = renderBoth(data, data.spp);
   expectAgreement(cmp);
-  for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
-    size_t off = 0;
-    double worst = 0.0;
-    for (size_t i = 0; i < expected.pixels.size(); ++i) {
-      for (int c = 0; c < 3; ++c) {
-        const double e = expected.pixels[i][c];
-        const double err = (std::fabs(double(image->pixels[i][c]) - e) - absolute) / e;
-        worst = std::max(worst, err);
-        if (err > tolerance) ++off;
-      }
-    }
-    EXPECT_EQ(off, 0u) << (image == &cmp.cpuImage ? "cpu" : "vulkan") << ": worst relative error "
-                       << worst;
-  }
+  expectNearClosedForm(cmp, expected, absolute, tolerance);
 }
 
 TEST(AnalyticLights, PointLightIrradianceOnAPlane) {
@@ -138,39 +126,11 @@ TEST(AnalyticLights, DistantLightCosine) {
       text, [&](glm::dvec3) { return glm::dvec3(0.5 / kPiD * 3.0 * cosTheta); }, 1e-5, 0.0);
 }
 
-// A cube of albedo 0.5 (convex: every ray that leaves it sees the environment) under a
-// constant environment of radiance 1: radiance 0.5 everywhere on it, 1 elsewhere.
-std::string furnace(int spp, const char* strategyLight) {
-  return "Scale -1 1 1\nLookAt 3 4 5  0 0 0  0 0 1\nCamera \"perspective\" \"float fov\" [40]\n"
-         "Film \"rgb\" \"integer xresolution\" [24] \"integer yresolution\" [24]\n"
-         "PixelFilter \"box\"\nSampler \"zsobol\" \"integer pixelsamples\" [" +
-         std::to_string(spp) + "]\nIntegrator \"path\" \"integer maxdepth\" [5]\nWorldBegin\n" +
-         std::string(strategyLight) +
-         "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n"
-         "Shape \"trianglemesh\" \"point3 P\" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1"
-         "  1 1 1  -1 1 1]\n  \"integer indices\" [0 2 1 0 3 2  4 5 6 4 6 7  0 1 5 0 5 4"
-         "  1 2 6 1 6 5  2 3 7 2 7 6  3 0 4 3 4 7]\n";
+// A cube of albedo 0.5 under a constant environment of radiance 1 (furnace_scene.h), 24 x 24.
+std::string furnace(int spp, const char* light) {
+  return test::furnaceScene(24, spp, light);
 }
-
-// The pixels that show only the object: no pixel within two of them shows the environment
-// (exactly 1: every sample's camera ray missed), so that none is on the silhouette.
-std::vector<size_t> objectPixels(const Image& image) {
-  std::vector<size_t> inside;
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      bool clear = true;
-      for (int dy = -2; dy <= 2; ++dy) {
-        for (int dx = -2; dx <= 2; ++dx) {
-          const int u = std::clamp(x + dx, 0, image.width - 1);
-          const int v = std::clamp(y + dy, 0, image.height - 1);
-          clear &= image.at(u, v) != vec3(1.0f);
-        }
-      }
-      if (clear) inside.push_back(size_t(y) * size_t(image.width) + size_t(x));
-    }
-  }
-  return inside;
-}
+using test::objectPixels;
 
 TEST(AnalyticLights, FurnaceUnderAConstantEnvironment) {
   for (uint strategy : {kStrategyMis, kStrategyNee, kStrategyBsdf}) {
@@ -184,23 +144,12 @@ TEST(AnalyticLights, FurnaceUnderAConstantEnvironment) {
     const Comparison cmp = renderBoth(data, data.spp);
     expectAgreement(cmp);
     for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
-      const std::vector<size_t> inside = objectPixels(*image);
-      ASSERT_GT(inside.size(), 60u);
-      double sum = 0.0, sumSquares = 0.0;
-      for (size_t i : inside) {
-        const double v = image->pixels[i].y;
-        sum += v;
-        sumSquares += v * v;
+      for (size_t i : objectPixels(*image)) {
         EXPECT_EQ(image->pixels[i].x, image->pixels[i].z);  // grey in, grey out
       }
-      const double n = double(inside.size());
-      const double mean = sum / n;
-      // The pixels are independent estimates of 0.5: their mean within four standard errors
-      // (light sampling alone wastes the half of its directions below the horizon: the
-      // noisiest, about 0.01).
-      const double standardError = std::sqrt(std::max(0.0, sumSquares / n - mean * mean) / n);
-      EXPECT_LT(standardError, 0.012);
-      EXPECT_NEAR(mean, 0.5, 4.0 * standardError + 1e-4);
+      // Light sampling alone wastes the half of its directions below the horizon: the noisiest,
+      // a standard error of about 0.01.
+      test::expectFurnaceMean(*image, 0.012);
     }
   }
 }

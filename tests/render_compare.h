@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 
 #include "cpu/integrator.h"
@@ -71,6 +72,26 @@ inline void expectAgreement(const Comparison& c) {
     EXPECT_NEAR(c.gpuMean[ch], c.cpuMean[ch], 1e-3f * c.cpuMean[ch]) << "channel " << ch;
   }
   EXPECT_GT(c.gpu.rays, 0u);
+}
+
+// Both backends' images against `expected` (a closed form), channel by channel: every value
+// within absolute + relative * expected of it.
+inline void expectNearClosedForm(const Comparison& cmp, const Image& expected, double absolute,
+                                 double relative) {
+  for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+    size_t off = 0;
+    double worst = 0.0;  // the largest error beyond what is allowed (negative: all inside)
+    for (size_t i = 0; i < expected.pixels.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        const double e = expected.pixels[i][c];
+        const double excess = std::fabs(double(image->pixels[i][c]) - e) - absolute - relative * e;
+        worst = i == 0 && c == 0 ? excess : std::max(worst, excess);
+        if (excess > 0.0) ++off;
+      }
+    }
+    EXPECT_EQ(off, 0u) << (image == &cmp.cpuImage ? "cpu" : "vulkan")
+                       << ": worst error beyond the bound " << worst;
+  }
 }
 
 // The image of radiance(ray), averaged over each pixel's box-filter square (16 x 16 camera

@@ -301,11 +301,11 @@ TEST(Textures, MaterialParametersTakeTheirTextures) {
 
 // ---- Rendered ------------------------------------------------------------------------------
 
-// A JSON scene: the camera 10 above the square [-10, 10]^2 of the plane y = 0 looking down
-// (image right = +x, image up = +z), the square's (u, v) = ((x + 10) / 20, (z + 10) / 20), a
-// distant light straight above of irradiance pi (so that the plane's radiance is its albedo),
-// one bounce.
-std::string planeScene(const std::string& textures, const std::string& material, int spp) {
+// A JSON scene seen from 10 above the origin looking down (image right = +x, image up = +z),
+// under a distant light straight above of irradiance pi (a diffuse surface's radiance is then
+// its albedo), one bounce: `textures`, `materials` and `shapes` are the arrays' contents.
+std::string topDownScene(const std::string& textures, const std::string& materials,
+                         const std::string& shapes, int spp) {
   return R"({"camera": {"position": [0, 10, 0], "target": [0, 0, 0], "up": [0, 0, 1],
     "vfov": 60, "width": 40, "height": 40},
     "integrator": {"spp": )" +
@@ -313,11 +313,19 @@ std::string planeScene(const std::string& textures, const std::string& material,
     "textures": [)" +
          textures + R"(],
     "materials": [)" +
-         material + R"(],
-    "shapes": [{"type": "quad", "material": "plane",
-      "vertices": [[10, 0, -10], [-10, 0, -10], [-10, 0, 10], [10, 0, 10]]}],
+         materials + R"(],
+    "shapes": [)" +
+         shapes + R"(],
     "lights": [{"type": "distant", "direction": [0, 1, 0],
       "radiance": [3.14159265, 3.14159265, 3.14159265]}]})";
+}
+
+// The square [-10, 10]^2 of the plane y = 0 in material `material` (named "plane"), its
+// (u, v) = ((10 - x) / 20, (z + 10) / 20).
+std::string planeScene(const std::string& textures, const std::string& material, int spp) {
+  return topDownScene(textures, material, R"({"type": "quad", "material": "plane",
+      "vertices": [[10, 0, -10], [-10, 0, -10], [-10, 0, 10], [10, 0, 10]]})",
+                      spp);
 }
 
 // The plane's radiance over each pixel (16 x 16 points of the box filter's square), from
@@ -337,19 +345,7 @@ void expectPlane(const SceneData& data, const Albedo& albedo, double tolerance) 
   const Image expected = expectedPlane(data, albedo);
   const Comparison cmp = renderBoth(data, data.spp);
   expectAgreement(cmp);
-  for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
-    size_t off = 0;
-    double worst = 0.0;
-    for (size_t i = 0; i < expected.pixels.size(); ++i) {
-      for (int c = 0; c < 3; ++c) {
-        const double e = expected.pixels[i][c];
-        const double err = std::fabs(double(image->pixels[i][c]) - e);
-        worst = std::max(worst, err);
-        if (err > tolerance) ++off;
-      }
-    }
-    EXPECT_EQ(off, 0u) << (image == &cmp.cpuImage ? "cpu" : "vulkan") << ": worst error " << worst;
-  }
+  expectNearClosedForm(cmp, expected, tolerance, 0.0);
 }
 
 // An image texture (4 x 4 texels over the plane twice along u, repeated, offset) on both
@@ -458,21 +454,15 @@ namespace {
 // number): camera rays see the plane through the cut-outs, and the plane is lit where the
 // light comes through them.
 std::string cutoutScene(const std::string& textures, const std::string& alpha, int spp) {
-  return R"({"camera": {"position": [0, 10, 0], "target": [0, 0, 0], "up": [0, 0, 1],
-    "vfov": 60, "width": 40, "height": 40},
-    "integrator": {"spp": )" +
-         std::to_string(spp) + R"(, "maxDepth": 1},
-    "textures": [)" +
-         textures + R"(],
-    "materials": [{"name": "plane", "type": "diffuse", "reflectance": [0.8, 0.8, 0.8]},
+  return topDownScene(textures,
+                      R"({"name": "plane", "type": "diffuse", "reflectance": [0.8, 0.8, 0.8]},
       {"name": "screen", "type": "diffuse", "reflectance": [0, 0, 0], "alpha": )" +
-         alpha + R"(}],
-    "shapes": [{"type": "quad", "material": "plane",
+                          alpha + "}",
+                      R"({"type": "quad", "material": "plane",
       "vertices": [[20, 0, -20], [-20, 0, -20], [-20, 0, 20], [20, 0, 20]]},
       {"type": "quad", "material": "screen",
-      "vertices": [[10, 5, -10], [-10, 5, -10], [-10, 5, 10], [10, 5, 10]]}],
-    "lights": [{"type": "distant", "direction": [0, 1, 0],
-      "radiance": [3.14159265, 3.14159265, 3.14159265]}]})";
+      "vertices": [[10, 5, -10], [-10, 5, -10], [-10, 5, 10], [10, 5, 10]]})",
+                      spp);
 }
 
 // A checkerboard alpha (4 x 4 squares over the screen, holes on the odd ones): the camera

@@ -552,6 +552,16 @@ struct Transform {
   }
 };
 
+// A "rotate" object ({"axis": [x, y, z], "degrees": d}) into t: right-handed about the axis.
+void readRotation(const JsonNode& n, Transform& t) {
+  n.checkKeys({"axis", "degrees"});
+  const JsonNode axisNode = n.require("axis");
+  const glm::dvec3 axis = axisNode.vec3();
+  if (glm::length(axis) == 0.0) axisNode.fail("rotation axis must not be the zero vector");
+  t.axis = glm::normalize(axis);
+  std::tie(t.cosAngle, t.sinAngle) = cosSinDegrees(n.require("degrees").number());
+}
+
 Transform readTransform(const JsonNode& node) {
   node.checkKeys({"scale", "rotate", "translate"});
   Transform t;
@@ -569,14 +579,7 @@ Transform readTransform(const JsonNode& node) {
       if (t.scale.x == 0.0) n->fail("scale factor must be non-zero");
     }
   }
-  if (auto n = node.find("rotate")) {
-    n->checkKeys({"axis", "degrees"});
-    const JsonNode axisNode = n->require("axis");
-    const glm::dvec3 axis = axisNode.vec3();
-    if (glm::length(axis) == 0.0) axisNode.fail("rotation axis must not be the zero vector");
-    t.axis = glm::normalize(axis);
-    std::tie(t.cosAngle, t.sinAngle) = cosSinDegrees(n->require("degrees").number());
-  }
+  if (auto n = node.find("rotate")) readRotation(*n, t);
   if (auto n = node.find("translate")) t.translate = n->vec3();
   return t;
 }
@@ -1108,12 +1111,7 @@ void readEnvironmentImage(const JsonNode& l, const std::filesystem::path& sceneF
     // The shapes' "rotate" (readTransform): right-handed about the axis, the image's frame into
     // the world.
     Transform t;
-    n->checkKeys({"axis", "degrees"});
-    const JsonNode axisNode = n->require("axis");
-    const glm::dvec3 axis = axisNode.vec3();
-    if (glm::length(axis) == 0.0) axisNode.fail("rotation axis must not be the zero vector");
-    t.axis = glm::normalize(axis);
-    std::tie(t.cosAngle, t.sinAngle) = cosSinDegrees(n->require("degrees").number());
+    readRotation(*n, t);
     for (int i = 0; i < 3; ++i) {
       glm::dvec3 e(0.0);
       e[i] = 1.0;
