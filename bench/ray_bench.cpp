@@ -75,6 +75,7 @@ struct Options {
   size_t gpuMinRays = size_t(1) << 20;  // see RayQueryBackend
   double bruteBudget = 2e8;             // triangle tests per ray set for the brute force
   bool embreeRobust = false;            // RTC_SCENE_FLAG_ROBUST instead of Embree's default
+  std::string embreeConfig;             // rtcNewDevice's string, e.g. "verbose=2"
   bool checkOnly = false;
   bool requireAgreement = false;
   std::string csv, agreementCsv;
@@ -398,6 +399,8 @@ std::unique_ptr<TraversalBackend> makeVulkanBackend(const BenchScene& scene, con
 // inclusive, ours exclusive: equal in practice). Shadow rays end one float short of tMax,
 // since Embree's tfar is inclusive and our tMax exclusive.
 struct EmbreeScene {
+  explicit EmbreeScene(const std::string& config)
+      : device(config.empty() ? nullptr : config.c_str()) {}
   bench::EmbreeDevice device;
   RTCScene scene = nullptr;
   ~EmbreeScene() {
@@ -406,7 +409,7 @@ struct EmbreeScene {
 };
 
 std::unique_ptr<TraversalBackend> makeEmbreeBackend(const BenchScene& scene, const Options& o) {
-  auto embree = std::make_shared<EmbreeScene>();
+  auto embree = std::make_shared<EmbreeScene>(o.embreeConfig);
   embree->scene =
       bench::newEmbreeScene(embree->device.get(), scene.sceneOrder,
                             o.embreeRobust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
@@ -997,6 +1000,9 @@ int main(int argc, char** argv) {
                  "Vulkan: trace copies of a smaller batch up to this many rays per call");
   app.add_option("--brute-budget", o.bruteBudget,
                  "Brute force: triangle tests per ray set (a subset of the rays beyond)");
+  app.add_option("--embree-config", o.embreeConfig,
+                 "Embree: rtcNewDevice's configuration string (\"verbose=2\" prints its tree's "
+                 "node and leaf counts and SAH cost)");
   app.add_flag("--embree-robust", o.embreeRobust,
                "Embree: RTC_SCENE_FLAG_ROBUST (watertight, slower) instead of the default");
   bool quick = false;

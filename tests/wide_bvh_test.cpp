@@ -177,6 +177,32 @@ TEST(WideBvh, HoldsEveryTriangleOnceInsideItsBoxes) {
   }
 }
 
+TEST(WideBvh, SameTreeForAnyNumberOfThreads) {
+  // Large enough for the collapse to split its work into pieces (bvh.nodes / 32768 workers).
+  const std::vector<Triangle> sphere = test::makeSphere(vec3(0.0f), 1.0f, 160, 161);
+  const Bvh bvh = buildBvh(sphere, BvhBuildOptions{1, BvhBuilder::kPloc});
+  ASSERT_GT(bvh.nodes.size(), 3u * 32768u);
+  const WideBvh one = buildWideBvh(bvh, 1);
+  expectValidWideBvh(bvh, one);
+  for (int threads : {2, 3, 8}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    const WideBvh wide = buildWideBvh(bvh, threads);
+    ASSERT_EQ(wide.nodes.size(), one.nodes.size());
+    ASSERT_EQ(wide.packets.size(), one.packets.size());
+    EXPECT_EQ(wide.shapes, one.shapes);
+    EXPECT_EQ(wide.maxDepth, one.maxDepth);
+    EXPECT_EQ(std::memcmp(wide.nodes.data(), one.nodes.data(), one.nodes.size() * sizeof(WideNode)),
+              0);
+    for (size_t p = 0; p < one.packets.size(); ++p) {  // (fields: a packet has padding)
+      const TrianglePacket &a = wide.packets[p], &b = one.packets[p];
+      ASSERT_TRUE(std::memcmp(a.v, b.v, sizeof(a.v)) == 0 && a.first == b.first &&
+                  a.count == b.count &&
+                  std::memcmp(a.primitive, b.primitive, sizeof(a.primitive)) == 0)
+          << "packet " << p;
+    }
+  }
+}
+
 TEST(WideBvh, SingleLeafTree) {
   const std::vector<Triangle> one = {
       Triangle{vec3(0), 0, vec3(1, 0, 0), kNoEmitter, vec3(0, 1, 0), 0}};

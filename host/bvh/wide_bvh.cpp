@@ -22,23 +22,74 @@
 namespace pt {
 namespace {
 
-// The binary nodes in the lanes of the wide node of binary node `index` (wide_bvh.h): lane i
-// holds the descendant reached by the steps i >> 2 & 1, i >> 1 & 1, i & 1 (0 left, 1 right),
-// or, where a leaf comes first, that leaf, in the first lane under it. (The root of a tree
-// that is one leaf is so its own node's only lane.)
-void laneNodes(const Bvh& bvh, uint32_t index, uint32_t (&lanes)[kWideLanes]) {
-  std::fill(lanes, lanes + kWideLanes, kWideEmpty);
-  // Node n at `level` below `index` covers the `kWideLanes >> level` lanes from `first`.
-  auto place = [&](auto& self, uint32_t n, int level, int first) -> void {
-    const BvhNode& node = bvh.nodes[n];
-    if (node.count > 0 || level == 3) {
-      lanes[first] = n;
-      return;
-    }
-    self(self, n + 1, level + 1, first);
-    self(self, node.offset, level + 1, first + (kWideLanes >> (level + 1)));
+// The lanes of the wide node of binary node `index`: the binary nodes below it that it
+// holds, found by opening, from the node's two children on, the interior lane of largest
+// surface area (the first of equal ones) until eight lanes are full or every lane is a leaf
+// (the collapse of Embree's and of Ylitie et al.'s wide BVHs, greedy on area: a ray enters a
+// child in proportion to its area, so the large ones are worth testing together). The lanes
+// keep the binary tree's depth-first order, so that each binary node in between covers a
+// range of consecutive lanes; `shape` records those ranges for the traversal of degenerate
+// rays (WideBvh::shapes). (The root of a tree that is one leaf is its own node's only lane.)
+struct NodeLanes {
+  uint32_t node[kWideLanes];
+  int count = 0;
+  uint32_t shape = 0;
+};
+
+float halfArea(const BvhNode& node) {
+  const vec3 e = node.boundsMax - node.boundsMin;
+  return e.x * e.y + e.y * e.z + e.z * e.x;
+}
+
+void laneNodes(const Bvh& bvh, uint32_t index, NodeLanes& lanes) {
+  std::fill(lanes.node, lanes.node + kWideLanes, kWideEmpty);
+  const BvhNode& root = bvh.nodes[index];
+  if (root.count > 0) {
+    lanes.node[0] = index;
+    lanes.count = 1;
+    lanes.shape = wide_shape::make(1);
+    return;
+  }
+  uint32_t opened[kWideLanes - 1];  // the binary nodes in between, `index` first
+  int openedCount = 0;
+  auto open = [&](int lane) {
+    const uint32_t n = lanes.node[lane];
+    opened[openedCount++] = n;
+    std::copy_backward(lanes.node + lane + 1, lanes.node + lanes.count,
+                       lanes.node + lanes.count + 1);
+    lanes.node[lane] = n + 1;
+    lanes.node[lane + 1] = bvh.nodes[n].offset;
+    ++lanes.count;
   };
-  place(place, index, 0, 0);
+  lanes.node[0] = index;
+  lanes.count = 1;
+  open(0);
+  while (lanes.count < kWideLanes) {
+    int widest = -1;
+    float widestArea = 0.0f;
+    for (int i = 0; i < lanes.count; ++i) {
+      const BvhNode& n = bvh.nodes[lanes.node[i]];
+      if (n.count > 0) continue;
+      const float area = halfArea(n);
+      if (widest < 0 || area > widestArea) {
+        widest = i;
+        widestArea = area;
+      }
+    }
+    if (widest < 0) break;
+    open(widest);
+  }
+  // Each binary node in between, in depth-first order: how many lanes its left child covers.
+  lanes.shape = wide_shape::make(lanes.count);
+  int split = 0;
+  auto record = [&](auto& self, uint32_t n) -> int {
+    if (std::find(opened, opened + openedCount, n) == opened + openedCount) return 1;
+    const int at = split++;
+    const int left = self(self, n + 1);
+    lanes.shape = wide_shape::withSplit(lanes.shape, at, left);
+    return left + self(self, bvh.nodes[n].offset);
+  };
+  PT_CHECK(record(record, index) == lanes.count);
 }
 
 // What Collapse::fill allocates for the wide node of binary node `index` and below: wide
@@ -47,10 +98,10 @@ struct Counts {
   size_t nodes = 0, packets = 0;
 };
 Counts countBelow(const Bvh& bvh, uint32_t index) {
-  uint32_t lanes[kWideLanes];
+  NodeLanes lanes;
   laneNodes(bvh, index, lanes);
   Counts counts;
-  for (uint32_t n : lanes) {
+  for (uint32_t n : lanes.node) {
     if (n == kWideEmpty) continue;
     const BvhNode& node = bvh.nodes[n];
     if (node.count > 0) {
@@ -94,16 +145,16 @@ class Collapse {
   // allocating nothing; with it: the piece, already listed in this order, gets its start).
   void fillTop(uint32_t at, uint32_t index, int depth, bool write, std::vector<Piece>& pieces,
                size_t& piece) {
-    uint32_t lanes[kWideLanes];
+    NodeLanes lanes;
     laneNodes(bvh_, index, lanes);
     if (write) fillNode(at, depth, lanes);
     for (int i = 0; i < kWideLanes; ++i) {
-      if (lanes[i] == kWideEmpty || bvh_.nodes[lanes[i]].count > 0) continue;
+      if (lanes.node[i] == kWideEmpty || bvh_.nodes[lanes.node[i]].count > 0) continue;
       const uint32_t child = write ? wide_.nodes[at].child[i] : 0;
       if (depth + 1 < kPieceDepth) {
-        fillTop(child, lanes[i], depth + 1, write, pieces, piece);
+        fillTop(child, lanes.node[i], depth + 1, write, pieces, piece);
       } else if (!write) {
-        pieces.push_back(Piece{0, lanes[i], depth + 1, {}});
+        pieces.push_back(Piece{0, lanes.node[i], depth + 1, {}});
       } else {
         Piece& p = pieces[piece++];
         p.at = child;
@@ -117,12 +168,12 @@ class Collapse {
 
   // Fills wide node `at` and everything below it.
   void fill(uint32_t at, uint32_t index, int depth) {
-    uint32_t lanes[kWideLanes];
+    NodeLanes lanes;
     laneNodes(bvh_, index, lanes);
     const WideNode& wide = fillNode(at, depth, lanes);
     for (int i = 0; i < kWideLanes; ++i) {
       if (wide.child[i] != kWideEmpty && !(wide.child[i] & kWideLeaf)) {
-        fill(wide.child[i], lanes[i], depth + 1);
+        fill(wide.child[i], lanes.node[i], depth + 1);
       }
     }
   }
@@ -134,17 +185,18 @@ class Collapse {
  private:
   // Wide node `at` from the binary nodes in its lanes, allocating its interior children's
   // slots and packing its leaf children's triangles.
-  const WideNode& fillNode(uint32_t at, int depth, const uint32_t (&lanes)[kWideLanes]) {
+  const WideNode& fillNode(uint32_t at, int depth, const NodeLanes& lanes) {
     maxDepth_ = std::max(maxDepth_, depth);
     WideNode& wide = wide_.nodes[at];
+    wide_.shapes[at] = lanes.shape;
     for (int i = 0; i < kWideLanes; ++i) {
       wide.child[i] = kWideEmpty;
       wide.packetCount[i] = 0;
       // An unused lane's box is inverted, lo = +inf and hi = -inf: no ray enters it, and its
       // slab entry distances, +inf, leave the minima over its group to the others.
       vec3 lo(INFINITY), hi(-INFINITY);
-      if (lanes[i] != kWideEmpty) {
-        const BvhNode& b = bvh_.nodes[lanes[i]];
+      if (lanes.node[i] != kWideEmpty) {
+        const BvhNode& b = bvh_.nodes[lanes.node[i]];
         lo = b.boundsMin;
         hi = b.boundsMax;
         if (b.count > 0) {
@@ -192,10 +244,10 @@ class Collapse {
 // pieces[piece] on, in the order fillTop lists them; `piece` moves past them).
 Counts countTop(const Bvh& bvh, uint32_t index, int depth,
                 const std::vector<Collapse::Piece>& pieces, size_t& piece) {
-  uint32_t lanes[kWideLanes];
+  NodeLanes lanes;
   laneNodes(bvh, index, lanes);
   Counts counts;
-  for (uint32_t n : lanes) {
+  for (uint32_t n : lanes.node) {
     if (n == kWideEmpty) continue;
     const BvhNode& node = bvh.nodes[n];
     if (node.count > 0) {
@@ -230,7 +282,7 @@ void adviseHugePages([[maybe_unused]] const std::vector<T>& v) {
 
 }  // namespace
 
-WideBvh buildWideBvh(const Bvh& bvh) {
+WideBvh buildWideBvh(const Bvh& bvh, int threads) {
   PT_CHECK(!bvh.nodes.empty() && !bvh.triangles.empty());
   PT_BVH_PROFILE_BEGIN();
   const auto start = std::chrono::steady_clock::now();
@@ -243,8 +295,9 @@ WideBvh buildWideBvh(const Bvh& bvh) {
   Collapse top(bvh, wide, 1, 0);
   top.fillTop(0, 0, 0, false, pieces, piece);
   // (One worker per hardware thread, fewer for small trees: the work is that of the nodes.)
-  Workers workers(int(std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()),
-                                       bvh.nodes.size() / 32768 + 1)));
+  const size_t hardware = std::max(1u, std::thread::hardware_concurrency());
+  Workers workers(int(
+      std::min<size_t>(threads > 0 ? size_t(threads) : hardware, bvh.nodes.size() / 32768 + 1)));
   workers.forChunks(pieces.size(), 1,
                     [&](size_t p, size_t) { pieces[p].counts = countBelow(bvh, pieces[p].index); });
   // The whole tree's size from the pieces'; then the top again, writing.
@@ -256,6 +309,7 @@ WideBvh buildWideBvh(const Bvh& bvh) {
   adviseHugePages(wide.packets);
   adviseHugePages(wide.nodes);
   wide.nodes.resize(1 + all.nodes);  // (not initialised: see WideNode)
+  wide.shapes.resize(1 + all.nodes);
   wide.packets.resize(all.packets);
   PT_BVH_PHASE("count and allocate");
   piece = 0;

@@ -1,7 +1,8 @@
-// The CPU reference's copy of the BVH for SIMD traversal: every three levels of the binary
-// tree become one node of eight children whose boxes are tested together, and the leaves'
-// triangles are repacked four to a packet in the structure-of-arrays layout that the
-// four-lane watertight test loads directly. The GPU keeps the binary tree (Bvh); this one
+// The CPU reference's copy of the BVH for SIMD traversal: the binary tree collapsed into
+// nodes of up to eight children whose boxes are tested together (each node opens the binary
+// nodes below it largest surface area first: buildWideBvh), and the leaves' triangles
+// repacked four to a packet in the structure-of-arrays layout that the four-lane watertight
+// test loads directly. The GPU keeps the binary tree (Bvh); this one
 // is built from it, after it, for the CPU backend only.
 //
 // A query gives exactly the binary traversal's answer (traverse.h), not just an equally
@@ -38,9 +39,9 @@ inline constexpr int kPacketLanes = 4;  // triangles per packet
 
 // Eight children's boxes and references. An interior child is the index of its WideNode; a
 // leaf child is kWideLeaf | the index of its first packet, with its packet count alongside.
-// A binary leaf less than three levels below N takes the first lane of the lanes under it;
-// the others are unused: kWideEmpty, with an inverted box (lo = +inf, hi = -inf) that no ray
-// enters.
+// The children in use are the first lanes, in the binary tree's depth-first order; where a
+// node has fewer than eight (every binary node below it is a leaf), the rest are unused:
+// kWideEmpty, with an inverted box (lo = +inf, hi = -inf) that no ray enters.
 // (Default construction leaves the fields unset, also in a vector's resize: buildWideBvh
 // writes every field of every node and packet, in parallel, and a value-initialising resize
 // would first zero the arrays on one thread.)
@@ -73,8 +74,30 @@ struct alignas(16) TrianglePacket {
   }
 };  // 176 bytes
 
+// How a wide node's lanes came out of the binary tree (WideBvh::shapes): the number of lanes
+// in use (bits 24 and up), and for each binary node in between, in depth-first order (the
+// node's own binary node first), how many of its lanes its left child covers (3 bits each).
+// A binary node k covering lanes [first, first + size), size >= 2, has its left child over
+// split(k) lanes from first, with index k + 1 if that is a range of two or more, and its
+// right child over the rest, with index k + split(k).
+namespace wide_shape {
+constexpr uint32_t make(int lanes) {
+  return uint32_t(lanes) << 24;
+}
+constexpr uint32_t withSplit(uint32_t shape, int k, int leftLanes) {
+  return shape | uint32_t(leftLanes) << (3 * k);
+}
+constexpr int lanes(uint32_t shape) {
+  return int(shape >> 24);
+}
+constexpr int split(uint32_t shape, int k) {
+  return int(shape >> (3 * k) & 7u);
+}
+}  // namespace wide_shape
+
 struct WideBvh {
-  std::vector<WideNode> nodes;  // nodes[0] is the root: the binary root's descendants
+  std::vector<WideNode> nodes;   // nodes[0] is the root: the binary root's descendants
+  std::vector<uint32_t> shapes;  // per node: wide_shape (only degenerate rays read it)
   std::vector<TrianglePacket> packets;
   vec3 rootMin{0.0f}, rootMax{0.0f};  // the binary root's box, tested first as it is there
   int maxDepth = 0;                   // deepest wide node below the root (root = 0)
@@ -83,7 +106,9 @@ struct WideBvh {
 
 // Collapses a built binary BVH. The result refers to bvh.triangles by index (Hit::triangle)
 // but holds copies of the vertices, so it does not depend on bvh's lifetime.
-WideBvh buildWideBvh(const Bvh& bvh);
+// `threads`: workers for the collapse (0: one per hardware thread); the tree is the same for
+// any number.
+WideBvh buildWideBvh(const Bvh& bvh, int threads = 0);
 
 namespace wide_detail {
 

@@ -64,10 +64,10 @@ namespace pt {
 // in it, or without a direction (|d| below kMinDirection on every axis: its sheared
 // coordinates are NaN, and every triangle takes it at t = NaN), breaks that; for those
 // this runs traverse.cpp's loop itself over the wide tree. A binary node is a range of one
-// wide node's lanes (all eight: the node's own binary node N; four: N's children; two:
-// theirs; one: a lane), and its box the union of its lanes' boxes, which is the binary
-// node's box exactly (every parent's box is the union of its children's). (The lanes
-// integrator tests the same in vector lanes: integrator_lanes.cpp, setUpRays.)
+// wide node's consecutive lanes (WideBvh::shapes says which), and its box the union of its
+// lanes' boxes, which is the binary node's box exactly (every parent's box is the union of
+// its children's). (The lanes integrator tests the same in vector lanes:
+// integrator_lanes.cpp, setUpRays.)
 namespace {
 
 bool degenerateRay(const Ray& ray) {
@@ -79,26 +79,23 @@ bool degenerateRay(const Ray& ray) {
                      std::fabs(d.z) < kMinDirection);
 }
 
+// Lanes [first, first + size) of a wide node; `split` is the binary node's index in the
+// node's wide_shape when size >= 2.
 struct BinaryNode {
   uint32_t node;  // the wide node
-  int first, size;
+  int first, size, split;
   bool isLeaf(const WideBvh& bvh) const {
     return size == 1 && (bvh.nodes[node].child[first] & kWideLeaf);
   }
 };
 
-// The binary node of a range of lanes: where only the first lane is in use (a leaf less
-// than three levels down), that lane; a lane that is an interior node, that node's own
-// range.
+// A lane that is an interior node stands for that node's own range of lanes.
 BinaryNode resolve(const WideBvh& bvh, BinaryNode b) {
-  for (;;) {
-    const WideNode& n = bvh.nodes[b.node];
-    const bool single = std::all_of(n.child + b.first + 1, n.child + b.first + b.size,
-                                    [](uint32_t c) { return c == kWideEmpty; });
-    if (!single) return b;
-    if (n.child[b.first] & kWideLeaf) return BinaryNode{b.node, b.first, 1};
-    b = BinaryNode{n.child[b.first], 0, kWideLanes};
+  if (b.size == 1 && !(bvh.nodes[b.node].child[b.first] & kWideLeaf)) {
+    const uint32_t child = bvh.nodes[b.node].child[b.first];
+    return BinaryNode{child, 0, wide_shape::lanes(bvh.shapes[child]), 0};
   }
+  return b;
 }
 
 bool intersectBinaryNode(const WideBvh& bvh, const RayPrecomputed& r, BinaryNode b, float tMax,
@@ -120,7 +117,7 @@ bool traverseAsBinary(const WideBvh& bvh, const Ray& ray, float tMax, Intersecti
   if (!intersectBox(r, bvh.rootMin, bvh.rootMax, tMax, tNear)) return false;
   BinaryNode stack[kBvhStackSize];
   uint32_t stackSize = 0;
-  BinaryNode node = resolve(bvh, BinaryNode{0, 0, kWideLanes});
+  BinaryNode node{0, 0, wide_shape::lanes(bvh.shapes[0]), 0};
   HitSearch search(tMax, filter);
   for (;;) {
     if (node.isLeaf(bvh)) {
@@ -132,9 +129,10 @@ bool traverseAsBinary(const WideBvh& bvh, const Ray& ray, float tMax, Intersecti
               : wide_detail::intersectLeafLaneByLane<kAnyHit, false>(bvh, first, count, r, search);
       if (hit && kAnyHit) return true;
     } else {
-      const int half = node.size / 2;
-      const BinaryNode left = resolve(bvh, BinaryNode{node.node, node.first, half});
-      const BinaryNode right = resolve(bvh, BinaryNode{node.node, node.first + half, half});
+      const int half = wide_shape::split(bvh.shapes[node.node], node.split);
+      const BinaryNode left = resolve(bvh, BinaryNode{node.node, node.first, half, node.split + 1});
+      const BinaryNode right = resolve(
+          bvh, BinaryNode{node.node, node.first + half, node.size - half, node.split + half});
       float tLeft = 0.0f, tRight = 0.0f;
       const bool hitLeft = intersectBinaryNode(bvh, r, left, search.range, tLeft);
       const bool hitRight = intersectBinaryNode(bvh, r, right, search.range, tRight);
