@@ -140,8 +140,8 @@ bool intersectLeafLaneByLane(const WideBvh& bvh, uint32_t firstPacket, uint32_t 
 
 // The same queries as on the binary Bvh (traverse.h), with the same answers. Boxes are
 // tested eight at a time and triangles four at a time, with x86-64 vector instructions
-// chosen at run time (AVX2, else SSE4 or SSSE3 in halves, else Highway's portable code);
-// Moller-Trumbore runs lane by lane.
+// chosen at run time (AVX-512 or AVX2, else SSE4 or SSSE3 in halves, else Highway's
+// portable code); Moller-Trumbore runs lane by lane.
 std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax = INFINITY,
                               Intersection test = Intersection::kWatertight,
                               const HitFilter* filter = nullptr);
