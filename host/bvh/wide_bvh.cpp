@@ -52,31 +52,32 @@ void laneNodes(const Bvh& bvh, uint32_t index, NodeLanes& lanes) {
   }
   uint32_t opened[kWideLanes - 1];  // the binary nodes in between, `index` first
   int openedCount = 0;
+  float area[kWideLanes];  // each lane's, or -1 for a leaf (never opened)
+  auto laneArea = [&](uint32_t n) {
+    const BvhNode& node = bvh.nodes[n];
+    return node.count > 0 ? -1.0f : halfArea(node);
+  };
   auto open = [&](int lane) {
     const uint32_t n = lanes.node[lane];
     opened[openedCount++] = n;
     std::copy_backward(lanes.node + lane + 1, lanes.node + lanes.count,
                        lanes.node + lanes.count + 1);
+    std::copy_backward(area + lane + 1, area + lanes.count, area + lanes.count + 1);
     lanes.node[lane] = n + 1;
     lanes.node[lane + 1] = bvh.nodes[n].offset;
+    area[lane] = laneArea(n + 1);
+    area[lane + 1] = laneArea(bvh.nodes[n].offset);
     ++lanes.count;
   };
   lanes.node[0] = index;
   lanes.count = 1;
   open(0);
   while (lanes.count < kWideLanes) {
-    int widest = -1;
-    float widestArea = 0.0f;
-    for (int i = 0; i < lanes.count; ++i) {
-      const BvhNode& n = bvh.nodes[lanes.node[i]];
-      if (n.count > 0) continue;
-      const float area = halfArea(n);
-      if (widest < 0 || area > widestArea) {
-        widest = i;
-        widestArea = area;
-      }
+    int widest = 0;
+    for (int i = 1; i < lanes.count; ++i) {
+      if (area[i] > area[widest]) widest = i;
     }
-    if (widest < 0) break;
+    if (area[widest] < 0.0f) break;
     open(widest);
   }
   // Each binary node in between, in depth-first order: how many lanes its left child covers.
