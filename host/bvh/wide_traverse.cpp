@@ -10,8 +10,8 @@
 // AVX-512 (Highway's AVX3) runs the same eight- and four-lane code with 32 vector registers
 // and mask registers, and the loop spills less: incoherent rays on the 1M-triangle scenes
 // trace 5-8 % faster than with AVX2 (Xeon, Sapphire Rapids). AVX3_DL would add nothing used
-// here. (integrator_lanes.cpp, which includes the traversal too, still leaves out both
-// AVX-512 targets: the renderer's lanes have not been measured with them.)
+// here. (integrator_lanes.cpp, which includes the traversal too, is compiled for the same
+// targets.)
 #ifndef HWY_DISABLED_TARGETS
 #define HWY_DISABLED_TARGETS (HWY_AVX3_DL)
 #endif
