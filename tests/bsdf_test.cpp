@@ -247,17 +247,6 @@ std::vector<vec3> pilotSamples(const Material& m, vec3 wo, uint64_t seed) {
   return pilot;
 }
 
-// The expected counts per cell: samples * the integral of the pdf over it, each within a few
-// hundredths of the count's standard deviation.
-template <typename Pdf>
-std::vector<double> expectedCounts(const SphereGrid& grid, const Pdf& pdf, int samples) {
-  const double n = samples;
-  std::vector<double> counts =
-      grid.integrate(pdf, [n](double p) { return 0.05 * std::sqrt(std::max(p * n, 1.0)) / n; });
-  for (double& c : counts) c *= n;
-  return counts;
-}
-
 // Draws c.samples directions from c.material and tests them against `pdf` by Pearson's
 // chi-square test. The histogram holds the non-delta samples (a delta lobe has no density to
 // compare with); one extra cell counts the rest, delta lobes and failed samples, against
@@ -284,7 +273,7 @@ test::Chi2Result chi2Test(const Chi2Case& c, const Pdf& pdf, const std::string& 
   }
   observed.back() = c.samples - nonDelta;
 
-  std::vector<double> expected = expectedCounts(grid, pdf, c.samples);
+  std::vector<double> expected = test::expectedCounts(grid, pdf, c.samples);
   double total = 0.0;
   for (double e : expected) total += e;
   // (Not 0 where the quadrature's rounding makes the pdf integrate to a hair above 1: a

@@ -374,6 +374,17 @@ inline SphereGrid focusedGrid(const std::vector<glm::vec3>& pilot, int thetaCell
   return SphereGrid(focus, thetaCells, phiCells);
 }
 
+// The expected counts per cell of `samples` draws from `pdf`: samples * the integral of the
+// pdf over each cell, each within a few hundredths of the count's standard deviation.
+template <typename Pdf>
+std::vector<double> expectedCounts(const SphereGrid& grid, const Pdf& pdf, int samples) {
+  const double n = samples;
+  std::vector<double> counts =
+      grid.integrate(pdf, [n](double p) { return 0.05 * std::sqrt(std::max(p * n, 1.0)) / n; });
+  for (double& c : counts) c *= n;
+  return counts;
+}
+
 // Writes the observed and the expected histograms side by side, and their difference, as a
 // PNG named after `name` in the system's temporary directory (kept: it is for a person to look
 // at after a failure); returns its path. Each block shows the upper hemisphere above the lower

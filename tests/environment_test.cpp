@@ -112,11 +112,7 @@ test::Chi2Result directionChi2(const Draw& draw, const Pdf& pdf, uint32_t seed) 
   for (int i = 0; i < kSamples; ++i) {
     observed[size_t(grid.cellOf(draw(vec2(uniform(rng), uniform(rng)))))] += 1.0;
   }
-  const double n = kSamples;
-  std::vector<double> expected =
-      grid.integrate(pdf, [n](double q) { return 0.05 * std::sqrt(std::max(q * n, 1.0)) / n; });
-  for (double& e : expected) e *= n;
-  return test::pearsonChi2(observed, expected);
+  return test::pearsonChi2(observed, test::expectedCounts(grid, pdf, kSamples));
 }
 
 TEST(EqualAreaMap, UniformSquareIsUniformSphere) {

@@ -462,11 +462,7 @@ test::Chi2Result lightChi2(const Light& light, vec3 p, float sceneRadius, const 
     }
     observed[size_t(grid.cellOf(s.wi))] += 1.0;
   }
-  const double n = kSamples;
-  std::vector<double> expected =
-      grid.integrate(pdf, [n](double q) { return 0.05 * std::sqrt(std::max(q * n, 1.0)) / n; });
-  for (double& e : expected) e *= n;
-  return test::pearsonChi2(observed, expected);
+  return test::pearsonChi2(observed, test::expectedCounts(grid, pdf, kSamples));
 }
 
 TEST(AnalyticLights, InfiniteLightSamplerPassesChiSquare) {

@@ -25,13 +25,19 @@ namespace {
 const std::filesystem::path kMtlData =
     std::filesystem::path(PT_SOURCE_DIR) / "tests/data/scene/mtl";
 
-std::string loadError(const std::filesystem::path& scene) {
+// The message of the InputError that f() throws, or "(no error)".
+template <typename F>
+std::string errorOf(const F& f) {
   try {
-    loadScene(scene);
+    f();
   } catch (const InputError& e) {
     return e.what();
   }
   return "(no error)";
+}
+
+std::string loadError(const std::filesystem::path& scene) {
+  return errorOf([&] { loadScene(scene); });
 }
 
 // The scene material of the first triangle whose material is named `mtlName` in box.mtl.
@@ -593,14 +599,8 @@ TEST(SceneMtlMaps, BumpMapsAreDisplacementScaledByBm) {
 
 TEST(SceneMtlMaps, UnreadableImageIsAOneLineErrorNamingMtlMaterialAndMap) {
   const test::TempDir dir;
-  const std::string missing = [&] {
-    try {
-      loadMappedQuad(dir, "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
-  }();
+  const std::string missing =
+      errorOf([&] { loadMappedQuad(dir, "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n"); });
   EXPECT_EQ(missing.find('\n'), std::string::npos) << missing;
   EXPECT_EQ(missing.rfind((dir / "m.mtl").string() + ": material 'm': map_Kd 'gone.png': " +
                               (dir / "gone.png").string() + ": ",
@@ -608,14 +608,7 @@ TEST(SceneMtlMaps, UnreadableImageIsAOneLineErrorNamingMtlMaterialAndMap) {
             0u)
       << missing;
   dir.write("bad.png", "not a png");
-  const std::string bad = [&] {
-    try {
-      loadMappedQuad(dir, "newmtl m\nmap_d bad.png\n");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
-  }();
+  const std::string bad = errorOf([&] { loadMappedQuad(dir, "newmtl m\nmap_d bad.png\n"); });
   EXPECT_NE(bad.find("m.mtl: material 'm': map_d 'bad.png': "), std::string::npos) << bad;
   EXPECT_EQ(bad.find('\n'), std::string::npos) << bad;
   // A material no face uses reads no image.

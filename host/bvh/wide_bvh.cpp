@@ -28,12 +28,13 @@ namespace {
 // (the collapse of Embree's and of Ylitie et al.'s wide BVHs, greedy on area: a ray enters a
 // child in proportion to its area, so the large ones are worth testing together). The lanes
 // keep the binary tree's depth-first order, so that each binary node in between covers a
-// range of consecutive lanes; `shape` records those ranges for the traversal of degenerate
+// range of consecutive lanes; laneShape records those ranges for the traversal of degenerate
 // rays (WideBvh::shapes). (The root of a tree that is one leaf is its own node's only lane.)
 struct NodeLanes {
   uint32_t node[kWideLanes];
   int count = 0;
-  uint32_t shape = 0;
+  uint32_t opened[kWideLanes - 1];  // the binary nodes in between, `index` first
+  int openedCount = 0;
 };
 
 float halfArea(const BvhNode& node) {
@@ -47,11 +48,8 @@ void laneNodes(const Bvh& bvh, uint32_t index, NodeLanes& lanes) {
   if (root.count > 0) {
     lanes.node[0] = index;
     lanes.count = 1;
-    lanes.shape = wide_shape::make(1);
     return;
   }
-  uint32_t opened[kWideLanes - 1];  // the binary nodes in between, `index` first
-  int openedCount = 0;
   float area[kWideLanes];  // each lane's, or -1 for a leaf (never opened)
   auto laneArea = [&](uint32_t n) {
     const BvhNode& node = bvh.nodes[n];
@@ -59,7 +57,7 @@ void laneNodes(const Bvh& bvh, uint32_t index, NodeLanes& lanes) {
   };
   auto open = [&](int lane) {
     const uint32_t n = lanes.node[lane];
-    opened[openedCount++] = n;
+    lanes.opened[lanes.openedCount++] = n;
     std::copy_backward(lanes.node + lane + 1, lanes.node + lanes.count,
                        lanes.node + lanes.count + 1);
     std::copy_backward(area + lane + 1, area + lanes.count, area + lanes.count + 1);
@@ -80,17 +78,24 @@ void laneNodes(const Bvh& bvh, uint32_t index, NodeLanes& lanes) {
     if (area[widest] < 0.0f) break;
     open(widest);
   }
-  // Each binary node in between, in depth-first order: how many lanes its left child covers.
-  lanes.shape = wide_shape::make(lanes.count);
+}
+
+// The wide_shape of the lanes of binary node `index`: for each binary node in between, in
+// depth-first order, how many lanes its left child covers.
+uint32_t laneShape(const Bvh& bvh, uint32_t index, const NodeLanes& lanes) {
+  uint32_t shape = wide_shape::make(lanes.count);
+  const uint32_t* opened = lanes.opened;
+  const uint32_t* openedEnd = lanes.opened + lanes.openedCount;
   int split = 0;
   auto record = [&](auto& self, uint32_t n) -> int {
-    if (std::find(opened, opened + openedCount, n) == opened + openedCount) return 1;
+    if (std::find(opened, openedEnd, n) == openedEnd) return 1;
     const int at = split++;
     const int left = self(self, n + 1);
-    lanes.shape = wide_shape::withSplit(lanes.shape, at, left);
+    shape = wide_shape::withSplit(shape, at, left);
     return left + self(self, bvh.nodes[n].offset);
   };
   PT_CHECK(record(record, index) == lanes.count);
+  return shape;
 }
 
 // What Collapse::fill allocates for the wide node of binary node `index` and below: wide
@@ -148,7 +153,7 @@ class Collapse {
                size_t& piece) {
     NodeLanes lanes;
     laneNodes(bvh_, index, lanes);
-    if (write) fillNode(at, depth, lanes);
+    if (write) fillNode(at, index, depth, lanes);
     for (int i = 0; i < kWideLanes; ++i) {
       if (lanes.node[i] == kWideEmpty || bvh_.nodes[lanes.node[i]].count > 0) continue;
       const uint32_t child = write ? wide_.nodes[at].child[i] : 0;
@@ -171,7 +176,7 @@ class Collapse {
   void fill(uint32_t at, uint32_t index, int depth) {
     NodeLanes lanes;
     laneNodes(bvh_, index, lanes);
-    const WideNode& wide = fillNode(at, depth, lanes);
+    const WideNode& wide = fillNode(at, index, depth, lanes);
     for (int i = 0; i < kWideLanes; ++i) {
       if (wide.child[i] != kWideEmpty && !(wide.child[i] & kWideLeaf)) {
         fill(wide.child[i], lanes.node[i], depth + 1);
@@ -184,12 +189,12 @@ class Collapse {
   int maxDepth() const { return maxDepth_; }
 
  private:
-  // Wide node `at` from the binary nodes in its lanes, allocating its interior children's
-  // slots and packing its leaf children's triangles.
-  const WideNode& fillNode(uint32_t at, int depth, const NodeLanes& lanes) {
+  // Wide node `at` from `lanes`, those of binary node `index`, allocating its interior
+  // children's slots and packing its leaf children's triangles.
+  const WideNode& fillNode(uint32_t at, uint32_t index, int depth, const NodeLanes& lanes) {
     maxDepth_ = std::max(maxDepth_, depth);
     WideNode& wide = wide_.nodes[at];
-    wide_.shapes[at] = lanes.shape;
+    wide_.shapes[at] = laneShape(bvh_, index, lanes);
     for (int i = 0; i < kWideLanes; ++i) {
       wide.child[i] = kWideEmpty;
       wide.packetCount[i] = 0;
