@@ -298,16 +298,16 @@ std::unique_ptr<TraversalBackend> perRayBackend(int threads, Closest closest, An
   return std::make_unique<PerRayBackend<Closest, Any>>(threads, std::move(closest), std::move(any));
 }
 
-// Our traversal over a tree with closestHit / anyHit overloads (traverse.h; a tree built from
-// the Bvh answers in Bvh::triangles indices, Hit::triangle), held alive by the backend.
+// Our traversal over a tree with closestHit / anyHit overloads (traverse.h: a hit names its
+// triangle's place in scene order, Hit::primitive), held alive by the backend.
 template <class Tree>
-std::unique_ptr<TraversalBackend> treeBackend(std::shared_ptr<const Tree> tree, const Bvh& bvh,
-                                              int threads) {
+std::unique_ptr<TraversalBackend> treeBackend(std::shared_ptr<const Tree> tree, int threads) {
   return perRayBackend(
       threads,
-      [tree, &bvh](const Ray& ray) {
+      [tree](const Ray& ray) {
+        // The hit's primitive comes from the leaf, as Embree's primID does (no lookup).
         const std::optional<Hit> hit = closestHit(*tree, ray);
-        return hit ? HitRecord{hit->t, bvh.triangles[hit->triangle].primitive} : HitRecord{};
+        return hit ? HitRecord{hit->t, hit->primitive} : HitRecord{};
       },
       [tree](const Ray& ray, float tMax) { return anyHit(*tree, ray, tMax); });
 }
@@ -315,13 +315,13 @@ std::unique_ptr<TraversalBackend> treeBackend(std::shared_ptr<const Tree> tree, 
 std::unique_ptr<TraversalBackend> makeCpuBackend(const BenchScene& scene, const Options& o) {
   // The scene owns the tree: a shared_ptr that does not own it.
   const std::shared_ptr<const Bvh> tree(std::shared_ptr<const void>(), &scene.data.bvh);
-  return treeBackend(tree, scene.data.bvh, o.threads);
+  return treeBackend(tree, o.threads);
 }
 
 // The wide tree the CPU renderer traverses (wide_bvh.h), collapsed from the same BVH.
 std::unique_ptr<TraversalBackend> makeWideBackend(const BenchScene& scene, const Options& o) {
   const std::shared_ptr<const WideBvh> tree(std::shared_ptr<const void>(), &scene.data.wideBvh());
-  return treeBackend(tree, scene.data.bvh, o.threads);
+  return treeBackend(tree, o.threads);
 }
 
 // A GPU backend that traces a whole batch of RayQuery in one call of `trace` (results in

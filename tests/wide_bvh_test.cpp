@@ -41,7 +41,7 @@ bool sameBits(float a, float b) {
 bool sameHit(const std::optional<Hit>& a, const std::optional<Hit>& b) {
   if (a.has_value() != b.has_value()) return false;
   if (!a) return true;
-  return sameBits(a->t, b->t) && a->triangle == b->triangle &&
+  return sameBits(a->t, b->t) && a->triangle == b->triangle && a->primitive == b->primitive &&
          sameBits(a->barycentrics.x, b->barycentrics.x) &&
          sameBits(a->barycentrics.y, b->barycentrics.y) &&
          sameBits(a->barycentrics.z, b->barycentrics.z);
@@ -243,8 +243,11 @@ TEST(WideBvh, MatchesBruteForceAndTheBinaryTraversalOnBunny) {
     for (int i = 0; i < kRays; ++i) {
       const auto hit = closestHit(wide, rays[i]);
       const test::BruteHit& e = expected[i];
-      // The same distance bit for bit (at an edge two triangles may share it).
-      const bool same = hit.has_value() == e.found && (!e.found || hit->t == e.t);
+      // The same distance bit for bit (at an edge two triangles may share it), and the hit
+      // names its triangle's primitive.
+      const bool same =
+          hit.has_value() == e.found &&
+          (!e.found || (hit->t == e.t && hit->primitive == bvh.triangles[hit->triangle].primitive));
       if (!same && ++mismatches <= 5) ADD_FAILURE() << "ray " << i << " closest hit differs";
       const bool blocked = anyHit(wide, rays[i], tMax[i]);
       if (blocked != (e.found && e.t < tMax[i]) && ++anyHitMismatches <= 5)

@@ -32,6 +32,7 @@ struct Hit {
   float t = 0.0f;
   vec3 barycentrics{0.0f};  // weights of v0, v1, v2
   uint triangle = 0;        // index into Bvh::triangles
+  uint primitive = 0;       // that triangle's Triangle::primitive (its place in scene order)
 };
 
 // Decides, for a query, whether a hit on Bvh::triangles[triangle] counts: false drops it, as if
@@ -64,6 +65,7 @@ struct HitSearch {
     if (filter != nullptr && !filter->accept(filter->context, index, hit)) return false;
     best = hit;
     best.triangle = index;
+    best.primitive = primitive;
     bestPrimitive = primitive;
     range = searchRange(best.t, tMax);
     found = true;

@@ -25,6 +25,7 @@
 //    1e18.)
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -111,6 +112,20 @@ struct WideBvh {
 WideBvh buildWideBvh(const Bvh& bvh, int threads = 0);
 
 namespace wide_detail {
+
+// What a query's per-target code returns (wide_traverse.cpp): the ray was degenerate (see
+// below: the caller traces it with the binary loop), missed, or hit.
+enum Outcome : int { kDegenerate = -1, kMissed = 0, kHit = 1 };
+
+// A ray that the vector code does not take (see above): an infinity or a NaN in it (x - x is
+// 0 for a number, NaN otherwise), or no direction.
+inline bool degenerateRay(const Ray& ray) {
+  const vec3 o = ray.origin, d = ray.direction;
+  const bool finite =
+      (o.x - o.x) + (o.y - o.y) + (o.z - o.z) + (d.x - d.x) + (d.y - d.y) + (d.z - d.z) == 0.0f;
+  return !finite || (std::fabs(d.x) < kMinDirection && std::fabs(d.y) < kMinDirection &&
+                     std::fabs(d.z) < kMinDirection);
+}
 
 // The triangles of a leaf (packetCount packets from firstPacket) one at a time, as
 // traverse.cpp's leaf loop tests them: for Highway's portable target, for Moller-Trumbore,

@@ -75,6 +75,13 @@ inline ChildLanes intersectBoxes(const WideNode& node, const RayLanes& lanes, fl
   return box;
 }
 
+// RayPrecomputed(ray); false for a degenerate ray (see the vector version below).
+inline bool precomputeRay(const Ray& ray, RayPrecomputed& r) {
+  if (wide_detail::degenerateRay(ray)) return false;
+  r = RayPrecomputed(ray);
+  return true;
+}
+
 template <bool kAnyHit>
 bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket, uint32_t packetCount,
                              const RayLanes& lanes, HitSearch& search) {
@@ -160,19 +167,111 @@ HWY_INLINE ChildLanes intersectBoxes(const WideNode& node, const RayLanes& ray, 
   return box;
 }
 
-// Recomputes, in double precision as intersectTriangle does, the edge functions of the
-// lanes where one came out exactly 0.
-HWY_NOINLINE inline void recomputeEdgesInDouble(uint32_t lanes, V ax, V ay, V bx, V by, V cx, V cy,
-                                                V& u, V& v, V& w) {
+// RayPrecomputed(ray) (traverse.cpp), the same values bit for bit, in a few vector operations
+// and without branches: for random directions, the constructor's branches on the largest axis
+// and on the signs are mispredicted often enough to cost a sixth of a small scene's rays. The
+// divisions are IEEE's in every lane, the constructor's six in two vectors. (The ray is read
+// in place and built in registers: vectors assembled in memory from single floats would wait
+// for those stores.) Returns false, and leaves `r` unset, for a degenerate ray (wide_bvh.h).
+HWY_INLINE bool precomputeRay(const Ray& ray, RayPrecomputed& r) {
+  static_assert(sizeof(Ray) == 6 * sizeof(float), "Ray: origin and direction, unpadded");
   const D d;
+  const float* in = &ray.origin.x;
+  const V o = hn::LoadU(d, in);  // origin; its fourth lane is direction.x, unused
+  // (o.z, d.x, d.y, d.z) shifted down a lane: the direction, its fourth lane unused.
+  const V dir = hn::CombineShiftRightBytes<4>(d, o, hn::LoadU(d, in + 2));
+  const V zero = hn::Zero(d);
+  const V minDirection = hn::Set(d, kMinDirection);
+  const V a = hn::Abs(dir);
+  const M tiny = hn::Lt(a, minDirection);
+  // degenerateRay's tests: every coordinate a number (x - x == 0), and some direction.
+  const M finite = hn::And(hn::Eq(hn::Sub(o, o), zero), hn::Eq(hn::Sub(dir, dir), zero));
+  if ((laneBits(d, finite) & 7u) != 7u || (laneBits(d, tiny) & 7u) == 7u) return false;
+  // 1 / direction, |direction| clamped away from 0 (safeInverse).
+  const V inv =
+      hn::Div(hn::Set(d, 1.0f), hn::IfThenElse(tiny, hn::CopySign(minDirection, dir), dir));
+  // kz: x if a.x > a.y and a.x > a.z, y if not a.x > a.y but a.y > a.z, else z; then kx and
+  // ky, the next axes, swapped where direction[kz] < 0: by arithmetic and a table, not
+  // branches.
+  const uint32_t nextAxis = laneBits(d, hn::Gt(a, hn::Shuffle0321(a)));   // x > y, y > z
+  const uint32_t axisAfter = laneBits(d, hn::Gt(a, hn::Shuffle1032(a)));  // x > z
+  const int xOverY = int(nextAxis & 1u), yOverZ = int(nextAxis >> 1 & 1u);
+  const int kz = 2 - 2 * xOverY * int(axisAfter & 1u) - (1 - xOverY) * yOverZ;
+  alignas(16) float d4[4];
+  hn::Store(dir, d, d4);
+  const int swapped = d4[kz] < 0.0f ? 1 : 0;
+  // Lanes kx, ky, then the fourth lane (set to 1 below) twice, by kz and swap.
+  alignas(16) static constexpr int32_t kShearLanes[3][2][4] = {
+      {{1, 2, 3, 3}, {2, 1, 3, 3}}, {{2, 0, 3, 3}, {0, 2, 3, 3}}, {{0, 1, 3, 3}, {1, 0, 3, 3}}};
+  const int32_t* lanes = kShearLanes[kz][swapped];
+  // sx, sy, sz = d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz] in one division.
+  const V dirOne = hn::IfThenElse(hn::FirstN(d, 3), dir, hn::Set(d, 1.0f));
+  const V shear =
+      hn::Div(hn::TableLookupLanes(dirOne, hn::SetTableIndices(d, lanes)), hn::Set(d, d4[kz]));
+  alignas(16) float inv4[4], shear4[4];
+  hn::Store(inv, d, inv4);
+  hn::Store(shear, d, shear4);
+  r.origin = ray.origin;
+  r.direction = ray.direction;
+  r.invDirection = vec3(inv4[0], inv4[1], inv4[2]);
+  r.kx = lanes[0];
+  r.ky = lanes[1];
+  r.kz = kz;
+  r.sx = shear4[0];
+  r.sy = shear4[1];
+  r.sz = shear4[2];
+  return true;
+}
+
+// A packet's vertices relative to the ray's origin, sheared so that the ray becomes the +z
+// axis: x and y of each, and z before the scaling by sz.
+struct ShearedPacket {
+  V akz, bkz, ckz, ax, ay, bx, by, cx, cy;
+};
+
+HWY_INLINE ShearedPacket shearPacket(const TrianglePacket& packet, const RayLanes& ray) {
+  const D d;
+  const float* v0 = packet.v[0][0];
+  const float* v1 = packet.v[1][0];
+  const float* v2 = packet.v[2][0];
+  ShearedPacket s;
+  s.akz = hn::Sub(hn::Load(d, v0 + ray.shearRow[2]), ray.shearOrigin[2]);
+  s.bkz = hn::Sub(hn::Load(d, v1 + ray.shearRow[2]), ray.shearOrigin[2]);
+  s.ckz = hn::Sub(hn::Load(d, v2 + ray.shearRow[2]), ray.shearOrigin[2]);
+  s.ax = hn::Sub(hn::Sub(hn::Load(d, v0 + ray.shearRow[0]), ray.shearOrigin[0]),
+                 hn::Mul(ray.sx, s.akz));
+  s.ay = hn::Sub(hn::Sub(hn::Load(d, v0 + ray.shearRow[1]), ray.shearOrigin[1]),
+                 hn::Mul(ray.sy, s.akz));
+  s.bx = hn::Sub(hn::Sub(hn::Load(d, v1 + ray.shearRow[0]), ray.shearOrigin[0]),
+                 hn::Mul(ray.sx, s.bkz));
+  s.by = hn::Sub(hn::Sub(hn::Load(d, v1 + ray.shearRow[1]), ray.shearOrigin[1]),
+                 hn::Mul(ray.sy, s.bkz));
+  s.cx = hn::Sub(hn::Sub(hn::Load(d, v2 + ray.shearRow[0]), ray.shearOrigin[0]),
+                 hn::Mul(ray.sx, s.ckz));
+  s.cy = hn::Sub(hn::Sub(hn::Load(d, v2 + ray.shearRow[1]), ray.shearOrigin[1]),
+                 hn::Mul(ray.sy, s.ckz));
+  return s;
+}
+
+// Recomputes, in double precision as intersectTriangle does, the edge functions of the
+// lanes where one came out exactly 0. Rare, so it shears the packet again rather than have
+// the fast path keep the sheared vertices for it (which spilled them to memory).
+struct EdgeFunctions {
+  V u, v, w;
+};
+HWY_NOINLINE inline EdgeFunctions recomputeEdgesInDouble(const TrianglePacket& packet,
+                                                         const RayLanes& ray, uint32_t lanes, V u,
+                                                         V v, V w) {
+  const D d;
+  const ShearedPacket s = shearPacket(packet, ray);
   alignas(16) float a[2][kPacketLanes], b[2][kPacketLanes], c[2][kPacketLanes];
   alignas(16) float uu[kPacketLanes], vv[kPacketLanes], ww[kPacketLanes];
-  hn::Store(ax, d, a[0]);
-  hn::Store(ay, d, a[1]);
-  hn::Store(bx, d, b[0]);
-  hn::Store(by, d, b[1]);
-  hn::Store(cx, d, c[0]);
-  hn::Store(cy, d, c[1]);
+  hn::Store(s.ax, d, a[0]);
+  hn::Store(s.ay, d, a[1]);
+  hn::Store(s.bx, d, b[0]);
+  hn::Store(s.by, d, b[1]);
+  hn::Store(s.cx, d, c[0]);
+  hn::Store(s.cy, d, c[1]);
   hn::Store(u, d, uu);
   hn::Store(v, d, vv);
   hn::Store(w, d, ww);
@@ -182,9 +281,7 @@ HWY_NOINLINE inline void recomputeEdgesInDouble(uint32_t lanes, V ax, V ay, V bx
     vv[i] = float(double(a[0][i]) * double(c[1][i]) - double(a[1][i]) * double(c[0][i]));
     ww[i] = float(double(b[0][i]) * double(a[1][i]) - double(b[1][i]) * double(a[0][i]));
   }
-  u = hn::Load(d, uu);
-  v = hn::Load(d, vv);
-  w = hn::Load(d, ww);
+  return EdgeFunctions{hn::Load(d, uu), hn::Load(d, vv), hn::Load(d, ww)};
 }
 
 // The watertight test (intersectTriangle) on the triangles of one leaf, its packets in
@@ -202,39 +299,27 @@ HWY_INLINE bool intersectLeafWatertight(const WideBvh& bvh, uint32_t firstPacket
   for (uint32_t p = firstPacket; p < firstPacket + packetCount; ++p) {
     const TrianglePacket& packet = bvh.packets[p];
     // Vertices relative to the origin, sheared so the ray becomes the +z axis.
-    const float* v0 = packet.v[0][0];
-    const float* v1 = packet.v[1][0];
-    const float* v2 = packet.v[2][0];
-    const V akz = hn::Sub(hn::Load(d, v0 + ray.shearRow[2]), ray.shearOrigin[2]);
-    const V bkz = hn::Sub(hn::Load(d, v1 + ray.shearRow[2]), ray.shearOrigin[2]);
-    const V ckz = hn::Sub(hn::Load(d, v2 + ray.shearRow[2]), ray.shearOrigin[2]);
-    const V ax = hn::Sub(hn::Sub(hn::Load(d, v0 + ray.shearRow[0]), ray.shearOrigin[0]),
-                         hn::Mul(ray.sx, akz));
-    const V ay = hn::Sub(hn::Sub(hn::Load(d, v0 + ray.shearRow[1]), ray.shearOrigin[1]),
-                         hn::Mul(ray.sy, akz));
-    const V bx = hn::Sub(hn::Sub(hn::Load(d, v1 + ray.shearRow[0]), ray.shearOrigin[0]),
-                         hn::Mul(ray.sx, bkz));
-    const V by = hn::Sub(hn::Sub(hn::Load(d, v1 + ray.shearRow[1]), ray.shearOrigin[1]),
-                         hn::Mul(ray.sy, bkz));
-    const V cx = hn::Sub(hn::Sub(hn::Load(d, v2 + ray.shearRow[0]), ray.shearOrigin[0]),
-                         hn::Mul(ray.sx, ckz));
-    const V cy = hn::Sub(hn::Sub(hn::Load(d, v2 + ray.shearRow[1]), ray.shearOrigin[1]),
-                         hn::Mul(ray.sy, ckz));
+    const ShearedPacket sh = shearPacket(packet, ray);
     // Scaled barycentrics: 2D edge functions of the projected edges against the origin.
-    V u = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
-    V v = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
-    V w = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
+    V u = hn::Sub(hn::Mul(sh.cx, sh.by), hn::Mul(sh.cy, sh.bx));
+    V v = hn::Sub(hn::Mul(sh.ax, sh.cy), hn::Mul(sh.ay, sh.cx));
+    V w = hn::Sub(hn::Mul(sh.bx, sh.ay), hn::Mul(sh.by, sh.ax));
     const uint32_t zeroEdge =
         laneBits(d, hn::Or(hn::Or(hn::Eq(u, zero), hn::Eq(v, zero)), hn::Eq(w, zero)));
-    if (zeroEdge != 0) recomputeEdgesInDouble(zeroEdge, ax, ay, bx, by, cx, cy, u, v, w);
+    if (zeroEdge != 0) {
+      const EdgeFunctions exact = recomputeEdgesInDouble(packet, ray, zeroEdge, u, v, w);
+      u = exact.u;
+      v = exact.v;
+      w = exact.w;
+    }
     // Rejections, as intersectTriangle makes them: mixed signs, det == 0, t out of range.
     const M negative = hn::Or(hn::Or(hn::Lt(u, zero), hn::Lt(v, zero)), hn::Lt(w, zero));
     const M positive = hn::Or(hn::Or(hn::Gt(u, zero), hn::Gt(v, zero)), hn::Gt(w, zero));
     const V det = hn::Add(hn::Add(u, v), w);
     // Scaled hit distance; compared against the range scaled by det.
-    const V az = hn::Mul(ray.sz, akz);
-    const V bz = hn::Mul(ray.sz, bkz);
-    const V cz = hn::Mul(ray.sz, ckz);
+    const V az = hn::Mul(ray.sz, sh.akz);
+    const V bz = hn::Mul(ray.sz, sh.bkz);
+    const V cz = hn::Mul(ray.sz, sh.ckz);
     const V t = hn::Add(hn::Add(hn::Mul(u, az), hn::Mul(v, bz)), hn::Mul(w, cz));
     const V range = hn::Mul(hn::Set(d, search.range), det);
     const M detPositive = hn::Gt(det, zero);
@@ -286,30 +371,55 @@ HWY_NOINLINE bool intersectLeafFast(const WideBvh& bvh, uint32_t firstPacket, ui
 // entry distance, nearest first (its low three bits replaced by the lane, so that keys differ
 // and equal distances go in lane order), any-hit queries, which stop at the first hit
 // wherever it is, as they come. byOrder[k] is the lane visited k-th; returns how many.
+// (The order decides only how soon the range shrinks, never the answer: isCloserHit.)
 template <bool kAnyHit>
 HWY_INLINE int visitOrder(const ChildLanes& box, uint8_t (&byOrder)[kWideLanes]) {
-  int count = 0;
-  if (kAnyHit || (box.hit & (box.hit - 1u)) == 0) {
-    for (uint32_t rest = box.hit; rest != 0; rest &= rest - 1u) {
-      byOrder[count++] = uint8_t(std::countr_zero(rest));
-    }
+  uint32_t hit = box.hit;
+  if (kAnyHit || (hit & (hit - 1u)) == 0) {
+    int count = 0;
+    for (; hit != 0; hit &= hit - 1u) byOrder[count++] = uint8_t(std::countr_zero(hit));
     return count;
   }
-  uint32_t key[kWideLanes];
-  for (uint32_t rest = box.hit; rest != 0; rest &= rest - 1u) {
-    const int i = std::countr_zero(rest);
-    key[i] = (std::bit_cast<uint32_t>(box.enter[i]) & ~7u) | uint32_t(i);  // enter >= 0
-    ++count;
+  auto key = [&](int i) {
+    return (std::bit_cast<uint32_t>(box.enter[i]) & ~7u) | uint32_t(i);  // enter >= 0
+  };
+  const int first = std::countr_zero(hit);
+  const uint32_t rest = hit & (hit - 1u);
+  if ((rest & (rest - 1u)) == 0) {  // two: one comparison
+    const int second = std::countr_zero(rest);
+    const bool swap = key(second) < key(first);
+    byOrder[0] = uint8_t(swap ? second : first);
+    byOrder[1] = uint8_t(swap ? first : second);
+    return 2;
   }
-  for (uint32_t rest = box.hit; rest != 0; rest &= rest - 1u) {
-    const int i = std::countr_zero(rest);
+  // Three or more: each lane's rank is the number of hit lanes with smaller keys.
+#if HWY_MAX_BYTES >= 32
+  // All eight keys in one vector, each lane's rank from one comparison.
+  const hn::RebindToSigned<DB> di;  // keys below 2^31: a signed comparison orders them
+  const auto keys = hn::Or(hn::And(hn::BitCast(di, hn::LoadU(DB(), box.enter)), hn::Set(di, ~7)),
+                           hn::Iota(di, 0));
+  alignas(32) int32_t keyOf[kWideLanes];
+  hn::Store(keys, di, keyOf);
+  for (uint32_t lanes = hit; lanes != 0; lanes &= lanes - 1u) {
+    const int i = std::countr_zero(lanes);
+    const int rank = std::popcount(laneBits(di, hn::Lt(keys, hn::Set(di, keyOf[i]))) & hit);
+    byOrder[rank] = uint8_t(i);
+  }
+#else
+  uint32_t keyOf[kWideLanes];
+  for (uint32_t lanes = hit; lanes != 0; lanes &= lanes - 1u) {
+    keyOf[std::countr_zero(lanes)] = key(std::countr_zero(lanes));
+  }
+  for (uint32_t lanes = hit; lanes != 0; lanes &= lanes - 1u) {
+    const int i = std::countr_zero(lanes);
     int rank = 0;
-    for (uint32_t other = box.hit; other != 0; other &= other - 1u) {
-      rank += key[std::countr_zero(other)] < key[i] ? 1 : 0;
+    for (uint32_t other = hit; other != 0; other &= other - 1u) {
+      rank += keyOf[std::countr_zero(other)] < keyOf[i] ? 1 : 0;
     }
     byOrder[rank] = uint8_t(i);
   }
-  return count;
+#endif
+  return std::popcount(hit);
 }
 
 // Asks for the memory of the children the ray enters, all at once, before the first is

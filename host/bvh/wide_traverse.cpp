@@ -27,29 +27,31 @@ HWY_BEFORE_NAMESPACE();
 namespace pt {
 namespace HWY_NAMESPACE {
 using wide_traversal::traverseFromRoot;
+using namespace wide_detail;  // Outcome
 
 template <bool kAnyHit, bool kWatertight>
-bool traverse(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter, Hit& best) {
-  // The root's box first, as traverse.cpp tests it (the rays that miss it miss every box).
-  const RayPrecomputed r(ray);
-  float rootEnter = 0.0f;
-  if (!intersectBox(r, bvh.rootMin, bvh.rootMax, tMax, rootEnter)) return false;
-  return traverseFromRoot<kAnyHit, kWatertight>(bvh, r, tMax, best, filter);
+int traverse(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter, Hit& best) {
+  RayPrecomputed r;
+  if (!wide_traversal::precomputeRay(ray, r)) return kDegenerate;
+  // traverse.cpp tests the root's box first; that test is left to the root node's: a ray that
+  // misses the root's box misses every box inside it (the slab test's distances are monotonic
+  // in the planes, so a box inside gives a later entry and an earlier exit).
+  return traverseFromRoot<kAnyHit, kWatertight>(bvh, r, tMax, best, filter) ? kHit : kMissed;
 }
 
-bool closestHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter,
-                          Hit& hit) {
+int closestHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter,
+                         Hit& hit) {
   return traverse</*kAnyHit=*/false, true>(bvh, ray, tMax, filter, hit);
 }
-bool closestHitFast(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter,
-                    Hit& hit) {
+int closestHitFast(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter,
+                   Hit& hit) {
   return traverse</*kAnyHit=*/false, false>(bvh, ray, tMax, filter, hit);
 }
-bool anyHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter,
-                      Hit& hit) {
+int anyHitWatertight(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter,
+                     Hit& hit) {
   return traverse</*kAnyHit=*/true, true>(bvh, ray, tMax, filter, hit);
 }
-bool anyHitFast(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter, Hit& hit) {
+int anyHitFast(const WideBvh& bvh, const Ray& ray, float tMax, const HitFilter* filter, Hit& hit) {
   return traverse</*kAnyHit=*/true, false>(bvh, ray, tMax, filter, hit);
 }
 
@@ -70,19 +72,10 @@ namespace pt {
 // lanes' boxes, which is the binary node's box exactly (every parent's box is the union of
 // its children's). (The lanes integrator tests the same in vector lanes:
 // integrator_lanes.cpp, setUpRays.)
+using namespace wide_detail;  // Outcome
+
 namespace {
 
-bool degenerateRay(const Ray& ray) {
-  const vec3 o = ray.origin, d = ray.direction;
-  // x - x is 0 for a number, NaN for an infinity or a NaN.
-  const bool finite =
-      (o.x - o.x) + (o.y - o.y) + (o.z - o.z) + (d.x - d.x) + (d.y - d.y) + (d.z - d.z) == 0.0f;
-  return !finite || (std::fabs(d.x) < kMinDirection && std::fabs(d.y) < kMinDirection &&
-                     std::fabs(d.z) < kMinDirection);
-}
-
-// Lanes [first, first + size) of a wide node; `split` is the binary node's index in the
-// node's wide_shape when size >= 2.
 struct BinaryNode {
   uint32_t node;  // the wide node
   int first, size, split;
@@ -166,11 +159,12 @@ HWY_EXPORT(anyHitFast);
 std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test,
                               const HitFilter* filter) {
   Hit hit;
-  const bool found = degenerateRay(ray)
+  const int outcome = test == Intersection::kWatertight
+                          ? HWY_DYNAMIC_DISPATCH(closestHitWatertight)(bvh, ray, tMax, filter, hit)
+                          : HWY_DYNAMIC_DISPATCH(closestHitFast)(bvh, ray, tMax, filter, hit);
+  const bool found = outcome == kDegenerate
                          ? traverseAsBinary</*kAnyHit=*/false>(bvh, ray, tMax, test, filter, hit)
-                     : test == Intersection::kWatertight
-                         ? HWY_DYNAMIC_DISPATCH(closestHitWatertight)(bvh, ray, tMax, filter, hit)
-                         : HWY_DYNAMIC_DISPATCH(closestHitFast)(bvh, ray, tMax, filter, hit);
+                         : outcome == kHit;
   if (found) return hit;
   return std::nullopt;
 }
@@ -178,12 +172,12 @@ std::optional<Hit> closestHit(const WideBvh& bvh, const Ray& ray, float tMax, In
 bool anyHit(const WideBvh& bvh, const Ray& ray, float tMax, Intersection test,
             const HitFilter* filter) {
   Hit hit;
-  if (degenerateRay(ray)) {
-    return traverseAsBinary</*kAnyHit=*/true>(bvh, ray, tMax, test, filter, hit);
-  }
-  return test == Intersection::kWatertight
-             ? HWY_DYNAMIC_DISPATCH(anyHitWatertight)(bvh, ray, tMax, filter, hit)
-             : HWY_DYNAMIC_DISPATCH(anyHitFast)(bvh, ray, tMax, filter, hit);
+  const int outcome = test == Intersection::kWatertight
+                          ? HWY_DYNAMIC_DISPATCH(anyHitWatertight)(bvh, ray, tMax, filter, hit)
+                          : HWY_DYNAMIC_DISPATCH(anyHitFast)(bvh, ray, tMax, filter, hit);
+  return outcome == kDegenerate
+             ? traverseAsBinary</*kAnyHit=*/true>(bvh, ray, tMax, test, filter, hit)
+             : outcome == kHit;
 }
 
 std::vector<int64_t> wideTraversalTargets() {

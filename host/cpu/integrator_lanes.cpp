@@ -240,7 +240,7 @@ HWY_INLINE uint32_t setUpRays(const WideBvh& bvh, const Lanes3& originLanes,
   const V zero = hn::Zero(d);
   const V3 o = load(originLanes);
   const V3 dir = load(directionLanes);
-  // Degenerate, as wide_traverse.cpp's degenerateRay tests it: not finite (x - x is 0 for a
+  // Degenerate, as wide_detail::degenerateRay (wide_bvh.h) tests it: not finite (x - x is 0 for a
   // number, NaN otherwise), or no direction.
   const V minDirection = splat(kMinDirection);
   const V finite = hn::Add(
