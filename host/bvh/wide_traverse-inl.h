@@ -109,33 +109,51 @@ HWY_INLINE uint32_t laneBits(Tag d, hn::Mask<Tag> m) {
   return bits;
 }
 
-// The ray's constants, broadcast to every lane, and where the rows it reads lie.
+// Where a node's near and far planes lie for a ray, by its octant (bit a: 1/d[a] < 0): the
+// slab distances min(t0, t1) and max(t0, t1) are the near and the far plane's, for a positive
+// 1/d the lower plane's distance being the smaller (rounding is monotonic), for a negative one
+// the upper's (1/d is never 0; its sign is the direction's). Offsets into WideNode::bounds,
+// in floats: lo.x, lo.y, lo.z, hi.x, hi.y, hi.z rows of kWideLanes each.
+struct SlabRows {
+  uint32_t near[3], far[3];
+};
+constexpr SlabRows slabRows(int octant) {
+  SlabRows rows{};
+  for (int axis = 0; axis < 3; ++axis) {
+    const bool negative = (octant >> axis & 1) != 0;
+    rows.near[axis] = uint32_t(kWideLanes * (negative ? axis + 3 : axis));
+    rows.far[axis] = uint32_t(kWideLanes * (negative ? axis : axis + 3));
+  }
+  return rows;
+}
+inline constexpr SlabRows kSlabRows[8] = {slabRows(0), slabRows(1), slabRows(2), slabRows(3),
+                                          slabRows(4), slabRows(5), slabRows(6), slabRows(7)};
+
+// The ray's constants, broadcast to every lane, and where the rows it reads lie. (Built from
+// plain arrays and tables: glm's vec3 indexing by a variable is a switch, whose branches for
+// random directions are mispredicted.)
 struct RayLanes {
   explicit RayLanes(const RayPrecomputed& r) {
+    const float o[3] = {r.origin.x, r.origin.y, r.origin.z};
+    const float inv[3] = {r.invDirection.x, r.invDirection.y, r.invDirection.z};
     const int k[3] = {r.kx, r.ky, r.kz};
+    const int octant = int(inv[0] < 0.0f) | int(inv[1] < 0.0f) << 1 | int(inv[2] < 0.0f) << 2;
+    rows = &kSlabRows[octant];
     for (int axis = 0; axis < 3; ++axis) {
-      origin[axis] = hn::Set(DB(), r.origin[axis]);
-      invDirection[axis] = hn::Set(DB(), r.invDirection[axis]);
-      // The slab distances min(t0, t1) and max(t0, t1) are the near and the far plane's: for
-      // a positive 1/d the lower plane's distance is the smaller (rounding is monotonic),
-      // for a negative one the upper's. 1/d is never 0; its sign is the direction's.
-      const bool positive = r.invDirection[axis] > 0.0f;
-      nearRow[axis] = kWideLanes * (positive ? axis : axis + 3);
-      farRow[axis] = kWideLanes * (positive ? axis + 3 : axis);
-      shearRow[axis] = kPacketLanes * k[axis];
-      shearOrigin[axis] = hn::Set(D(), r.origin[k[axis]]);
+      origin[axis] = hn::Set(DB(), o[axis]);
+      invDirection[axis] = hn::Set(DB(), inv[axis]);
+      shearRow[axis] = uint32_t(kPacketLanes * k[axis]);
+      shearOrigin[axis] = hn::Set(D(), o[k[axis]]);
     }
     sx = hn::Set(D(), r.sx);
     sy = hn::Set(D(), r.sy);
     sz = hn::Set(D(), r.sz);
-    farScale = hn::Set(DB(), kFarScale);
   }
   VB origin[3], invDirection[3];
-  size_t nearRow[3], farRow[3];  // offsets into WideNode::bounds, in floats
-  size_t shearRow[3];            // offsets of axes kx, ky, kz into a vertex of a packet
-  V shearOrigin[3];              // origin[kx], origin[ky], origin[kz]
+  const SlabRows* rows;  // the ray's octant's
+  uint32_t shearRow[3];  // offsets of axes kx, ky, kz into a vertex of a packet, in floats
+  V shearOrigin[3];      // origin[kx], origin[ky], origin[kz]
   V sx, sy, sz;
-  VB farScale;
 };
 
 // The slab test of intersectBox on the eight children at once. Unused lanes hold an
@@ -153,14 +171,14 @@ HWY_INLINE ChildLanes intersectBoxes(const WideNode& node, const RayLanes& ray, 
     VB tMin[3], tFar[3];
 #pragma GCC unroll 3
     for (int axis = 0; axis < 3; ++axis) {
-      tMin[axis] = hn::Mul(hn::Sub(hn::Load(d, bounds + ray.nearRow[axis]), ray.origin[axis]),
+      tMin[axis] = hn::Mul(hn::Sub(hn::Load(d, bounds + ray.rows->near[axis]), ray.origin[axis]),
                            ray.invDirection[axis]);
-      tFar[axis] = hn::Mul(hn::Sub(hn::Load(d, bounds + ray.farRow[axis]), ray.origin[axis]),
+      tFar[axis] = hn::Mul(hn::Sub(hn::Load(d, bounds + ray.rows->far[axis]), ray.origin[axis]),
                            ray.invDirection[axis]);
     }
     const VB enter = hn::Max(hn::Max(tMin[0], tMin[1]), hn::Max(tMin[2], zero));
     const VB exit = hn::Mul(hn::Min(hn::Min(tFar[0], tFar[1]), hn::Min(tFar[2], hn::Set(d, tMax))),
-                            ray.farScale);
+                            hn::Set(d, kFarScale));
     box.hit |= laneBits(d, hn::Le(enter, exit)) << (p * kBoxPartLanes);
     hn::StoreU(enter, d, box.enter + p * kBoxPartLanes);
   }
