@@ -385,18 +385,23 @@ HWY_NOINLINE bool intersectLeafFast(const WideBvh& bvh, uint32_t firstPacket, ui
       bvh, firstPacket, packetCount, ray, search);
 }
 
-// The hit children of a node in the order to visit them: closest-hit queries take them by
-// entry distance, nearest first (its low three bits replaced by the lane, so that keys differ
-// and equal distances go in lane order), any-hit queries, which stop at the first hit
-// wherever it is, as they come. byOrder[k] is the lane visited k-th; returns how many.
-// (The order decides only how soon the range shrinks, never the answer: isCloserHit.)
+// The hit children of a node in the order to visit them, by entry distance (its low three
+// bits replaced by the lane, so that keys differ): closest-hit queries nearest first, any-hit
+// queries farthest first. byOrder[k] is the lane visited k-th; returns how many. (The order
+// decides only how soon a query ends, never its answer: isCloserHit.)
+// Farthest first for any hit: a shadow ray leaves a surface, and the children it enters
+// first lie around its origin, which rarely blocks it. bunny-dragon's shadow rays visit 0.63
+// leaves each, against 1.57 in lane order (the binary tree's depth-first order) and 1.59
+// nearest first; ray_bench, 1 thread, against lane order: shadow rays on bunny-dragon 1.24x
+// as fast, on the sphere 1.14x. (Embree's any-hit traversal takes the last lane first, which
+// here visits 0.62 leaves: the lane order happens to run along these rays, which it need
+// not on another scene; the distances do not depend on it.)
 template <bool kAnyHit>
 HWY_INLINE int visitOrder(const ChildLanes& box, uint8_t (&byOrder)[kWideLanes]) {
-  uint32_t hit = box.hit;
-  if (kAnyHit || (hit & (hit - 1u)) == 0) {
-    int count = 0;
-    for (; hit != 0; hit &= hit - 1u) byOrder[count++] = uint8_t(std::countr_zero(hit));
-    return count;
+  const uint32_t hit = box.hit;
+  if ((hit & (hit - 1u)) == 0) {
+    byOrder[0] = uint8_t(std::countr_zero(hit));
+    return 1;
   }
   auto key = [&](int i) {
     return (std::bit_cast<uint32_t>(box.enter[i]) & ~7u) | uint32_t(i);  // enter >= 0
@@ -405,12 +410,13 @@ HWY_INLINE int visitOrder(const ChildLanes& box, uint8_t (&byOrder)[kWideLanes])
   const uint32_t rest = hit & (hit - 1u);
   if ((rest & (rest - 1u)) == 0) {  // two: one comparison
     const int second = std::countr_zero(rest);
-    const bool swap = key(second) < key(first);
+    const bool swap = kAnyHit ? key(second) > key(first) : key(second) < key(first);
     byOrder[0] = uint8_t(swap ? second : first);
     byOrder[1] = uint8_t(swap ? first : second);
     return 2;
   }
-  // Three or more: each lane's rank is the number of hit lanes with smaller keys.
+  // Three or more: each lane's rank is the number of hit lanes with smaller keys (any hit:
+  // larger).
 #if HWY_MAX_BYTES >= 32
   // All eight keys in one vector, each lane's rank from one comparison.
   const hn::RebindToSigned<DB> di;  // keys below 2^31: a signed comparison orders them
@@ -420,7 +426,9 @@ HWY_INLINE int visitOrder(const ChildLanes& box, uint8_t (&byOrder)[kWideLanes])
   hn::Store(keys, di, keyOf);
   for (uint32_t lanes = hit; lanes != 0; lanes &= lanes - 1u) {
     const int i = std::countr_zero(lanes);
-    const int rank = std::popcount(laneBits(di, hn::Lt(keys, hn::Set(di, keyOf[i]))) & hit);
+    const auto other = hn::Set(di, keyOf[i]);
+    const int rank =
+        std::popcount(laneBits(di, kAnyHit ? hn::Gt(keys, other) : hn::Lt(keys, other)) & hit);
     byOrder[rank] = uint8_t(i);
   }
 #else
@@ -432,7 +440,8 @@ HWY_INLINE int visitOrder(const ChildLanes& box, uint8_t (&byOrder)[kWideLanes])
     const int i = std::countr_zero(lanes);
     int rank = 0;
     for (uint32_t other = hit; other != 0; other &= other - 1u) {
-      rank += keyOf[std::countr_zero(other)] < keyOf[i] ? 1 : 0;
+      const uint32_t k = keyOf[std::countr_zero(other)];
+      rank += (kAnyHit ? k > keyOf[i] : k < keyOf[i]) ? 1 : 0;
     }
     byOrder[rank] = uint8_t(i);
   }
