@@ -48,25 +48,24 @@ struct HitFilter {
 // on the tree or the visiting order), and the range that boxes and triangles are tested
 // against (searchRange).
 struct HitSearch {
-  float tMax;                             // the query's range, exact
-  float range;                            // what boxes and triangles are tested against
-  Hit best;                               // the closest hit so far (t = tMax before the first)
-  uint32_t bestPrimitive = kNoPrimitive;  // its Triangle::primitive
+  float tMax;   // the query's range, exact
+  float range;  // what boxes and triangles are tested against
+  Hit best;     // the closest hit so far (t = tMax and primitive kNoPrimitive before the first)
   bool found = false;
   const HitFilter* filter = nullptr;  // none: every hit counts
   explicit HitSearch(float queryTMax, const HitFilter* hitFilter = nullptr)
       : tMax(queryTMax), range(queryTMax), filter(hitFilter) {
     best.t = queryTMax;
+    best.primitive = kNoPrimitive;
   }
   // Offers a hit on Bvh::triangles[index], whose Triangle::primitive is `primitive`; takes it
   // and returns true if isCloserHit prefers it to the closest so far.
   bool offer(const Hit& hit, uint32_t index, uint32_t primitive) {
-    if (!isCloserHit(hit.t, primitive, best.t, bestPrimitive)) return false;
+    if (!isCloserHit(hit.t, primitive, best.t, best.primitive)) return false;
     if (filter != nullptr && !filter->accept(filter->context, index, hit)) return false;
     best = hit;
     best.triangle = index;
     best.primitive = primitive;
-    bestPrimitive = primitive;
     range = searchRange(best.t, tMax);
     found = true;
     return true;

@@ -249,25 +249,23 @@ struct ShearedPacket {
 
 HWY_INLINE ShearedPacket shearPacket(const TrianglePacket& packet, const RayLanes& ray) {
   const D d;
+  // Row `axis` of a vertex's coordinates, relative to the origin.
+  auto relative = [&](const float* vertex, int axis) {
+    return hn::Sub(hn::Load(d, vertex + ray.shearRow[axis]), ray.shearOrigin[axis]);
+  };
   const float* v0 = packet.v[0][0];
   const float* v1 = packet.v[1][0];
   const float* v2 = packet.v[2][0];
   ShearedPacket s;
-  s.akz = hn::Sub(hn::Load(d, v0 + ray.shearRow[2]), ray.shearOrigin[2]);
-  s.bkz = hn::Sub(hn::Load(d, v1 + ray.shearRow[2]), ray.shearOrigin[2]);
-  s.ckz = hn::Sub(hn::Load(d, v2 + ray.shearRow[2]), ray.shearOrigin[2]);
-  s.ax = hn::Sub(hn::Sub(hn::Load(d, v0 + ray.shearRow[0]), ray.shearOrigin[0]),
-                 hn::Mul(ray.sx, s.akz));
-  s.ay = hn::Sub(hn::Sub(hn::Load(d, v0 + ray.shearRow[1]), ray.shearOrigin[1]),
-                 hn::Mul(ray.sy, s.akz));
-  s.bx = hn::Sub(hn::Sub(hn::Load(d, v1 + ray.shearRow[0]), ray.shearOrigin[0]),
-                 hn::Mul(ray.sx, s.bkz));
-  s.by = hn::Sub(hn::Sub(hn::Load(d, v1 + ray.shearRow[1]), ray.shearOrigin[1]),
-                 hn::Mul(ray.sy, s.bkz));
-  s.cx = hn::Sub(hn::Sub(hn::Load(d, v2 + ray.shearRow[0]), ray.shearOrigin[0]),
-                 hn::Mul(ray.sx, s.ckz));
-  s.cy = hn::Sub(hn::Sub(hn::Load(d, v2 + ray.shearRow[1]), ray.shearOrigin[1]),
-                 hn::Mul(ray.sy, s.ckz));
+  s.akz = relative(v0, 2);
+  s.bkz = relative(v1, 2);
+  s.ckz = relative(v2, 2);
+  s.ax = hn::Sub(relative(v0, 0), hn::Mul(ray.sx, s.akz));
+  s.ay = hn::Sub(relative(v0, 1), hn::Mul(ray.sy, s.akz));
+  s.bx = hn::Sub(relative(v1, 0), hn::Mul(ray.sx, s.bkz));
+  s.by = hn::Sub(relative(v1, 1), hn::Mul(ray.sy, s.bkz));
+  s.cx = hn::Sub(relative(v2, 0), hn::Mul(ray.sx, s.ckz));
+  s.cy = hn::Sub(relative(v2, 1), hn::Mul(ray.sy, s.ckz));
   return s;
 }
 

@@ -76,6 +76,8 @@ using namespace wide_detail;  // Outcome
 
 namespace {
 
+// Lanes [first, first + size) of a wide node; `split` is the binary node's index in the
+// node's wide_shape when size >= 2.
 struct BinaryNode {
   uint32_t node;  // the wide node
   int first, size, split;
