@@ -222,7 +222,7 @@ std::string cubeScene(int size, int spp, const std::string& light) {
   return test::furnaceScene(size, spp, light);
 }
 
-TEST(EnvironmentRender, FurnaceUnderAUniformImage) {
+TEST(EnvironmentRender, FurnaceUnderAUniformImageOnBothBackends) {
   const test::TempDir dir;
   Image white(8, 8);
   for (vec3& c : white.pixels) c = vec3(1.0f);

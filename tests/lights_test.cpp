@@ -69,7 +69,7 @@ void expectClosedForm(const std::string& text, const Radiance& radiance, double 
   expectNearClosedForm(cmp, expected, absolute, tolerance);
 }
 
-TEST(AnalyticLights, PointLightIrradianceOnAPlane) {
+TEST(AnalyticLights, PointLightIrradianceOnAPlaneOnBothBackends) {
   // I = (2, 3, 4) * scale 1.5 at (0.5, 0.3, 2): the plane shows (albedo / pi) I cos / r^2.
   const glm::dvec3 light(0.5, 0.3, 2.0);
   const glm::dvec3 intensity = glm::dvec3(2.0, 3.0, 4.0) * 1.5;
@@ -88,7 +88,7 @@ TEST(AnalyticLights, PointLightIrradianceOnAPlane) {
       0.01, 1e-5);
 }
 
-TEST(AnalyticLights, SpotLightFalloff) {
+TEST(AnalyticLights, SpotLightFalloffOnBothBackends) {
   // A spot at (0, 0, 3) aimed straight down, cone 30 degrees with 10 of falloff, given by its
   // power: I = power / (2 pi (1 - (cosStart + cosEnd) / 2)) (pbrt-v4's SpotLight::Create).
   const double cosEnd = std::cos(30.0 * kPiD / 180.0);
@@ -114,7 +114,7 @@ TEST(AnalyticLights, SpotLightFalloff) {
       0.01, 1e-3);
 }
 
-TEST(AnalyticLights, DistantLightCosine) {
+TEST(AnalyticLights, DistantLightCosineOnBothBackends) {
   // Light arriving from direction (1, 0, 2) ("from" - "to"), "illuminance" 3 at normal
   // incidence: the plane shows (albedo / pi) * 3 * cos(theta), the same everywhere.
   const double cosTheta = 2.0 / std::sqrt(5.0);
@@ -132,7 +132,7 @@ std::string furnace(int spp, const char* light) {
 }
 using test::objectPixels;
 
-TEST(AnalyticLights, FurnaceUnderAConstantEnvironment) {
+TEST(AnalyticLights, FurnaceUnderAConstantEnvironmentOnBothBackends) {
   for (uint strategy : {kStrategyMis, kStrategyNee, kStrategyBsdf}) {
     SCOPED_TRACE(strategy);
     Scene scene =
@@ -154,7 +154,7 @@ TEST(AnalyticLights, FurnaceUnderAConstantEnvironment) {
   }
 }
 
-TEST(AnalyticLights, MaxDepthCountsScatteringEventsAsPbrtDoes) {
+TEST(AnalyticLights, MaxDepthCountsScatteringEventsAsPbrtDoesOnBothBackends) {
   // pbrt-v4's maxdepth counts scattering events: at 0 a camera ray adds the emission it finds
   // (the environment) and stops, so the cube is black; at 1 it is lit directly (0.5: the cube
   // is convex, so nothing comes from further bounces).
@@ -179,7 +179,7 @@ TEST(AnalyticLights, MaxDepthCountsScatteringEventsAsPbrtDoes) {
   }
 }
 
-TEST(AnalyticLights, TwoSidedAreaLightsEmitFromTheirBack) {
+TEST(AnalyticLights, TwoSidedAreaLightsEmitFromTheirBackOnBothBackends) {
   // A square light 2 above the plane, out of the camera's view: two-sided and facing up, it
   // lights the plane as the same square one-sided and facing down does (pbrt-v4's
   // "twosided"); one-sided and facing up, not at all.
@@ -550,7 +550,7 @@ TEST(AnalyticLights, SphereLightSamplerPassesChiSquare) {
   }
 }
 
-TEST(AnalyticLights, SphereLightIrradianceOnAPlane) {
+TEST(AnalyticLights, SphereLightIrradianceOnAPlaneOnBothBackends) {
   // A sphere of radius 0.5 and radiance 5 centred 1.2 above the plane (out of the camera's
   // view): irradiance
   // pi L sin^2(thetaMax) cos(theta) where it sees the whole sphere, so the plane shows

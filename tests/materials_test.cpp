@@ -181,7 +181,7 @@ ImageMean imageMean(const Image& image) {
 // In the furnace every material that loses no energy shows radiance 1, whatever it is; one
 // that absorbs shows less, never more. The camera sees the smooth-shaded sphere, which fills
 // the view; both backends, nothing invalid.
-TEST(MaterialsFurnace, NeverAboveOneAndOneWhenLossless) {
+TEST(MaterialsFurnace, NeverAboveOneAndOneWhenLosslessOnBothBackends) {
   Material transmissive = diffuseTransmission();
   transmissive.reflectance = vec3(0.5f);
   transmissive.transmittance = vec3(0.5f);
@@ -282,7 +282,7 @@ TEST(MaterialsShadingNormals, TwistedNormalsStayFiniteOnBothBackends) {
 
 // Smooth shading changes the image (the sphere's facets disappear) and the backends agree on
 // it, for the seed's materials too.
-TEST(MaterialsShadingNormals, SmoothSphereAgreesAndDiffersFromFlat) {
+TEST(MaterialsShadingNormals, SmoothSphereAgreesAndDiffersFromFlatOnBothBackends) {
   Scene scene = loadScene(test::kConfigs / "cornell-box.json");
   Material glass = dielectric(1.5f, 0.0f);
   scene.materials.push_back(glass);

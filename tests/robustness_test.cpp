@@ -71,7 +71,7 @@ TEST(RobustFurnace, ClosedFormOnBothBackendsUpToAlbedo099) {
 // of the same samples. The device sums a batch's samples in float (2,000 here) and the host
 // folds the float sums into its exact film after every batch; a plain float running sum of
 // the same samples is shown to be far off, so the bound can tell.
-TEST(RobustEnergy, MillionSamplePixelMatchesADoubleSum) {
+TEST(RobustEnergy, MillionSamplePixelOnVulkanMatchesADoubleSum) {
   Scene scene;
   scene.materials = {Material{vec3(0.5f, 0.6f, 0.7f), kMaterialDiffuse, vec3(0.0f), 0},
                      Material{vec3(0.0f), kMaterialDiffuse, vec3(5.0f, 4.0f, 3.0f), 0}};
@@ -145,7 +145,7 @@ SceneData litBox(const std::function<void(Scene&)>& extra) {
                 CameraDesc{vec3(0, 0, -0.9f), vec3(0, -0.3f, 0), vec3(0, 1, 0), 80.0f, 24, 24}, 64);
 }
 
-TEST(RobustDegenerate, SliverAndZeroAreaEmitters) {
+TEST(RobustDegenerate, SliverAndZeroAreaEmittersOnBothBackends) {
   const SceneData data = litBox([](Scene& scene) {
     // A needle-thin sliver emitter, and a zero-area (collinear) one that must never be sampled.
     scene.triangles.push_back(
@@ -160,7 +160,7 @@ TEST(RobustDegenerate, SliverAndZeroAreaEmitters) {
   expectSaneAndAgreeing(data, 8, 100.0f);
 }
 
-TEST(RobustDegenerate, CoplanarOverlappingSurfaces) {
+TEST(RobustDegenerate, CoplanarOverlappingSurfacesOnBothBackends) {
   const SceneData data = litBox([](Scene& scene) {
     addQuad(scene, vec3(0, -0.999f, 0), vec3(0, 0, 0.5f), vec3(0.5f, 0, 0), 1);
     addQuad(scene, vec3(0.2f, -0.999f, 0), vec3(0, 0, 0.5f), vec3(0.5f, 0, 0), 0);
@@ -168,7 +168,7 @@ TEST(RobustDegenerate, CoplanarOverlappingSurfaces) {
   expectSaneAndAgreeing(data, 8, 100.0f, /*requireAgreement=*/false);
 }
 
-TEST(RobustDegenerate, CameraInsideAClosedObject) {
+TEST(RobustDegenerate, CameraInsideAClosedObjectOnBothBackends) {
   // Inside a closed sphere of diffuse triangles lit by nothing: black, never NaN.
   Scene scene;
   scene.materials = {Material{vec3(0.8f), kMaterialDiffuse, vec3(0.0f), 0},
@@ -183,7 +183,7 @@ TEST(RobustDegenerate, CameraInsideAClosedObject) {
   for (const vec3& p : c.cpuImage.pixels) EXPECT_EQ(p, vec3(0.0f));
 }
 
-TEST(RobustDegenerate, EmitterFacingAwayAndGrazingLight) {
+TEST(RobustDegenerate, EmitterFacingAwayAndGrazingLightOnBothBackends) {
   // A floor lit by an emitter standing on it edge-on (cos at the light -> 0 along the floor)
   // and by one that faces away from everything (it lights nothing).
   Scene scene;
@@ -197,7 +197,7 @@ TEST(RobustDegenerate, EmitterFacingAwayAndGrazingLight) {
   expectSaneAndAgreeing(data, 8, 100.0f);
 }
 
-TEST(RobustDegenerate, TwoFacingMirrorsAtMaxDepth64) {
+TEST(RobustDegenerate, TwoFacingMirrorsAtMaxDepth64OnBothBackends) {
   Scene scene;
   scene.materials = {Material{vec3(1.0f), kMaterialMirror, vec3(0.0f), 0},
                      Material{vec3(0.5f), kMaterialDiffuse, vec3(1.0f), 0}};
@@ -241,7 +241,7 @@ void expectSameImages(const Comparison& c, const Comparison& unit) {
   }
 }
 
-TEST(RobustScale, CornellBoxScaledBy1eMinus4And1e4RendersTheSameImage) {
+TEST(RobustScale, CornellBoxScaledBy1eMinus4And1e4RendersTheSameImageOnBothBackends) {
   // Ray offsets scale with the coordinates and the intersection test is watertight, so the
   // image must not depend on the scene's units: no acne, no light leaking at the blocks.
   constexpr int kSize = 32, kSpp = 16;
@@ -254,7 +254,7 @@ TEST(RobustScale, CornellBoxScaledBy1eMinus4And1e4RendersTheSameImage) {
   }
 }
 
-TEST(RobustScale, CornellBoxFarFromTheOriginRendersTheSameImage) {
+TEST(RobustScale, CornellBoxFarFromTheOriginRendersTheSameImageOnBothBackends) {
   // Translated by 1e5 on every axis (coordinates rounded to float there, as a scene file
   // would be): the renderer moves it back next to the origin, exactly, so only the rounding
   // of the input geometry (at most 0.004 units in a 556-unit box) can change the image.

@@ -468,7 +468,7 @@ std::string cutoutScene(const std::string& textures, const std::string& alpha, i
 // A checkerboard alpha (4 x 4 squares over the screen, holes on the odd ones): the camera
 // sees the plane through a hole, lit where the hole straight above it lets the light through,
 // on both backends, against the same geometry worked out here.
-TEST(Textures, AlphaCutoutsPassRaysAndCastTheirShadow) {
+TEST(Textures, AlphaCutoutsPassRaysAndCastTheirShadowOnBothBackends) {
   const test::TempDir dir;
   const Scene scene = loadScene(
       dir.write("cutout.json",
@@ -510,7 +510,7 @@ TEST(Textures, AlphaCutoutsPassRaysAndCastTheirShadow) {
 
 // pbrt-v4's stochastic alpha: a screen of alpha 0.5 passes half the camera rays and half the
 // light, so the plane behind it averages 0.8 / 4.
-TEST(Textures, PartialAlphaPassesThatFractionOfRays) {
+TEST(Textures, PartialAlphaPassesThatFractionOfRaysOnBothBackends) {
   const test::TempDir dir;
   const Scene scene = loadScene(dir.write("half.json", cutoutScene("", "0.5", 256)));
   const SceneData data = prepareScene(scene, RenderSettings{});
@@ -531,7 +531,7 @@ namespace {
 
 // A bump map of a constant leaves the surface as it is: the same image, bit for bit, on both
 // backends, as without one.
-TEST(Textures, ConstantBumpMapLeavesTheImageUnchanged) {
+TEST(Textures, ConstantBumpMapLeavesTheImageUnchangedOnBothBackends) {
   const test::TempDir dir;
   const auto render = [&](const std::string& displacement) {
     const Scene scene = loadScene(dir.write(
@@ -551,7 +551,7 @@ TEST(Textures, ConstantBumpMapLeavesTheImageUnchanged) {
 // A displacement rising linearly along u (a 2 x 1 image of 0 and 1, bilinear between the texel
 // centres, scaled by 5: dD/du = 10) tilts the plane's shading normal by atan(10 / |dp/du|) =
 // atan(0.5) about v: under light from straight above the diffuse plane shows 0.8 cos(tilt).
-TEST(Textures, LinearBumpTiltsTheNormalAsPbrtsBumpMap) {
+TEST(Textures, LinearBumpTiltsTheNormalAsPbrtsBumpMapOnBothBackends) {
   const test::TempDir dir;
   TextureImage ramp;
   Image twoTexels(2, 1);
