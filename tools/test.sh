@@ -9,19 +9,18 @@ cmake --build build
 ctest --test-dir build --output-on-failure -j "$(nproc)"
 
 # The CPU side again under AddressSanitizer + UndefinedBehaviorSanitizer (docs/errors.md),
-# without NDEBUG so that every PT_DCHECK runs too. Tests that render on lavapipe (a name with
-# Vulkan, GpuTraversal, BothBackends or OnVulkan) stay in the normal run above: under ASan
-# their CPU halves take minutes. The Vulkan driver is hidden from this run, so a test that
-# renders on lavapipe without saying so in its name fails here ("no Vulkan driver found") and gets
-# renamed, rather than slowing this run unnoticed. One small render on lavapipe does run
-# under ASan, for the host side of the Vulkan backend (uploads, batches, read-back);
-# tests/lavapipe_under_asan_test.cpp keeps the driver loaded so that LeakSanitizer can see
-# what lavapipe's LLVM still holds at exit.
+# without NDEBUG so that every PT_DCHECK runs too. Tests that render on lavapipe (their names
+# match $lavapipe) stay in the normal run above: under ASan their CPU halves take minutes.
+# The Vulkan driver is hidden from this run, so a test that renders on lavapipe without
+# saying so in its name fails here ("no Vulkan driver found") and gets renamed, rather than
+# slowing this run unnoticed. One small render on lavapipe does run under ASan, for the host
+# side of the Vulkan backend (uploads, batches, read-back); tests/lavapipe_under_asan_test.cpp
+# keeps the driver loaded so that LeakSanitizer can see what lavapipe's LLVM still holds.
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DPT_SANITIZE=ON
 cmake --build build-asan --target pt_tests
+lavapipe='Vulkan|GpuTraversal|BothBackends|OnVulkan'
 # ray_bench (label bench) is not built here: only pt_tests is.
 VK_DRIVER_FILES=/nonexistent VK_ICD_FILENAMES=/nonexistent \
-  ctest --test-dir build-asan --output-on-failure -j "$(nproc)" \
-  -E 'Vulkan|GpuTraversal|BothBackends|OnVulkan' -LE 'slurm|bench'
+  ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -E "$lavapipe" -LE 'slurm|bench'
 ctest --test-dir build-asan --output-on-failure -R '^Vulkan\.CornellBoxMatchesCpuReference$'
