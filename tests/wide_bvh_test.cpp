@@ -11,6 +11,7 @@
 #include <random>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "brute_force.h"
@@ -139,10 +140,58 @@ void expectValidWideBvh(const Bvh& bvh, const WideBvh& wide) {
       }
     }
     EXPECT_GE(used, 1) << "node " << item.node << " holds nothing";
+    // A leaf lane's box is exactly its triangles' (a split leaf's two lanes each their own).
+    for (int i = 0; i < kWideLanes; ++i) {
+      if (node.child[i] == kWideEmpty || !(node.child[i] & kWideLeaf)) continue;
+      vec3 lo(INFINITY), hi(-INFINITY);
+      const uint32_t first = node.child[i] & ~kWideLeaf;
+      for (uint32_t p = first; p < first + node.packetCount[i]; ++p) {
+        for (uint32_t lane = 0; lane < wide.packets[p].count; ++lane) {
+          const Triangle t = wide.packets[p].triangle(lane);
+          lo = min(lo, min(t.v0, min(t.v1, t.v2)));
+          hi = max(hi, max(t.v0, max(t.v1, t.v2)));
+        }
+      }
+      EXPECT_EQ(lo, vec3(node.bounds[0][i], node.bounds[1][i], node.bounds[2][i]))
+          << "node " << item.node << " lane " << i;
+      EXPECT_EQ(hi, vec3(node.bounds[3][i], node.bounds[4][i], node.bounds[5][i]))
+          << "node " << item.node << " lane " << i;
+    }
   }
   for (size_t i = 0; i < n; ++i) ASSERT_EQ(seen[i], 1) << "triangle " << i;
   for (size_t p = 0; p < wide.packets.size(); ++p) ASSERT_EQ(packetSeen[p], 1) << "packet " << p;
   for (size_t k = 0; k < wide.nodes.size(); ++k) ASSERT_EQ(nodeSeen[k], 1) << "node " << k;
+}
+
+// The leaves that the collapse split over two lanes (wide_shape::leafSplit), checked: two
+// adjacent leaf lanes whose packets, and triangles, follow on from each other, so that the
+// degenerate rays' binary traversal reads them as the one leaf they were. Returns how many.
+int expectValidSplitLeaves(const WideBvh& wide) {
+  int splits = 0;
+  for (size_t n = 0; n < wide.nodes.size(); ++n) {
+    const WideNode& node = wide.nodes[n];
+    const uint64_t shape = wide.shapes[n];
+    // The binary ranges of the shape, as the traversal of degenerate rays walks them.
+    auto walk = [&](auto& self, int first, int size, int k) -> void {
+      if (size < 2) return;
+      const int half = wide_shape::split(shape, k);
+      if (!wide_shape::leafSplit(shape, k)) {
+        self(self, first, half, k + 1);
+        self(self, first + half, size - half, k + half);
+        return;
+      }
+      ++splits;
+      ASSERT_EQ(size, 2) << "node " << n;
+      ASSERT_EQ(half, 1) << "node " << n;
+      const uint32_t a = node.child[first], b = node.child[first + 1];
+      ASSERT_TRUE((a & kWideLeaf) && a != kWideEmpty && (b & kWideLeaf) && b != kWideEmpty);
+      EXPECT_EQ((a & ~kWideLeaf) + node.packetCount[first], b & ~kWideLeaf) << "node " << n;
+      const TrianglePacket& last = wide.packets[(b & ~kWideLeaf) - 1];
+      EXPECT_EQ(last.first + last.count, wide.packets[b & ~kWideLeaf].first) << "node " << n;
+    };
+    walk(walk, 0, wide_shape::lanes(shape), 0);
+  }
+  return splits;
 }
 
 // The binary order that the wide traversal keeps rests on every interior box being exactly
@@ -235,10 +284,17 @@ TEST(WideBvh, MatchesBruteForceAndTheBinaryTraversalOnBunny) {
     hits += expected[i].found;
   }
   EXPECT_GT(hits, kRays / 2);  // the test exercises hits, not just misses
-  for (BvhBuilder builder : kBuilders) {
-    SCOPED_TRACE(builderName(builder));
-    const Bvh bvh = buildBvh(bunny, BvhBuildOptions{4, builder});
+  // Leaves of up to 4 triangles (one packet), and of up to 8 (the CPU renderer's), which the
+  // collapse splits where a node has lanes to spare.
+  for (auto [builder, leafSize] : {std::pair{BvhBuilder::kLbvh, 4},
+                                   {BvhBuilder::kBinnedSah, 4},
+                                   {BvhBuilder::kPloc, 4},
+                                   {BvhBuilder::kPloc, 8}}) {
+    SCOPED_TRACE(builderName(builder) + ", leaf size " + std::to_string(leafSize));
+    const Bvh bvh = buildBvh(bunny, BvhBuildOptions{leafSize, builder});
     const WideBvh wide = buildWideBvh(bvh);
+    expectValidWideBvh(bvh, wide);
+    EXPECT_EQ(expectValidSplitLeaves(wide) > 0, leafSize > 4);
     int mismatches = 0, anyHitMismatches = 0;
     for (int i = 0; i < kRays; ++i) {
       const auto hit = closestHit(wide, rays[i]);
@@ -288,6 +344,7 @@ TEST(WideBvh, SameAnswersOnEveryInstructionSet) {
     SCOPED_TRACE("leaf size " + std::to_string(leafSize));
     const Bvh bvh = buildBvh(bunny, BvhBuildOptions{leafSize, BvhBuilder::kPloc});
     const WideBvh wide = buildWideBvh(bvh);
+    EXPECT_EQ(expectValidSplitLeaves(wide) > 0, leafSize > 4);
     forEachTarget([&] { EXPECT_EQ(countDifferences(bvh, wide, rays, tMax), 0); });
   }
 }
@@ -349,8 +406,6 @@ TEST(WideBvh, DegenerateRaysAsTheBinaryTraversal) {
   // Zero, NaN and infinite components in the direction or the origin, and huge origins: the
   // answer is the binary traversal's (for NaN rays: nothing, turned away at the root box).
   const std::vector<Triangle> sphere = test::makeSphere(vec3(0.5f, -0.25f, 2.0f), 1.0f, 12, 16);
-  const Bvh bvh = buildBvh(sphere, BvhBuildOptions{2});
-  const WideBvh wide = buildWideBvh(bvh);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = INFINITY;
   const vec3 origins[] = {vec3(0.5f, -0.25f, 2.0f), vec3(0.5f, -0.25f, -3.0f), vec3(0.0f),
@@ -376,7 +431,14 @@ TEST(WideBvh, DegenerateRaysAsTheBinaryTraversal) {
     rays.push_back(Ray{vec3(0.5f, -0.25f, 2.0f) + vec3(uni(rng), uni(rng), uni(rng)), d});
   }
   const std::vector<float> tMax(rays.size(), 5.0f);
-  forEachTarget([&] { EXPECT_EQ(countDifferences(bvh, wide, rays, tMax), 0); });
+  // Leaves of up to 2 triangles, and of up to 8, which the collapse splits over two lanes.
+  for (int leafSize : {2, 8}) {
+    SCOPED_TRACE("leaf size " + std::to_string(leafSize));
+    const Bvh bvh = buildBvh(sphere, BvhBuildOptions{leafSize});
+    const WideBvh wide = buildWideBvh(bvh);
+    EXPECT_EQ(expectValidSplitLeaves(wide) > 0, leafSize > 4);
+    forEachTarget([&] { EXPECT_EQ(countDifferences(bvh, wide, rays, tMax), 0); });
+  }
 }
 
 // How many of the rays meet, in some triangle of the mesh, an edge function that comes out

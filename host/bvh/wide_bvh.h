@@ -1,9 +1,9 @@
 // The CPU reference's copy of the BVH for SIMD traversal: the binary tree collapsed into
 // nodes of up to eight children whose boxes are tested together (each node opens the binary
-// nodes below it largest surface area first: buildWideBvh), and the leaves' triangles
-// repacked four to a packet in the structure-of-arrays layout that the four-lane watertight
-// test loads directly. The GPU keeps the binary tree (Bvh); this one
-// is built from it, after it, for the CPU backend only.
+// nodes below it largest surface area first, then splits leaves of two packets or more into
+// lanes it has left: buildWideBvh), and the leaves' triangles repacked four to a packet in
+// the structure-of-arrays layout that the four-lane watertight test loads directly. The GPU
+// keeps the binary tree (Bvh); this one is built from it, after it, for the CPU backend only.
 //
 // A query gives exactly the binary traversal's answer (traverse.h), not just an equally
 // valid one: same hit distance, same triangle, same barycentrics, bit for bit, because
@@ -76,29 +76,37 @@ struct alignas(16) TrianglePacket {
 };  // 176 bytes
 
 // How a wide node's lanes came out of the binary tree (WideBvh::shapes): the number of lanes
-// in use (bits 24 and up), and for each binary node in between, in depth-first order (the
+// in use (bits 24 to 27), and for each binary node in between, in depth-first order (the
 // node's own binary node first), how many of its lanes its left child covers (3 bits each).
 // A binary node k covering lanes [first, first + size), size >= 2, has its left child over
 // split(k) lanes from first, with index k + 1 if that is a range of two or more, and its
-// right child over the rest, with index k + split(k).
+// right child over the rest, with index k + split(k). Where leafSplit(k) (bit 32 + k), k is
+// not an interior node but a leaf whose triangles the collapse split over its two lanes
+// (their packets consecutive, in the leaf's order; its box the union of theirs).
 namespace wide_shape {
-constexpr uint32_t make(int lanes) {
-  return uint32_t(lanes) << 24;
+constexpr uint64_t make(int lanes) {
+  return uint64_t(lanes) << 24;
 }
-constexpr uint32_t withSplit(uint32_t shape, int k, int leftLanes) {
-  return shape | uint32_t(leftLanes) << (3 * k);
+constexpr uint64_t withSplit(uint64_t shape, int k, int leftLanes) {
+  return shape | uint64_t(leftLanes) << (3 * k);
 }
-constexpr int lanes(uint32_t shape) {
-  return int(shape >> 24);
+constexpr uint64_t withLeafSplit(uint64_t shape, int k) {
+  return shape | uint64_t(1) << (32 + k);
 }
-constexpr int split(uint32_t shape, int k) {
+constexpr int lanes(uint64_t shape) {
+  return int(shape >> 24 & 15u);
+}
+constexpr int split(uint64_t shape, int k) {
   return int(shape >> (3 * k) & 7u);
+}
+constexpr bool leafSplit(uint64_t shape, int k) {
+  return (shape >> (32 + k) & 1u) != 0;
 }
 }  // namespace wide_shape
 
 struct WideBvh {
   std::vector<WideNode> nodes;   // nodes[0] is the root: the binary root's descendants
-  std::vector<uint32_t> shapes;  // per node: wide_shape (only degenerate rays read it)
+  std::vector<uint64_t> shapes;  // per node: wide_shape (only degenerate rays read it)
   std::vector<TrianglePacket> packets;
   vec3 rootMin{0.0f}, rootMax{0.0f};  // the binary root's box, tested first as it is there
   int maxDepth = 0;                   // deepest wide node below the root (root = 0)

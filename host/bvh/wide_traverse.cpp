@@ -77,12 +77,14 @@ using namespace wide_detail;  // Outcome
 namespace {
 
 // Lanes [first, first + size) of a wide node; `split` is the binary node's index in the
-// node's wide_shape when size >= 2.
+// node's wide_shape when size >= 2. A leaf is one leaf lane, or two that the collapse split
+// it into (wide_shape::leafSplit).
 struct BinaryNode {
   uint32_t node;  // the wide node
   int first, size, split;
   bool isLeaf(const WideBvh& bvh) const {
-    return size == 1 && (bvh.nodes[node].child[first] & kWideLeaf);
+    return size == 1 ? (bvh.nodes[node].child[first] & kWideLeaf) != 0
+                     : size == 2 && wide_shape::leafSplit(bvh.shapes[node], split);
   }
 };
 
@@ -118,8 +120,11 @@ bool traverseAsBinary(const WideBvh& bvh, const Ray& ray, float tMax, Intersecti
   HitSearch search(tMax, filter);
   for (;;) {
     if (node.isLeaf(bvh)) {
-      const uint32_t first = bvh.nodes[node.node].child[node.first] & ~kWideLeaf;
-      const uint32_t count = bvh.nodes[node.node].packetCount[node.first];
+      // (A split leaf's packets are consecutive: its lanes' together are the leaf's.)
+      const WideNode& wide = bvh.nodes[node.node];
+      const uint32_t first = wide.child[node.first] & ~kWideLeaf;
+      uint32_t count = 0;
+      for (int i = node.first; i < node.first + node.size; ++i) count += wide.packetCount[i];
       const bool hit =
           test == Intersection::kWatertight
               ? wide_detail::intersectLeafLaneByLane<kAnyHit, true>(bvh, first, count, r, search)
