@@ -142,7 +142,6 @@ void laneNodes(const Bvh& bvh, uint32_t index, NodeLanes& lanes) {
     lanes.opened[lanes.openedCount++] = lanes.lane[i].node;
     return lanes.lane + i;
   };
-  lanes.lane[0].gain = 0.0f;  // the node's own binary node is always opened
   for (;;) {
     // (A leaf's plan is made only where its bound beats the best so far: the choice is the
     // one that planning every leaf would give.)

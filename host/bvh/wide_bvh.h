@@ -1,9 +1,10 @@
 // The CPU reference's copy of the BVH for SIMD traversal: the binary tree collapsed into
 // nodes of up to eight children whose boxes are tested together (each node opens the binary
-// nodes below it largest surface area first, then splits leaves of two packets or more into
-// lanes it has left: buildWideBvh), and the leaves' triangles repacked four to a packet in
-// the structure-of-arrays layout that the four-lane watertight test loads directly. The GPU
-// keeps the binary tree (Bvh); this one is built from it, after it, for the CPU backend only.
+// nodes below it, or splits a leaf of two packets or more over two lanes, whichever saves
+// the most SAH cost first: buildWideBvh), and the leaves' triangles repacked four to a
+// packet in the structure-of-arrays layout that the four-lane watertight test loads
+// directly. The GPU keeps the binary tree (Bvh); this one is built from it, after it, for the
+// CPU backend only.
 //
 // A query gives exactly the binary traversal's answer (traverse.h), not just an equally
 // valid one: same hit distance, same triangle, same barycentrics, bit for bit, because
