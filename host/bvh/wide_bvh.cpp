@@ -5,11 +5,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <cstring>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #ifdef __linux__
 #include <sys/mman.h>
+#include <unistd.h>
 #endif
 #ifdef PT_BVH_PROFILE
 #include <cstdio>
@@ -197,35 +200,35 @@ uint64_t laneShape(const Bvh& bvh, uint32_t index, const NodeLanes& lanes) {
   return shape;
 }
 
-// What Collapse::fill allocates for the wide node of binary node `index` and below: wide
-// nodes below it (not its own), and triangle packets (of its leaf lanes and below).
+// What Collapse::fill allocates below a wide node: wide nodes (not the node itself), and
+// triangle packets (of its leaf lanes and below).
 struct Counts {
   size_t nodes = 0, packets = 0;
 };
-Counts countBelow(const Bvh& bvh, uint32_t index) {
-  NodeLanes lanes;
-  laneNodes(bvh, index, lanes);
-  Counts counts;
-  for (int i = 0; i < lanes.count; ++i) {
-    const Lane& lane = lanes.lane[i];
-    if (lane.triangles > 0) {
-      counts.packets += packetsOf(lane.triangles);
-    } else {
-      const Counts below = countBelow(bvh, lane.node);
-      counts.nodes += 1 + below.nodes;
-      counts.packets += below.packets;
-    }
+
+// What Collapse::fill may allocate below binary node `index` (interior), without collapsing
+// it: at most one wide node per interior binary node under it (each wide node below it
+// stands for a distinct one), and exactly the packets of its leaves (a leaf split into two
+// lanes holds the leaf's packets between them). The subtree is the depth-first range from
+// `index` to its last node, the end of its rightmost path.
+Counts boundBelow(const Bvh& bvh, uint32_t index) {
+  uint32_t last = index;
+  while (bvh.nodes[last].count == 0) last = bvh.nodes[last].offset;
+  Counts bound;
+  bound.nodes = size_t(last - index) / 2 - 1;  // (nodes - 1) / 2 interior ones, less `index`
+  for (uint32_t n = index; n <= last; ++n) {
+    if (bvh.nodes[n].count > 0) bound.packets += packetsOf(bvh.nodes[n].count);
   }
-  return counts;
+  return bound;
 }
 
-// Fills the wide tree depth first, into arrays of their final sizes: a node's interior
-// children take consecutive slots (allocated as the node is filled, before anything below
-// them), and its leaf children's packets are consecutive, so that the children a ray visits
-// after one another tend to share pages and cache lines. The subtrees below kPieceDepth
-// are filled by the workers: each one's slots and packets start where the serial order
-// would put them (the counts of the subtrees before it), so the tree is the same for any
-// number of workers.
+// Fills the wide tree depth first: a node's interior children take consecutive slots
+// (allocated as the node is filled, before anything below them), and its leaf children's
+// packets are consecutive, so that the children a ray visits after one another tend to share
+// pages and cache lines. The subtrees below kPieceDepth are filled by the workers: each
+// one's packets start where the serial order would put them (the packets of the subtrees
+// before it), its slots after the bounds of the slots of those (boundBelow); buildWideBvh
+// then closes the gaps, so the tree is the same for any number of workers.
 class Collapse {
  public:
   // Wide nodes this deep are the roots of the pieces the workers fill (at most 8^2 = 64).
@@ -239,7 +242,7 @@ class Collapse {
   struct Piece {
     uint32_t at, index;
     int depth;
-    Counts counts;
+    Counts counts;  // boundBelow: its packets, and room for its nodes
     size_t firstNode = 0, firstPacket = 0;
   };
 
@@ -344,7 +347,8 @@ class Collapse {
   int maxDepth_ = 0;
 };
 
-// countBelow of binary node `index` at `depth`, from the counts of the pieces below it (from
+// The Counts below the wide node of binary node `index` at `depth` in the top levels, from
+// the counts (bounds, for nodes) of the pieces below it (from
 // pieces[piece] on, in the order fillTop lists them; `piece` moves past them).
 Counts countTop(const Bvh& bvh, uint32_t index, int depth,
                 const std::vector<Collapse::Piece>& pieces, size_t& piece) {
@@ -383,6 +387,62 @@ void adviseHugePages([[maybe_unused]] const std::vector<T>& v) {
 #endif
 }
 
+// Gives the pages of a vector's storage past its elements back to the system (Linux; the
+// vector is not grown again): the pieces' slots past the gaps were written before the nodes
+// moved down, and would otherwise stay resident (40 MB for the 1M-triangle sphere).
+template <typename T>
+void releaseTail([[maybe_unused]] std::vector<T>& v) {
+#ifdef __linux__
+  const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
+  const uintptr_t begin =
+      (reinterpret_cast<uintptr_t>(v.data() + v.size()) + page - 1) & ~(page - 1);
+  const uintptr_t end = reinterpret_cast<uintptr_t>(v.data() + v.capacity()) & ~(page - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
+#endif
+}
+
+// Moves the nodes down over the slots the pieces left unused (piece p used the first
+// used[p] of its counts.nodes from firstNode on; the pieces are in the order of their
+// slots), and renumbers the interior children to match: one memmove per stretch of used
+// slots, then every node's references in parallel.
+void closeGaps(WideBvh& wide, const std::vector<Collapse::Piece>& pieces,
+               const std::vector<size_t>& used, Workers& workers) {
+  static_assert(std::is_trivially_copyable_v<WideNode>);
+  // Old index i at or past gapEnd[k] (and before gapEnd[k + 1]) moves down by removed[k].
+  std::vector<size_t> gapEnd(pieces.size()), removed(pieces.size());
+  size_t from = 0, gone = 0;  // the stretch of used slots that starts at `from`
+  auto moveDown = [&](size_t end) {
+    if (gone > 0 && end > from) {
+      std::memmove(&wide.nodes[from - gone], &wide.nodes[from], (end - from) * sizeof(WideNode));
+      std::memmove(&wide.shapes[from - gone], &wide.shapes[from], (end - from) * sizeof(uint64_t));
+    }
+  };
+  for (size_t p = 0; p < pieces.size(); ++p) {
+    moveDown(pieces[p].firstNode + used[p]);
+    gone += pieces[p].counts.nodes - used[p];
+    from = pieces[p].firstNode + pieces[p].counts.nodes;
+    gapEnd[p] = from;
+    removed[p] = gone;
+  }
+  moveDown(wide.nodes.size());
+  const size_t size = wide.nodes.size() - gone;
+  wide.nodes.resize(size);
+  wide.shapes.resize(size);
+  wide.shapes.shrink_to_fit();
+  if (gone == 0) return;
+  releaseTail(wide.nodes);
+  workers.forChunks(size, 4096, [&](size_t begin, size_t end) {
+    for (size_t n = begin; n < end; ++n) {
+      for (uint32_t& child : wide.nodes[n].child) {
+        if (child == kWideEmpty || (child & kWideLeaf)) continue;
+        const size_t k =
+            size_t(std::upper_bound(gapEnd.begin(), gapEnd.end(), size_t(child)) - gapEnd.begin());
+        if (k > 0) child -= uint32_t(removed[k - 1]);
+      }
+    }
+  });
+}
+
 }  // namespace
 
 WideBvh buildWideBvh(const Bvh& bvh, int threads) {
@@ -402,11 +462,12 @@ WideBvh buildWideBvh(const Bvh& bvh, int threads) {
   Workers workers(int(
       std::min<size_t>(threads > 0 ? size_t(threads) : hardware, bvh.nodes.size() / 32768 + 1)));
   workers.forChunks(pieces.size(), 1,
-                    [&](size_t p, size_t) { pieces[p].counts = countBelow(bvh, pieces[p].index); });
-  // The whole tree's size from the pieces'; then the top again, writing.
+                    [&](size_t p, size_t) { pieces[p].counts = boundBelow(bvh, pieces[p].index); });
+  // The arrays' sizes from the pieces' (nodes: a bound); then the top again, writing.
   piece = 0;
   const Counts all = countTop(bvh, 0, 0, pieces, piece);
-  PT_CHECK(all.packets < size_t(kWideLeaf), "too many triangle packets");
+  PT_CHECK(all.packets < size_t(kWideLeaf) && all.nodes < size_t(kWideLeaf),
+           "too many triangle packets or nodes");
   wide.nodes.reserve(1 + all.nodes);
   wide.packets.reserve(all.packets);
   adviseHugePages(wide.packets);
@@ -419,16 +480,20 @@ WideBvh buildWideBvh(const Bvh& bvh, int threads) {
   top.fillTop(0, 0, 0, true, pieces, piece);
   PT_BVH_PHASE("fill the top");
   std::vector<int> depths(pieces.size());
+  std::vector<size_t> used(pieces.size());  // of each piece's slots
   workers.forChunks(pieces.size(), 1, [&](size_t p, size_t) {
     Collapse collapse(bvh, wide, pieces[p].firstNode, pieces[p].firstPacket);
     collapse.fill(pieces[p].at, pieces[p].index, pieces[p].depth);
-    PT_CHECK(collapse.nodesAllocated() == pieces[p].firstNode + pieces[p].counts.nodes &&
+    used[p] = collapse.nodesAllocated() - pieces[p].firstNode;
+    PT_CHECK(used[p] <= pieces[p].counts.nodes &&
              collapse.packetsAllocated() == pieces[p].firstPacket + pieces[p].counts.packets);
     depths[p] = collapse.maxDepth();
   });
   PT_BVH_PHASE("fill the pieces");
   PT_CHECK(top.nodesAllocated() == wide.nodes.size() &&
            top.packetsAllocated() == wide.packets.size());
+  closeGaps(wide, pieces, used, workers);
+  PT_BVH_PHASE("close the gaps");
   wide.maxDepth = top.maxDepth();
   for (int depth : depths) wide.maxDepth = std::max(wide.maxDepth, depth);
   wide.buildSeconds =
