@@ -348,8 +348,8 @@ class Collapse {
 };
 
 // The Counts below the wide node of binary node `index` at `depth` in the top levels, from
-// the counts (bounds, for nodes) of the pieces below it (from
-// pieces[piece] on, in the order fillTop lists them; `piece` moves past them).
+// those of the pieces below it (bounds, for nodes; from pieces[piece] on, in the order
+// fillTop lists them; `piece` moves past them).
 Counts countTop(const Bvh& bvh, uint32_t index, int depth,
                 const std::vector<Collapse::Piece>& pieces, size_t& piece) {
   NodeLanes lanes;
