@@ -904,8 +904,15 @@ class PlocBuilder {
       // The merges' new ids, n + node on in lane order, in their lanes.
       const __m512i outId = _mm512_mask_expand_epi32(
           id, merges, _mm512_add_epi32(lanes, _mm512_set1_epi32(int(n + node))));
-      for (int r = 0; r < 6; ++r) _mm512_mask_compressstoreu_ps(outRows[r] + out, keep, merged[r]);
-      _mm512_mask_compressstoreu_epi32(outIds + out, keep, outId);
+      // Compressed in registers, then stored under a mask of the first lanes (the same
+      // values): AMD's Zen 4 runs the compressing store to memory (vcompressps with a memory
+      // operand) as slow microcode. On an EPYC (Zen 4) the dragon's seven compactions took
+      // 37 ms with it, 12 ms this way.
+      const __mmask16 kept = __mmask16((1u << __builtin_popcount(keep)) - 1u);
+      for (int r = 0; r < 6; ++r) {
+        _mm512_mask_storeu_ps(outRows[r] + out, kept, _mm512_maskz_compress_ps(keep, merged[r]));
+      }
+      _mm512_mask_storeu_epi32(outIds + out, kept, _mm512_maskz_compress_epi32(keep, outId));
       out += uint32_t(__builtin_popcount(keep));
       if (merges == 0) continue;
       halfArea16(merged, mergedArea);
