@@ -529,15 +529,17 @@ bool traverseFromRoot(const WideBvh& bvh, const RayPrecomputed& r, float tMax, H
 // degenerate (no NaN or infinity in it, and a direction: wide_bvh.h; closestHit and anyHit
 // take those elsewhere).
 HWY_INLINE bool closestHitFromRoot(const WideBvh& bvh, const RayPrecomputed& ray, float tMax,
-                                   Intersection test, Hit& hit) {
-  return test == Intersection::kWatertight ? traverseFromRoot<false, true>(bvh, ray, tMax, hit)
-                                           : traverseFromRoot<false, false>(bvh, ray, tMax, hit);
+                                   Intersection test, Hit& hit, const HitFilter* filter = nullptr) {
+  return test == Intersection::kWatertight
+             ? traverseFromRoot<false, true>(bvh, ray, tMax, hit, filter)
+             : traverseFromRoot<false, false>(bvh, ray, tMax, hit, filter);
 }
 HWY_INLINE bool anyHitFromRoot(const WideBvh& bvh, const RayPrecomputed& ray, float tMax,
-                               Intersection test) {
+                               Intersection test, const HitFilter* filter = nullptr) {
   Hit hit;
-  return test == Intersection::kWatertight ? traverseFromRoot<true, true>(bvh, ray, tMax, hit)
-                                           : traverseFromRoot<true, false>(bvh, ray, tMax, hit);
+  return test == Intersection::kWatertight
+             ? traverseFromRoot<true, true>(bvh, ray, tMax, hit, filter)
+             : traverseFromRoot<true, false>(bvh, ray, tMax, hit, filter);
 }
 
 }  // namespace wide_traversal

@@ -37,57 +37,22 @@ Ray cameraRay(const Camera& camera, vec2 filmPoint);
 vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
                     bool debugPrint = false);
 
-// The path's state that a scattering event updates (sampleRadiance's variables of the same
-// names).
-struct PathState {
-  vec3 L;               // radiance gathered so far
-  vec3 beta;            // path throughput
-  float etaScale;       // product of the squared relative indices refracted through
-  float bsdfPdf;        // solid-angle pdf of the BSDF sample that produced the next ray
-  bool specularBounce;  // the next ray leaves a specular bounce
+// Alpha cut-outs (texture.h's alphaKeepsHit) as the traversal's filter of one ray's hits; u is
+// the ray's number (texture.h's pathAlphaRandom, shadowAlphaRandom).
+struct AlphaCutouts {
+  const SceneData* scene;
+  TextureTables tables;
+  float u;
+  static bool accept(const void* context, uint32_t triangle, const Hit& hit);
+  HitFilter filter() const { return HitFilter{accept, this}; }
 };
 
-// A path vertex on one of bsdf.h's materials (not diffuse or mirror), and what its scattering
-// event needs: the hit triangle and point, the geometric normal ng, the shading normal ns, the
-// direction towards the viewer wo, the ray offsets' scale, this event's random numbers (u) and
-// the coordinates of its random streams (pixel, sample, dimension).
-struct BsdfVertex {
-  const Triangle* triangle;
-  const Material* material;
-  vec3 p, ng, ns, wo;
-  float magnitude;
-  BounceRandom u;
-  uvec2 pixel;
-  uint32_t sampleIndex;
-  uint dim;
-  uint depth;  // scattering events so far, this one included (for --debug-pixel)
-};
+// Traces the shadow ray of light sample ls (path_vertex.h), drawn with uLight: true when
+// nothing blocks it (alpha cut-outs passed by). Adds it to `rays`.
+bool traceShadowRay(const SceneData& scene, const LightSample& ls, vec2 uLight, uint64_t& rays);
 
-// The scattering event at such a vertex, sampleRadiance's steps: light sampling with the
-// BSDF's f and pdf (unless it has only delta lobes), then BSDF sampling. Adds the light's
-// contribution to state.L, updates beta, etaScale, bsdfPdf and specularBounce, and returns
-// the new direction in wi with the geometric normal on its side (where the next ray starts) in
-// side; false when the path ends (no direction). sampleRadianceLanes runs it lane by lane, so
-// both give the same bits.
-bool scatterAtBsdfVertex(const SceneData& scene, const BsdfVertex& v, PathState& state, vec3& wi,
-                         vec3& side, uint64_t& rays, bool debugPrint);
-
-// Light sampling at a diffuse vertex (reflectance / pi = f) towards the analytic light (lights.h)
-// that `emitter` names: sampleRadiance's next-event estimation for such a light, exposed for
-// the lanes (integrator_lanes.h), which call it lane by lane. p, n (the shading normal facing
-// the viewer), ng (geometric), the ray offset's scale, the path throughput; returns the
-// contribution to L, weighed by MIS (misOn) unless the light is a delta.
-vec3 sampleAnalyticLightDiffuse(const SceneData& scene, const Emitter& emitter, vec3 p, vec3 n,
-                                vec3 ng, bool shadingNormals, float magnitude, vec3 beta, vec3 f,
-                                vec2 uLight, bool misOn, Intersection test, uint64_t& rays,
-                                bool debugPrint = false, uint depth = 0);
-
-// The radiance a path gathers when its ray leaves the scene along `direction`: the infinite
-// light's (none without one; an image's by direction), at full weight after a specular bounce
-// (or from the camera), else weighed as BSDF-sampled emission is (MIS, or nothing with light
-// sampling alone).
-vec3 environmentSeen(const SceneData& scene, vec3 direction, vec3 beta, bool specularBounce,
-                     float bsdfPdf);
+// --debug-pixel's line about a light sample found clear (the shader prints the same).
+void printLightSample(const SceneData& scene, uint depth, const LightSample& ls, float weight);
 
 // Renders into film (which must have the camera's resolution), adding spp samples per pixel
 // in passes of one sample index each; stopped early (options.stop), it adds whole passes

@@ -14,11 +14,7 @@ namespace pt {
 std::vector<TriangleShading> computeTriangleShading(const std::vector<Triangle>& triangles) {
   std::vector<TriangleShading> shading;
   shading.reserve(triangles.size());
-  for (const Triangle& t : triangles) {
-    const vec3 edgeCross = cross(t.v1 - t.v0, t.v2 - t.v0);
-    shading.push_back(TriangleShading{normalize(edgeCross), triangleMagnitude(t.v0, t.v1, t.v2),
-                                      0.5f * length(edgeCross)});
-  }
+  for (const Triangle& t : triangles) shading.push_back(triangleShadingOf(t));
   return shading;
 }
 

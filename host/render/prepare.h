@@ -15,6 +15,7 @@
 
 #include "bvh/bvh.h"
 #include "bvh/wide_bvh.h"
+#include "path_vertex.h"
 #include "scene/scene.h"
 #include "texture.h"
 
@@ -85,17 +86,8 @@ struct EffectSet {
   std::string toString() const;  // e.g. "diffuse+mirror+nee+mis+rr" (+"fast-isect", "sobol")
 };
 
-// What the CPU reference computes at every path vertex on a triangle, and at every light
-// sample on an emitting one, computed once per triangle with the same operations in the same
-// order (ptcore is compiled without fused multiply-adds), so that the values are, bit for bit,
-// the ones the integrator computed in place before. The shader computes them in place.
-struct TriangleShading {
-  vec3 normal;      // normalize(cross(v1 - v0, v2 - v0)): the unit geometric normal
-  float magnitude;  // triangleMagnitude(v0, v1, v2): the scale of the ray offsets there
-  float area;       // 0.5 * length(cross(v1 - v0, v2 - v0))
-};                  // 20 bytes
-
-// One TriangleShading per triangle, in the order of `triangles` (Bvh::triangles).
+// One TriangleShading (path_vertex.h) per triangle, in the order of `triangles`
+// (Bvh::triangles): what the CPU reads at every hit and light sample, computed once.
 std::vector<TriangleShading> computeTriangleShading(const std::vector<Triangle>& triangles);
 
 // What only the CPU reference reads: the wide copy of the BVH (wide_bvh.h) and the
@@ -168,6 +160,18 @@ struct SceneData {
   TextureTables textureTables() const {
     return TextureTables{textureNodes.data(), imageWords.data(), materialTextures.data(),
                          uvs.data()};
+  }
+  // What shaders/path_vertex.h reads on the CPU (builds cpuCopies on a first call).
+  PathScene pathScene() const {
+    return PathScene{&params,
+                     bvh.triangles.data(),
+                     cpuCopies().shading.data(),
+                     materials.data(),
+                     emitters.data(),
+                     lights.data(),
+                     normals.empty() ? nullptr : normals.data(),
+                     textureTables(),
+                     environmentTexels.data()};
   }
 };
 

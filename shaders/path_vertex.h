@@ -1,0 +1,542 @@
+// What a path does at a surface vertex, written once for the CPU reference, the CPU's vector
+// lanes and the shader (C++ through GLM, GLSL through #include): the shading point of a hit,
+// the emission a ray finds and its MIS weight, light sampling (choosing an emitter, a point or
+// direction on it, the shadow ray's ends, the sample's MIS weight and contribution), the BSDF
+// sample's continuation and Russian roulette. They are the steps of pbrt-v4's
+// PathIntegrator::Li and SampleLd; each integrator calls them in that order and keeps only
+// what is its own: how rays are traced (and when), how paths are scheduled, how the film is
+// written. The BSDFs are bsdf.h's, the lights lights.h's and environment.h's, the textures
+// texture.h's.
+//
+// What the functions read: in C++ a PathScene (the scene's arrays); in GLSL the includer
+// defines loadTriangle(i), loadMaterial(i), loadEmitter(i), loadLight(i), loadNormals(i),
+// triangleShadingAt(i, tri), environmentMap() and the global `params` before including this.
+// PT_SCENE_PARAM / PT_SCENE_ARG pass the PathScene in C++ and nothing in GLSL.
+//
+// Effects a scene does not use fold away in the shader: it defines the PT_HAS_* switches as
+// its specialization constants (C++ has them all, and tests the data). The shader variant
+// for scenes of Lambertian and mirror surfaces only defines PT_NO_BSDF_MATERIALS, and none of
+// bsdf.h's other materials, lights.h, texture.h and environment.h is compiled in.
+//
+// Floating-point operations are in the order the images of the renderer were made with:
+// backends that call these functions give the bits they gave before. Where a product is
+// grouped oddly for that reason, the comment says so.
+#ifndef PT_PATH_VERTEX_H
+#define PT_PATH_VERTEX_H
+
+#include "bsdf.h"
+#include "sampling.h"
+#include "shared_types.h"
+#ifndef PT_NO_BSDF_MATERIALS
+#include "environment.h"
+#include "lights.h"
+#include "texture.h"
+#endif
+
+#ifndef PT_HAS_DIFFUSE
+#define PT_HAS_DIFFUSE true
+#define PT_HAS_MIRROR true
+#define PT_HAS_NEE true
+#define PT_HAS_MIS true
+#define PT_HAS_BSDF_EMISSION true
+#define PT_HAS_RUSSIAN_ROULETTE true
+#define PT_HAS_SHADING_NORMALS true
+#define PT_HAS_TWO_SIDED_EMITTERS true
+#define PT_HAS_SPHERE_LIGHTS true
+#define PT_HAS_ANALYTIC_LIGHTS true
+#define PT_HAS_ENVIRONMENT true
+#define PT_HAS_ENVIRONMENT_IMAGE true
+#define PT_HAS_TEXTURES true
+#define PT_HAS_BUMP_MAPS true
+#define PT_HAS_BSDF_MATERIALS true
+#endif
+
+#ifdef __cplusplus
+namespace pt {
+#endif
+
+// A triangle's geometric normal, area and the scale of the ray offsets there: what every hit
+// and every light sample on it needs. The CPU computes them once per triangle
+// (computeTriangleShading, render/prepare.h); the shader at each use. Same operations, same
+// bits (host code is compiled without fused multiply-adds).
+struct TriangleShading {
+  vec3 normal;      // normalize(cross(v1 - v0, v2 - v0)): the unit geometric normal
+  float magnitude;  // triangleMagnitude(v0, v1, v2): the scale of the ray offsets there
+  float area;       // 0.5 * length(cross(v1 - v0, v2 - v0))
+};
+
+PT_INLINE TriangleShading triangleShadingOf(Triangle t) {
+  vec3 edgeCross = cross(t.v1 - t.v0, t.v2 - t.v0);
+  return TriangleShading(normalize(edgeCross), triangleMagnitude(t.v0, t.v1, t.v2),
+                         0.5f * length(edgeCross));
+}
+
+#ifdef __cplusplus
+// The scene's arrays as the vertex functions read them on the CPU.
+struct PathScene {
+  const RenderParams* params;
+  const Triangle* triangles;       // Bvh::triangles
+  const TriangleShading* shading;  // by triangle
+  const Material* materials;
+  const Emitter* emitters;
+  const Light* lights;
+  const TriangleNormals* normals;  // by Triangle::primitive; null without vertex normals
+  TextureTables textures;
+  const vec4* environmentTexels;
+};
+#define PT_SCENE_PARAM const PathScene &scene,
+#define PT_SCENE_ARG scene,
+#define PT_SCENE_ONLY scene
+#define PT_SCENE_PARAM_ONLY const PathScene& scene
+#define PT_PARAMS (*scene.params)
+#define PT_SCENE_TEXTURES scene.textures,
+inline Triangle loadTriangle(const PathScene& scene, uint i) {
+  return scene.triangles[i];
+}
+inline TriangleShading triangleShadingAt(const PathScene& scene, uint i, const Triangle&) {
+  return scene.shading[i];
+}
+inline Material loadMaterial(const PathScene& scene, uint i) {
+  return scene.materials[i];
+}
+inline Emitter loadEmitter(const PathScene& scene, uint i) {
+  return scene.emitters[i];
+}
+inline Light loadLight(const PathScene& scene, uint i) {
+  return scene.lights[i];
+}
+inline TriangleNormals loadNormals(const PathScene& scene, uint primitive) {
+  return scene.normals[primitive];
+}
+inline EnvironmentMap environmentMap(const PathScene& scene) {
+  const RenderParams& p = *scene.params;
+  return EnvironmentMap{p.environmentX,         p.environmentY,      p.environmentZ,
+                        p.environmentWidth,     p.environmentHeight, p.environmentMapping,
+                        scene.environmentTexels};
+}
+#else
+TriangleShading triangleShadingAt(uint i, Triangle tri) {
+  return triangleShadingOf(tri);
+}
+#define PT_SCENE_PARAM
+#define PT_SCENE_ARG
+#define PT_SCENE_ONLY
+#define PT_SCENE_PARAM_ONLY
+#define PT_PARAMS params
+#define PT_SCENE_TEXTURES
+#endif
+
+// ---- The strategy ---------------------------------------------------------------------------
+// Light sampling, BSDF-sampled emission, their MIS and Russian roulette, as the scene and the
+// command line ask (--strategy, --rr) and the effects allow.
+
+PT_INLINE bool neeOn(PT_SCENE_PARAM_ONLY) {
+  return PT_HAS_NEE && PT_PARAMS.emitterCount > 0u && PT_PARAMS.strategy != kStrategyBsdf;
+}
+PT_INLINE bool misOn(PT_SCENE_PARAM_ONLY) {
+  return PT_HAS_MIS && PT_PARAMS.strategy == kStrategyMis;
+}
+PT_INLINE bool bsdfEmissionOn(PT_SCENE_PARAM_ONLY) {
+  return PT_HAS_BSDF_EMISSION && PT_PARAMS.strategy != kStrategyNee;
+}
+PT_INLINE bool rouletteOn(PT_SCENE_PARAM_ONLY) {
+  return PT_HAS_RUSSIAN_ROULETTE && PT_PARAMS.russianRoulette != 0u;
+}
+
+// ---- The path and its vertex ------------------------------------------------------------------
+
+// What a path carries from one vertex to the next (pbrt-v4's names).
+struct PathState {
+  vec3 L;               // radiance gathered so far
+  vec3 beta;            // path throughput
+  float etaScale;       // product of the squared relative indices refracted through (for RR)
+  float bsdfPdf;        // solid-angle pdf of the BSDF sample that produced the ray
+  bool specularBounce;  // the ray leaves a specular bounce (or the camera)
+};
+
+// A path at the camera: nothing gathered, throughput 1; the camera ray counts as specular, so
+// that emission it finds is taken at full weight.
+PT_INLINE PathState startPathState() {
+  return PathState(vec3(0.0f), vec3(1.0f), 1.0f, 0.0f, true);
+}
+
+// The coordinates of a scattering event's random numbers (sampling.h): the BSDFs' random
+// streams are drawn from them (bsdf.h's makeRandomStream).
+struct VertexKey {
+  uvec2 pixel;  // the film's pixel
+  uint sampleIndex;
+  uint dim;  // the event's first dimension, kDimFirstBounce + kDimsPerBounce * bounce
+};
+
+// How a vertex scatters: Lambertian and the ideal mirror about the normal facing the viewer in
+// world space, or one of bsdf.h's materials in its shading frame.
+PT_CONST uint kScatterLambertian = 0u;
+PT_CONST uint kScatterMirror = 1u;
+PT_CONST uint kScatterBsdf = 2u;
+
+// A path's vertex on a surface: what light sampling, BSDF sampling and the next ray read.
+struct SurfacePoint {
+  Material material;    // its textured parameters resolved at the hit
+  vec3 p;               // the hit point, from the barycentrics
+  vec3 ng;              // unit geometric normal
+  vec3 ns;              // shading normal (ng without vertex normals or bump), not turned to wo
+  vec3 n;               // ns or ng turned towards wo: Lambertian and mirror shade about it
+  vec3 wo;              // unit direction towards the previous vertex
+  float cosOut;         // dot(ng, wo)
+  float magnitude;      // the ray offsets' scale (sampling.h's offsetRayOrigin)
+  float area;           // the triangle's area (the density of light sampling's points on it)
+  bool shadingNormals;  // ns may differ from ng
+  uint scatter;         // kScatter*
+  ShadingFrame frame;   // bsdf.h's frame about ns (kScatterBsdf only)
+  vec3 woLocal;         // wo in that frame
+};
+
+// The shading point of a hit on triangle `index` (tri) at barycentrics b (weights of v0, v1,
+// v2), seen from direction wo.
+PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, vec3 b, vec3 wo) {
+  SurfacePoint s;
+  s.material = loadMaterial(PT_SCENE_ARG tri.material);
+#ifndef PT_NO_BSDF_MATERIALS
+  // The parameters that textures give, at the hit's texture coordinates.
+  vec2 uv = vec2(0.0f);
+  MaterialTextures textures;
+  bool textured = (PT_HAS_TEXTURES || PT_HAS_BUMP_MAPS) && PT_PARAMS.texturesPresent != 0u;
+  if (textured) {
+    uv = interpolatedUV(uvsAt(PT_SCENE_TEXTURES tri.primitive), b);
+    textures = materialTexturesAt(PT_SCENE_TEXTURES tri.material);
+    if (PT_HAS_TEXTURES) s.material = resolveMaterial(PT_SCENE_TEXTURES s.material, textures, uv);
+  }
+#endif
+  TriangleShading shading = triangleShadingAt(PT_SCENE_ARG index, tri);
+  s.p = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
+  s.ng = shading.normal;
+  s.magnitude = shading.magnitude;
+  s.area = shading.area;
+  s.wo = wo;
+  s.cosOut = dot(s.ng, wo);
+  // Lambertian and mirror surfaces are two-sided: shaded with the normal facing the ray. With
+  // vertex normals, about the interpolated normal. (pbrt-v4 does not guard against the light
+  // leaks a shading normal can cause, and nor do we: BSDFs are evaluated about ns whichever
+  // side of the geometric surface wi is on; rays leave on the side of ng they go to.)
+  s.n = s.cosOut >= 0.0f ? s.ng : -s.ng;
+  s.ns = s.ng;
+  s.shadingNormals = PT_HAS_SHADING_NORMALS && PT_PARAMS.normalsPresent != 0u;
+#ifndef PT_NO_BSDF_MATERIALS
+  TriangleNormals normals;
+  if (s.shadingNormals) {
+    normals = loadNormals(PT_SCENE_ARG tri.primitive);
+    s.ns = interpolatedNormal(normals, b, s.ng);
+    s.n = dot(s.ns, wo) >= 0.0f ? s.ns : -s.ns;
+  }
+  // A bump map moves the shading normal (texture.h).
+  if (PT_HAS_BUMP_MAPS && textured && textures.displacement != kNoTexture) {
+    vec3 bumped = bumpedNormal(PT_SCENE_TEXTURES textures.displacement, tri,
+                               uvsAt(PT_SCENE_TEXTURES tri.primitive), uv, s.ng, s.ns,
+                               s.shadingNormals, normals);
+    if (bumped != s.ns) {
+      s.ns = bumped;
+      s.shadingNormals = true;
+      s.n = dot(s.ns, wo) >= 0.0f ? s.ns : -s.ns;
+    }
+  }
+#endif
+  // The switches fold the type tests away where a scene has one kind of surface.
+  uint type = s.material.type;
+  if (PT_HAS_MIRROR && ((!PT_HAS_DIFFUSE && !PT_HAS_BSDF_MATERIALS) || type == kMaterialMirror)) {
+    s.scatter = kScatterMirror;
+  } else if (PT_HAS_BSDF_MATERIALS && (!PT_HAS_DIFFUSE || type != kMaterialDiffuse)) {
+    s.scatter = kScatterBsdf;
+  } else {
+    s.scatter = kScatterLambertian;
+  }
+#ifndef PT_NO_BSDF_MATERIALS
+  if (s.scatter == kScatterBsdf) {
+    // The frame about the shading normal, not turned towards the ray: a dielectric tells
+    // inside from outside by it.
+    s.frame = makeShadingFrame(s.ns, tri.v1 - tri.v0);
+    s.woLocal = toLocal(s.frame, wo);
+  }
+#endif
+  return s;
+}
+
+// ---- Emission found by a ray -------------------------------------------------------------
+
+// Adds the emission of the surface the path's ray found (triangle tri, `t` along the unit ray
+// from rayOrigin) where it emits towards the ray: on its geometric normal's side, or on both.
+// At full weight after a specular bounce (or from the camera); else weighed against the chance
+// that light sampling had produced the same point (MIS), or not counted (light sampling
+// alone).
+PT_INLINE void addEmissionFound(PT_SCENE_PARAM PT_INOUT(PathState) path, Triangle tri,
+                                SurfacePoint s, float t, vec3 rayOrigin) {
+  float cosEmit =
+      (PT_HAS_TWO_SIDED_EMITTERS && s.material.twoSided != 0u) ? abs(s.cosOut) : s.cosOut;
+  if (tri.emitter == kNoEmitter || !(cosEmit > 0.0f)) return;
+  vec3 Le = s.material.emission;
+  if (path.specularBounce) {
+    path.L += path.beta * Le;
+  } else if (bsdfEmissionOn(PT_SCENE_ONLY)) {
+    float weight = 1.0f;
+    if (misOn(PT_SCENE_ONLY)) {
+      // Light sampling's density of this point: uniform on the triangle, per solid angle.
+      Emitter emitter = loadEmitter(PT_SCENE_ARG tri.emitter);
+      float lightPdf = emitter.pmf * t * t / (cosEmit * s.area);
+#ifndef PT_NO_BSDF_MATERIALS
+      // A sphere light's triangle: light sampling draws its cone (seen from the ray's origin).
+      if (PT_HAS_SPHERE_LIGHTS && (emitter.triangle & kEmitterLight) != 0u) {
+        lightPdf =
+            emitter.pmf *
+            sphereLightPdf(loadLight(PT_SCENE_ARG emitter.triangle & ~kEmitterLight), rayOrigin);
+      }
+#endif
+      weight = powerHeuristic(path.bsdfPdf, lightPdf);
+    }
+    path.L += path.beta * weight * Le;
+  }
+}
+
+// Adds the infinite light's radiance seen by a ray that leaves the scene along `direction`
+// (none without one; an image's by direction), weighed as emission found on a surface is.
+PT_INLINE void addEnvironmentFound(PT_SCENE_PARAM PT_INOUT(PathState) path, vec3 direction) {
+#ifndef PT_NO_BSDF_MATERIALS
+  if (!PT_HAS_ENVIRONMENT || PT_PARAMS.environmentEmitter == kNoEmitter) return;
+  vec3 Le = PT_PARAMS.environment;
+  float lightPdf = PT_PARAMS.environmentPdf;
+  if (PT_HAS_ENVIRONMENT_IMAGE && PT_PARAMS.environmentWidth != 0u) {
+    // The image: the direction's texel, and its density times the light's pmf.
+    EnvironmentLookup e = environmentLookup(environmentMap(PT_SCENE_ONLY), direction);
+    Le = e.Le;
+    lightPdf = PT_PARAMS.environmentPdf * e.pdf;
+  }
+  if (path.specularBounce) {
+    path.L += path.beta * Le;
+  } else if (bsdfEmissionOn(PT_SCENE_ONLY)) {
+    float weight = 1.0f;
+    if (misOn(PT_SCENE_ONLY)) weight = powerHeuristic(path.bsdfPdf, lightPdf);
+    path.L += path.beta * weight * Le;
+  }
+#endif
+}
+
+// ---- Light sampling (next-event estimation) -----------------------------------------------
+
+// Whether light sampling is done at the vertex: the strategy asks for it, and the surface has
+// a lobe it can find (not a mirror, not black, not only delta lobes).
+PT_INLINE bool samplesLightAt(PT_SCENE_PARAM SurfacePoint s) {
+  if (!neeOn(PT_SCENE_ONLY) || s.scatter == kScatterMirror) return false;
+#ifndef PT_NO_BSDF_MATERIALS
+  if (s.scatter == kScatterBsdf) return bsdfHasNonSpecular(s.material);
+#endif
+  return s.material.reflectance != vec3(0.0f);
+}
+
+// A light sample seen from a vertex, before its shadow ray is traced. Its contribution, once
+// the ray from `from` to `to` (t in [0, 1)) is found clear, is
+//   beta * f * Li * (scale * weight / lightPdf)
+// with the MIS weight from lightSampleContribution. f is the BSDF's value times |cos| towards
+// the light, but for a Lambertian surface lit by an emissive triangle, whose cosine is `scale`
+// (the products in the order the renderer's images were made with); scale is 1 otherwise.
+struct LightSample {
+  bool found;      // false: nothing to trace (the light faces away, or no BSDF value)
+  vec3 from;       // the shadow ray's origin, offset from the surface
+  vec3 to;         // its end: offset from the light's point, or beyond the scene
+  vec3 f;          // see above
+  float scale;     // see above
+  vec3 Li;         // radiance arriving (a delta light's weight)
+  float lightPdf;  // the probability of the emitter times the density of the sample
+  float cosTheta;  // Lambertian: dot(n, wi), for the BSDF's density
+  vec3 wiLocal;    // bsdf.h's materials: wi in the shading frame, for the BSDF's density
+  bool delta;      // a point, spot or distant light: no MIS (BSDF sampling never finds it)
+  uint emitter;    // Emitter::triangle of the emitter chosen (for --debug-pixel)
+};
+
+PT_INLINE LightSample noLightSample() {
+  return LightSample(false, vec3(0.0f), vec3(0.0f), vec3(0.0f), 1.0f, vec3(0.0f), 0.0f, 0.0f,
+                     vec3(0.0f), false, 0u);
+}
+
+// The side of the geometric surface a ray towards w leaves from.
+PT_INLINE vec3 geometricSide(SurfacePoint s, vec3 w) {
+  return dot(s.ng, w) > 0.0f ? s.ng : -s.ng;
+}
+
+// Samples the light from vertex s (pbrt-v4's SampleLd): an emitter from the alias table with
+// uChoose, and with uLight a uniform point on its triangle or a sample of the analytic light
+// (lights.h, environment.h) it names; the BSDF's value towards it, and the shadow ray's ends.
+// The shadow ray leaves along n from a Lambertian surface without shading normals, else from
+// the side of the geometric surface the light is on.
+PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM SurfacePoint s, VertexKey key, vec2 uChoose,
+                                    vec2 uLight) {
+  LightSample ls = noLightSample();
+  uint slot = aliasTableSlot(uChoose.x, PT_PARAMS.emitterCount);
+  Emitter emitter =
+      loadEmitter(PT_SCENE_ARG aliasTablePick(slot, loadEmitter(PT_SCENE_ARG slot), uChoose.y));
+  ls.emitter = emitter.triangle;
+  bool lambertian = s.scatter != kScatterBsdf;
+  vec3 wi;
+#ifndef PT_NO_BSDF_MATERIALS
+  if (PT_HAS_ANALYTIC_LIGHTS && (emitter.triangle & kEmitterLight) != 0u) {
+    // An analytic light: the environment image's sample for an infinite light that has one,
+    // lights.h's otherwise.
+    Light light = loadLight(PT_SCENE_ARG emitter.triangle & ~kEmitterLight);
+    AnalyticLightSample analytic;
+    if (PT_HAS_ENVIRONMENT_IMAGE && light.type == kLightInfinite &&
+        PT_PARAMS.environmentWidth != 0u) {
+      analytic =
+          sampleEnvironmentLight(environmentMap(PT_SCENE_ONLY), s.p, uLight, PT_PARAMS.sceneRadius);
+    } else {
+      analytic = sampleAnalyticLight(light, s.p, uLight, PT_PARAMS.sceneRadius);
+    }
+    wi = analytic.wi;
+    if (lambertian) {
+      ls.cosTheta = dot(s.n, wi);
+      if (!(ls.cosTheta > 0.0f) || !(maxComponent(analytic.Li) > 0.0f)) return ls;
+      ls.f = s.material.reflectance * kInvPi * ls.cosTheta;
+    } else {
+      if (!(maxComponent(analytic.Li) > 0.0f)) return ls;
+      ls.wiLocal = toLocal(s.frame, wi);
+      ls.f = bsdfF(s.material, s.woLocal, ls.wiLocal,
+                   makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed,
+                                    kStreamEval)) *
+             absCosTheta(ls.wiLocal);
+      if (!(maxComponent(ls.f) > 0.0f)) return ls;
+    }
+    ls.to = analytic.target;
+    ls.Li = analytic.Li;
+    ls.lightPdf = emitter.pmf * analytic.pdf;
+    ls.delta = analytic.delta;
+  } else
+#endif
+  {
+    // An emissive triangle: a uniform point on it.
+    Triangle light = loadTriangle(PT_SCENE_ARG emitter.triangle);
+    TriangleShading lightShading = triangleShadingAt(PT_SCENE_ARG emitter.triangle, light);
+    Material lightMaterial = loadMaterial(PT_SCENE_ARG light.material);
+    vec2 b = sampleTriangleBarycentrics(uLight);
+    vec3 point = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
+    vec3 lightNormal = lightShading.normal;  // it emits on this side
+    vec3 toLight = point - s.p;
+    float dist2 = dot(toLight, toLight);
+    wi = toLight / sqrt(dist2);
+    float cosLight = -dot(lightNormal, wi);  // > 0: the point sees the emitting side
+    // A two-sided light seen from its back: the side the point sees is the emitting one, its
+    // normal turned towards the point (for the cosine and the shadow ray's offset).
+    if (PT_HAS_TWO_SIDED_EMITTERS && lightMaterial.twoSided != 0u && cosLight < 0.0f) {
+      cosLight = -cosLight;
+      lightNormal = -lightNormal;
+    }
+    if (lambertian) {
+      ls.cosTheta = dot(s.n, wi);
+      if (!(cosLight > 0.0f && ls.cosTheta > 0.0f)) return ls;
+      ls.f = s.material.reflectance * kInvPi;
+      ls.scale = ls.cosTheta;
+    } else {
+#ifndef PT_NO_BSDF_MATERIALS
+      if (!(cosLight > 0.0f)) return ls;
+      ls.wiLocal = toLocal(s.frame, wi);
+      ls.f = bsdfF(s.material, s.woLocal, ls.wiLocal,
+                   makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed,
+                                    kStreamEval)) *
+             absCosTheta(ls.wiLocal);
+      if (!(maxComponent(ls.f) > 0.0f)) return ls;
+#endif
+    }
+    ls.to = offsetRayOrigin(point, lightNormal, lightShading.magnitude);
+    ls.Li = lightMaterial.emission;
+    ls.lightPdf = emitter.pmf * dist2 / (cosLight * lightShading.area);
+  }
+  vec3 side = (lambertian && !s.shadingNormals) ? s.n : geometricSide(s, wi);
+  ls.from = offsetRayOrigin(s.p, side, s.magnitude);
+  ls.found = true;
+  return ls;
+}
+
+// The contribution of a light sample whose shadow ray was found clear, with the path's
+// throughput beta, weighed by the power heuristic against BSDF sampling's density of the same
+// direction (MIS; not for delta lights); the weight in `weight`.
+PT_INLINE vec3 lightSampleContribution(PT_SCENE_PARAM SurfacePoint s, VertexKey key, LightSample ls,
+                                       vec3 beta, PT_OUT(float) weight) {
+  weight = 1.0f;
+  if (misOn(PT_SCENE_ONLY) && !ls.delta) {
+    float bsdfDensity = ls.cosTheta * kInvPi;
+#ifndef PT_NO_BSDF_MATERIALS
+    if (s.scatter == kScatterBsdf) {
+      bsdfDensity = bsdfPdf(
+          s.material, s.woLocal, ls.wiLocal,
+          makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed, kStreamLightPdf));
+    }
+#endif
+    weight = powerHeuristic(ls.lightPdf, bsdfDensity);
+  }
+  return beta * ls.f * ls.Li * (ls.scale * weight / ls.lightPdf);
+}
+
+// ---- BSDF sampling and Russian roulette ---------------------------------------------------
+
+// Samples the BSDF at vertex s for the path's next direction wi (uLobe: the choice between
+// lobes, uBsdf: the direction) and updates the path's throughput, the sample's density (for
+// MIS at the next vertex), whether it was specular, and etaScale. False: no direction, the
+// path ends.
+PT_INLINE bool sampleBsdfAt(PT_SCENE_PARAM SurfacePoint s, VertexKey key, PT_INOUT(PathState) path,
+                            float uLobe, vec2 uBsdf, PT_OUT(vec3) wi) {
+  if (s.scatter == kScatterMirror) {
+    // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
+    vec3 d = -s.wo;
+    wi = d - 2.0f * dot(d, s.n) * s.n;
+    path.beta *= s.material.reflectance;
+    path.specularBounce = true;
+    return true;
+  }
+#ifndef PT_NO_BSDF_MATERIALS
+  if (s.scatter == kScatterBsdf) {
+    BsdfSample bs = bsdfSample(
+        s.material, s.woLocal, uLobe, uBsdf,
+        makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed, kStreamSample));
+    if (bs.flags == 0u) return false;
+    wi = fromLocal(s.frame, bs.wi);
+    path.beta *= bs.f * (absCosTheta(bs.wi) / bs.pdf);
+    path.specularBounce = (bs.flags & kBsdfSpecular) != 0u;
+    path.bsdfPdf = bs.pdfIsProportional
+                       ? bsdfPdf(s.material, s.woLocal, bs.wi,
+                                 makeRandomStream(key.pixel, key.sampleIndex, key.dim,
+                                                  PT_PARAMS.seed, kStreamSamplePdf))
+                       : bs.pdf;
+    if ((bs.flags & kBsdfTransmission) != 0u) path.etaScale *= bs.eta * bs.eta;
+    return true;
+  }
+#endif
+  // Lambertian: cosine-weighted, so f * cos / pdf = reflectance. A direction in the tangent
+  // plane contributes nothing.
+  wi = localToWorld(sampleCosineHemisphere(uBsdf), s.n);
+  path.bsdfPdf = dot(wi, s.n) * kInvPi;
+  if (!(path.bsdfPdf > 0.0f)) return false;
+  path.beta *= s.material.reflectance;
+  path.specularBounce = false;
+  return true;
+}
+
+// Russian roulette after `depth` scattering events, with uniform number u: false when the path
+// is terminated; the survivors' throughput is scaled up (unbiased). The probability follows
+// beta times etaScale (pbrt-v4's), which refractions do not inflate.
+PT_INLINE bool survivesRoulette(PT_SCENE_PARAM PT_INOUT(PathState) path, uint depth, float u) {
+  if (!rouletteOn(PT_SCENE_ONLY) || depth < PT_PARAMS.rrStartDepth) return true;
+  float q =
+      max(0.0f, 1.0f - maxComponent(PT_HAS_BSDF_MATERIALS ? path.beta * path.etaScale : path.beta));
+  if (u < q) return false;
+  path.beta /= 1.0f - q;
+  return true;
+}
+
+// Where the path's next ray, towards wi, starts: offset from the surface on the side it goes
+// to (along n from a Lambertian or mirror surface without shading normals, which wi leaves on
+// n's side).
+PT_INLINE vec3 nextRayOrigin(SurfacePoint s, vec3 wi) {
+  vec3 side = (s.scatter != kScatterBsdf && !s.shadingNormals) ? s.n : geometricSide(s, wi);
+  return offsetRayOrigin(s.p, side, s.magnitude);
+}
+
+#ifdef __cplusplus
+}  // namespace pt
+#endif
+
+#endif  // PT_PATH_VERTEX_H
