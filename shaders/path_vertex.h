@@ -90,22 +90,22 @@ struct PathScene {
 #define PT_SCENE_PARAM_ONLY const PathScene& scene
 #define PT_PARAMS (*scene.params)
 #define PT_SCENE_TEXTURES scene.textures,
-inline Triangle loadTriangle(const PathScene& scene, uint i) {
+inline const Triangle& loadTriangle(const PathScene& scene, uint i) {
   return scene.triangles[i];
 }
-inline TriangleShading triangleShadingAt(const PathScene& scene, uint i, const Triangle&) {
+inline const TriangleShading& triangleShadingAt(const PathScene& scene, uint i, const Triangle&) {
   return scene.shading[i];
 }
-inline Material loadMaterial(const PathScene& scene, uint i) {
+inline const Material& loadMaterial(const PathScene& scene, uint i) {
   return scene.materials[i];
 }
-inline Emitter loadEmitter(const PathScene& scene, uint i) {
+inline const Emitter& loadEmitter(const PathScene& scene, uint i) {
   return scene.emitters[i];
 }
-inline Light loadLight(const PathScene& scene, uint i) {
+inline const Light& loadLight(const PathScene& scene, uint i) {
   return scene.lights[i];
 }
-inline TriangleNormals loadNormals(const PathScene& scene, uint primitive) {
+inline const TriangleNormals& loadNormals(const PathScene& scene, uint primitive) {
   return scene.normals[primitive];
 }
 inline EnvironmentMap environmentMap(const PathScene& scene) {
@@ -267,8 +267,8 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
 // At full weight after a specular bounce (or from the camera); else weighed against the chance
 // that light sampling had produced the same point (MIS), or not counted (light sampling
 // alone).
-PT_INLINE void addEmissionFound(PT_SCENE_PARAM PT_INOUT(PathState) path, Triangle tri,
-                                SurfacePoint s, float t, vec3 rayOrigin) {
+PT_INLINE void addEmissionFound(PT_SCENE_PARAM PT_INOUT(PathState) path, PT_IN(Triangle) tri,
+                                PT_IN(SurfacePoint) s, float t, vec3 rayOrigin) {
   float cosEmit =
       (PT_HAS_TWO_SIDED_EMITTERS && s.material.twoSided != 0u) ? abs(s.cosOut) : s.cosOut;
   if (tri.emitter == kNoEmitter || !(cosEmit > 0.0f)) return;
@@ -322,7 +322,7 @@ PT_INLINE void addEnvironmentFound(PT_SCENE_PARAM PT_INOUT(PathState) path, vec3
 
 // Whether light sampling is done at the vertex: the strategy asks for it, and the surface has
 // a lobe it can find (not a mirror, not black, not only delta lobes).
-PT_INLINE bool samplesLightAt(PT_SCENE_PARAM SurfacePoint s) {
+PT_INLINE bool samplesLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s) {
   if (!neeOn(PT_SCENE_ONLY) || s.scatter == kScatterMirror) return false;
 #ifndef PT_NO_BSDF_MATERIALS
   if (s.scatter == kScatterBsdf) return bsdfHasNonSpecular(s.material);
@@ -356,7 +356,7 @@ PT_INLINE LightSample noLightSample() {
 }
 
 // The side of the geometric surface a ray towards w leaves from.
-PT_INLINE vec3 geometricSide(SurfacePoint s, vec3 w) {
+PT_INLINE vec3 geometricSide(PT_IN(SurfacePoint) s, vec3 w) {
   return dot(s.ng, w) > 0.0f ? s.ng : -s.ng;
 }
 
@@ -365,8 +365,8 @@ PT_INLINE vec3 geometricSide(SurfacePoint s, vec3 w) {
 // (lights.h, environment.h) it names; the BSDF's value towards it, and the shadow ray's ends.
 // The shadow ray leaves along n from a Lambertian surface without shading normals, else from
 // the side of the geometric surface the light is on.
-PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM SurfacePoint s, VertexKey key, vec2 uChoose,
-                                    vec2 uLight) {
+PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
+                                    vec2 uChoose, vec2 uLight) {
   LightSample ls = noLightSample();
   uint slot = aliasTableSlot(uChoose.x, PT_PARAMS.emitterCount);
   Emitter emitter =
@@ -454,8 +454,8 @@ PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM SurfacePoint s, VertexKey key
 // The contribution of a light sample whose shadow ray was found clear, with the path's
 // throughput beta, weighed by the power heuristic against BSDF sampling's density of the same
 // direction (MIS; not for delta lights); the weight in `weight`.
-PT_INLINE vec3 lightSampleContribution(PT_SCENE_PARAM SurfacePoint s, VertexKey key, LightSample ls,
-                                       vec3 beta, PT_OUT(float) weight) {
+PT_INLINE vec3 lightSampleContribution(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
+                                       PT_IN(LightSample) ls, vec3 beta, PT_OUT(float) weight) {
   weight = 1.0f;
   if (misOn(PT_SCENE_ONLY) && !ls.delta) {
     float bsdfDensity = ls.cosTheta * kInvPi;
@@ -477,8 +477,8 @@ PT_INLINE vec3 lightSampleContribution(PT_SCENE_PARAM SurfacePoint s, VertexKey 
 // lobes, uBsdf: the direction) and updates the path's throughput, the sample's density (for
 // MIS at the next vertex), whether it was specular, and etaScale. False: no direction, the
 // path ends.
-PT_INLINE bool sampleBsdfAt(PT_SCENE_PARAM SurfacePoint s, VertexKey key, PT_INOUT(PathState) path,
-                            float uLobe, vec2 uBsdf, PT_OUT(vec3) wi) {
+PT_INLINE bool sampleBsdfAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
+                            PT_INOUT(PathState) path, float uLobe, vec2 uBsdf, PT_OUT(vec3) wi) {
   if (s.scatter == kScatterMirror) {
     // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
     vec3 d = -s.wo;
@@ -530,7 +530,7 @@ PT_INLINE bool survivesRoulette(PT_SCENE_PARAM PT_INOUT(PathState) path, uint de
 // Where the path's next ray, towards wi, starts: offset from the surface on the side it goes
 // to (along n from a Lambertian or mirror surface without shading normals, which wi leaves on
 // n's side).
-PT_INLINE vec3 nextRayOrigin(SurfacePoint s, vec3 wi) {
+PT_INLINE vec3 nextRayOrigin(PT_IN(SurfacePoint) s, vec3 wi) {
   vec3 side = (s.scatter != kScatterBsdf && !s.shadingNormals) ? s.n : geometricSide(s, wi);
   return offsetRayOrigin(s.p, side, s.magnitude);
 }

@@ -1,9 +1,10 @@
 // The GPU path tracer: one invocation traces a pass's samples of one pixel (as many as the
 // host chose for the dispatch) and adds them to the accumulation buffer's sums. The same
-// integrator as host/cpu/integrator.cpp (NEE + BSDF sampling with MIS, Russian roulette,
-// Lambertian and mirror, and bsdf.h's materials), written separately in GLSL; the layouts
-// (shared_types.h), random numbers (sampling.h) and the BSDFs beyond the two (bsdf.h) are
-// shared.
+// integrator as host/cpu/integrator.cpp (NEE + BSDF sampling with MIS, Russian roulette):
+// its steps at a path vertex are path_vertex.h's, which the CPU calls too, as it shares the
+// layouts (shared_types.h), random numbers (sampling.h), BSDFs (bsdf.h), lights and textures.
+// What is this file's own: the traversal (bvh.glsl), the exact retrace of rays the fast test
+// gave up on, the path regeneration loop, lavapipe's loop cap, and the accumulation.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #ifdef PT_DEBUG_PRINTF
@@ -231,6 +232,24 @@ Light loadLight(uint i) {
 }
 #endif
 
+// The path's vertex (path_vertex.h), over the effects in use.
+#define PT_HAS_DIFFUSE kDiffuse
+#define PT_HAS_MIRROR kMirror
+#define PT_HAS_NEE kNee
+#define PT_HAS_MIS kMis
+#define PT_HAS_BSDF_EMISSION kBsdfEmission
+#define PT_HAS_RUSSIAN_ROULETTE kRussianRoulette
+#define PT_HAS_SHADING_NORMALS kShadingNormals
+#define PT_HAS_TWO_SIDED_EMITTERS kTwoSidedEmitters
+#define PT_HAS_SPHERE_LIGHTS kSphereLights
+#define PT_HAS_ANALYTIC_LIGHTS kAnalyticLights
+#define PT_HAS_ENVIRONMENT kEnvironment
+#define PT_HAS_ENVIRONMENT_IMAGE kEnvironmentImage
+#define PT_HAS_TEXTURES kTextures
+#define PT_HAS_BUMP_MAPS kBumpMaps
+#define PT_HAS_BSDF_MATERIALS kBsdfMaterials
+#include "path_vertex.h"
+
 // A ray whose first traversal gave up at an edge function of exactly zero (traceRayWith in
 // bvh.glsl), traced again with the exact test once the bounce is done (main): a shadow ray,
 // whose light sample then adds `contribution` to the path's radiance unless occluded, or the
@@ -247,50 +266,9 @@ struct Retrace {
   vec3 contribution;
 };
 
-// A uniform point on an emitter chosen from the alias table with uChoose (uLight: the point).
-struct LightPoint {
-  vec3 point;
-  vec3 normal;  // the emitter's unit geometric normal (it emits on this side)
-  float area;
-  float magnitude;  // for the ray offset at the light
-  float pmf;        // probability of choosing this emitter
-  vec3 Le;
-  uint triangle;
-  uint primitive;
-  bool twoSided;  // emits on both sides
-};
-
-// The emitter the alias table gives for uChoose.
-Emitter pickEmitter(vec2 uChoose) {
-  uint slot = aliasTableSlot(uChoose.x, params.emitterCount);
-  return loadEmitter(aliasTablePick(slot, loadEmitter(slot), uChoose.y));
-}
-
-LightPoint pointOnEmitter(Emitter emitter, vec2 uLight) {
-  Triangle light = loadTriangle(emitter.triangle);
-  vec2 b = sampleTriangleBarycentrics(uLight);
-  vec3 lightCross = cross(light.v1 - light.v0, light.v2 - light.v0);
-  Material lightMaterial = loadMaterial(light.material);
-  return LightPoint((1.0 - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2,
-                    normalize(lightCross), 0.5 * length(lightCross),
-                    triangleMagnitude(light.v0, light.v1, light.v2), emitter.pmf,
-                    lightMaterial.emission, emitter.triangle, light.primitive,
-                    kTwoSidedEmitters && lightMaterial.twoSided != 0u);
-}
-
-// A two-sided light seen from its back (cosLight < 0): the side the receiver sees is the
-// emitting one, its normal turned towards the receiver (for the cosine and the shadow ray's
-// offset).
-void faceTwoSided(inout LightPoint light, inout float cosLight) {
-  if (light.twoSided && cosLight < 0.0) {
-    cosLight = -cosLight;
-    light.normal = -light.normal;
-  }
-}
-
-// Traces the shadow ray of a light sample from `from` (offset) to the light point (offset),
-// `direction` spanning it with t in [0, 1): kShadowOccluded, kShadowClear, or kShadowRetrace
-// when the traversal gave up (see Retrace), the ray then to be traced again later.
+// Traces the shadow ray of a light sample (path_vertex.h) from `from` to `to`, `direction`
+// spanning it with t in [0, 1): kShadowOccluded, kShadowClear, or kShadowRetrace when the
+// traversal gave up (see Retrace), the ray then to be traced again later.
 const uint kShadowOccluded = 0u;
 const uint kShadowClear = 1u;
 const uint kShadowRetrace = 2u;
@@ -304,11 +282,6 @@ uint traceShadowRayTo(vec3 from, vec3 to, out vec3 direction) {
   if (inexact) return kShadowRetrace;
   return occluded ? kShadowOccluded : kShadowClear;
 }
-uint traceShadowRay(vec3 from, LightPoint light, out vec3 direction) {
-  return traceShadowRayTo(from, offsetRayOrigin(light.point, light.normal, light.magnitude),
-                          direction);
-}
-
 // A clear shadow ray's contribution, or zero with `retrace` set to add it once the ray has been
 // traced again.
 vec3 addOrDefer(uint shadow, vec3 from, vec3 direction, vec3 contribution, inout Retrace retrace) {
@@ -317,142 +290,20 @@ vec3 addOrDefer(uint shadow, vec3 from, vec3 direction, vec3 contribution, inout
   return vec3(0.0);
 }
 
-void debugLightSample(uint depth, LightPoint light, float lightPdf, float weight) {
+// --debug-pixel's line about a light sample found clear (integrator.cpp prints the same).
+void debugLightSample(uint depth, LightSample ls, float weight) {
 #ifdef PT_DEBUG_PRINTF
   if (gDebug) {
-    debugPrintfEXT("gpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g",
-                   depth, light.triangle, light.primitive, lightPdf, weight);
+    if ((ls.emitter & kEmitterLight) != 0u) {
+      debugPrintfEXT("gpu depth %u: light sample on analytic light pdf=%g weight=%g", depth,
+                     ls.lightPdf, weight);
+    } else {
+      debugPrintfEXT("gpu depth %u: light sample on triangle %u (primitive %u) pdf=%g weight=%g",
+                     depth, ls.emitter, loadTriangle(ls.emitter).primitive, ls.lightPdf, weight);
+    }
   }
 #endif
 }
-
-#ifndef PT_NO_BSDF_MATERIALS
-// A light sample of one of lights.h's lights (chosen with probability pmf), given the BSDF's
-// f * |cos| towards it (fCos) and its density (bsdfDensity, read only for MIS): traces the
-// shadow ray from `from` and returns the contribution, weighed by the power heuristic unless
-// the light is a delta (which BSDF sampling never finds).
-vec3 analyticLightContribution(AnalyticLightSample ls, float pmf, vec3 from, vec3 beta, vec3 fCos,
-                               float bsdfDensity, bool misOn, uint depth, inout Retrace retrace) {
-  vec3 direction;
-  uint shadow = traceShadowRayTo(from, ls.target, direction);
-  if (shadow == kShadowOccluded) return vec3(0.0);
-  float lightPdf = pmf * ls.pdf;
-  float weight = (misOn && !ls.delta) ? powerHeuristic(lightPdf, bsdfDensity) : 1.0;
-#ifdef PT_DEBUG_PRINTF
-  if (gDebug) {
-    debugPrintfEXT("gpu depth %u: light sample on analytic light pdf=%g weight=%g", depth, lightPdf,
-                   weight);
-  }
-#endif
-  vec3 contribution = beta * fCos * ls.Li * (weight / lightPdf);
-  return addOrDefer(shadow, from, direction, contribution, retrace);
-}
-
-// A sample of the analytic light an emitter names, from p: the environment image's for an
-// infinite light that has one (integrator.cpp's sampleLight).
-AnalyticLightSample sampleLight(Emitter emitter, vec3 p, vec2 u) {
-  Light light = loadLight(emitter.triangle & ~kEmitterLight);
-  if (kEnvironmentImage && light.type == kLightInfinite && params.environmentWidth != 0u) {
-    return sampleEnvironmentLight(environmentMap(), p, u, params.sceneRadius);
-  }
-  return sampleAnalyticLight(light, p, u, params.sceneRadius);
-}
-#endif
-
-// Samples direct illumination at diffuse vertex p with shading normal n (next-event
-// estimation, pbrt's SampleLd): picks an emitter from the alias table with uChoose, a uniform
-// point on its triangle with uLight, and traces a shadow ray to it. Returns the light's
-// contribution to L, beta * f * Le * cos / pdf, weighted by the power heuristic against BSDF
-// sampling when misOn; zero when the point faces away or is occluded, and zero with `retrace`
-// set when the shadow ray is to be traced again. The shadow ray leaves along n, or with
-// shading normals (n then interpolated) on the side of the geometric normal ng the light is on.
-vec3 sampleDirectLight(vec3 p, vec3 n, vec3 ng, bool shadingNormals, float magnitude, vec3 beta,
-                       vec3 f, vec2 uChoose, vec2 uLight, bool misOn, uint depth,
-                       inout Retrace retrace) {
-#ifndef PT_NO_BSDF_MATERIALS
-  if (kAlphaCutouts) gAlphaU = shadowAlphaRandom(uLight);
-#endif
-  // Pick an emitter from the alias table, then a uniform point on its triangle (or a sample of
-  // an analytic light).
-  Emitter emitter = pickEmitter(uChoose);
-#ifndef PT_NO_BSDF_MATERIALS
-  if (kAnalyticLights && (emitter.triangle & kEmitterLight) != 0u) {
-    AnalyticLightSample ls = sampleLight(emitter, p, uLight);
-    float cosWi = dot(n, ls.wi);
-    if (!(cosWi > 0.0) || !(maxComponent(ls.Li) > 0.0)) return vec3(0.0);
-    vec3 from =
-        offsetRayOrigin(p, shadingNormals ? (dot(ng, ls.wi) > 0.0 ? ng : -ng) : n, magnitude);
-    return analyticLightContribution(ls, emitter.pmf, from, beta, f * cosWi, cosWi * kInvPi, misOn,
-                                     depth, retrace);
-  }
-#endif
-  LightPoint light = pointOnEmitter(emitter, uLight);
-
-  vec3 toLight = light.point - p;
-  float dist2 = dot(toLight, toLight);
-  vec3 wl = toLight / sqrt(dist2);
-  float cosLight = -dot(light.normal, wl);  // > 0: we see the emitting side
-  if (kTwoSidedEmitters) faceTwoSided(light, cosLight);
-  float cosSurface = dot(n, wl);
-  if (!(cosLight > 0.0 && cosSurface > 0.0)) return vec3(0.0);
-
-  // Shadow ray between the two offset points; t in [0, 1) spans the segment.
-  vec3 from = offsetRayOrigin(p, shadingNormals ? (dot(ng, wl) > 0.0 ? ng : -ng) : n, magnitude);
-  vec3 direction;
-  uint shadow = traceShadowRay(from, light, direction);
-  if (shadow == kShadowOccluded) return vec3(0.0);
-
-  float lightPdf = light.pmf * dist2 / (cosLight * light.area);
-  float weight = misOn ? powerHeuristic(lightPdf, cosSurface * kInvPi) : 1.0;
-  debugLightSample(depth, light, lightPdf, weight);
-  vec3 contribution = beta * f * light.Le * (cosSurface * weight / lightPdf);
-  return addOrDefer(shadow, from, direction, contribution, retrace);
-}
-
-#ifndef PT_NO_BSDF_MATERIALS
-// sampleDirectLight at a vertex with one of bsdf.h's BSDFs (integrator.cpp's
-// sampleDirectLightBsdf): the BSDF's value and density in the local shading frame; the shadow
-// ray leaves from the side of the geometric normal ng the light is on.
-vec3 sampleDirectLightBsdf(vec3 p, vec3 ng, ShadingFrame frame, Material material, vec3 wo,
-                           float magnitude, vec3 beta, vec2 uChoose, vec2 uLight,
-                           RandomStream evalStream, RandomStream pdfStream, bool misOn, uint depth,
-                           inout Retrace retrace) {
-  if (kAlphaCutouts) gAlphaU = shadowAlphaRandom(uLight);
-  Emitter emitter = pickEmitter(uChoose);
-  if (kAnalyticLights && (emitter.triangle & kEmitterLight) != 0u) {
-    AnalyticLightSample ls = sampleLight(emitter, p, uLight);
-    if (!(maxComponent(ls.Li) > 0.0)) return vec3(0.0);
-    vec3 wiLocal = toLocal(frame, ls.wi);
-    vec3 fCos = bsdfF(material, wo, wiLocal, evalStream) * absCosTheta(wiLocal);
-    if (!(maxComponent(fCos) > 0.0)) return vec3(0.0);
-    float density = (misOn && !ls.delta) ? bsdfPdf(material, wo, wiLocal, pdfStream) : 0.0;
-    vec3 from = offsetRayOrigin(p, dot(ng, ls.wi) > 0.0 ? ng : -ng, magnitude);
-    return analyticLightContribution(ls, emitter.pmf, from, beta, fCos, density, misOn, depth,
-                                     retrace);
-  }
-  LightPoint light = pointOnEmitter(emitter, uLight);
-  vec3 toLight = light.point - p;
-  float dist2 = dot(toLight, toLight);
-  vec3 wl = toLight / sqrt(dist2);
-  float cosLight = -dot(light.normal, wl);  // > 0: we see the emitting side
-  if (kTwoSidedEmitters) faceTwoSided(light, cosLight);
-  if (!(cosLight > 0.0)) return vec3(0.0);
-  vec3 wi = toLocal(frame, wl);
-  vec3 f = bsdfF(material, wo, wi, evalStream) * absCosTheta(wi);
-  if (!(maxComponent(f) > 0.0)) return vec3(0.0);
-
-  vec3 from = offsetRayOrigin(p, dot(ng, wl) > 0.0 ? ng : -ng, magnitude);
-  vec3 direction;
-  uint shadow = traceShadowRay(from, light, direction);
-  if (shadow == kShadowOccluded) return vec3(0.0);
-
-  float lightPdf = light.pmf * dist2 / (cosLight * light.area);
-  float weight = misOn ? powerHeuristic(lightPdf, bsdfPdf(material, wo, wi, pdfStream)) : 1.0;
-  debugLightSample(depth, light, lightPdf, weight);
-  vec3 contribution = beta * f * light.Le * (weight / lightPdf);
-  return addOrDefer(shadow, from, direction, contribution, retrace);
-}
-#endif
 
 // What sampleRadiance (host/cpu/integrator.cpp) keeps across its loop: one sample's path,
 // between two bounces.
@@ -461,32 +312,12 @@ struct Path {
   uint depth;   // scattering events so far
   vec3 origin;  // the ray to trace next
   vec3 direction;
-  vec3 L;               // radiance gathered so far
-  vec3 beta;            // path throughput
-  bool specularBounce;  // the ray leaves a specular bounce (or the camera)
-  float weight;         // the camera sample's weight (filter.h): multiplies L at the end
-  float bsdfPdf;        // solid-angle pdf of the BSDF sample that produced the ray
-  float etaScale;       // product of the squared relative indices refracted through
-  bool hitReady;        // the ray's closest hit is hitFound and hit already (see Retrace)
+  PathState state;  // L, beta, etaScale, bsdfPdf, specularBounce (path_vertex.h)
+  float weight;     // the camera sample's weight (filter.h): multiplies L at the end
+  bool hitReady;    // the ray's closest hit is hitFound and hit already (see Retrace)
   bool hitFound;
   HitData hit;
 };
-
-// The effects in use. Those switched off by a specialization constant fold away here; the
-// run-time half of each test keeps the unspecialized shader (every constant true) correct for
-// any scene.
-bool neeOn() {
-  return kNee && params.emitterCount > 0u && params.strategy != kStrategyBsdf;
-}
-bool misOn() {
-  return kMis && params.strategy == kStrategyMis;
-}
-bool bsdfEmissionOn() {
-  return kBsdfEmission && params.strategy != kStrategyNee;
-}
-bool rouletteOn() {
-  return kRussianRoulette && params.russianRoulette != 0u;
-}
 
 // sampleRadiance's start: the camera ray through a point of the pixel's filter (and of the
 // lens), radiance 0, throughput 1. `pixel` is the film's (the image's plus the crop's corner).
@@ -503,26 +334,21 @@ Path startPath(uvec2 pixel, uint sampleIndex) {
   path.origin = camera.origin;
   path.direction = camera.direction;
   path.weight = camera.weight;
-  path.L = vec3(0.0);
-  path.beta = vec3(1.0);
-  // The camera ray counts as specular: emission it finds is taken at full weight.
-  path.specularBounce = true;
-  path.bsdfPdf = 0.0;
-  path.etaScale = 1.0;
+  path.state = startPathState();
   path.hitReady = false;
   path.hitFound = false;
   path.hit = HitData(0.0, 0u);
   return path;
 }
 
-// One iteration of sampleRadiance's loop: traces the path's ray, adds the emission it finds,
-// scatters. Returns true when the path has ended, its radiance then being path.L once
-// `retrace` is done (main).
+// One iteration of sampleRadiance's loop (the same steps of path_vertex.h): traces the path's
+// ray, adds the emission it finds, samples a light, scatters. Returns true when the path has
+// ended, its radiance then being path.state.L once `retrace` is done (main).
 bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   uint seed = params.seed;
   bool sobol = PT_SOBOL;  // else independent random numbers
   uint sampleIndex = path.sampleIndex;
-  // Find the closest surface along the ray; the background is black.
+  // Find the closest surface along the ray.
   HitData hit = path.hit;
   bool found = path.hitFound;
   if (!path.hitReady) {
@@ -540,183 +366,68 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   }
   path.hitReady = false;
   if (!found) {
-#ifndef PT_NO_BSDF_MATERIALS
     // The ray leaves the scene: the infinite light's radiance, weighed as an emitter's.
-    if (kEnvironment && params.environmentEmitter != kNoEmitter) {
-      vec3 Le = params.environment;
-      float lightPdf = params.environmentPdf;
-      if (kEnvironmentImage && params.environmentWidth != 0u) {
-        // The image: the direction's texel, and its density times the light's pmf.
-        EnvironmentLookup e = environmentLookup(environmentMap(), path.direction);
-        Le = e.Le;
-        lightPdf = params.environmentPdf * e.pdf;
-      }
-      if (path.specularBounce) {
-        path.L += path.beta * Le;
-      } else if (bsdfEmissionOn()) {
-        float weight = 1.0;
-        if (misOn()) {
-          weight = powerHeuristic(path.bsdfPdf, lightPdf);
-        }
-        path.L += path.beta * weight * Le;
-      }
-    }
-#endif
+    addEnvironmentFound(path.state, path.direction);
     return true;
   }
+  // The shading point: material (textures resolved), hit point from the barycentrics (more
+  // accurate than origin + t * direction), normals, how it scatters.
   Triangle tri = loadTriangle(hit.triangle);
-  Material material = loadMaterial(tri.material);
-  // Hit point from barycentrics (more accurate than origin + t * direction).
-  vec3 b = hitBarycentrics(path.origin, path.direction, tri);
-#ifndef PT_NO_BSDF_MATERIALS
-  // The parameters that textures give, at the hit's texture coordinates.
-  vec2 uv = vec2(0.0);
-  MaterialTextures textures;
-  if ((kTextures || kBumpMaps) && params.texturesPresent != 0u) {
-    uv = interpolatedUV(uvsAt(tri.primitive), b);
-    textures = materialTexturesAt(tri.material);
-    if (kTextures) material = resolveMaterial(material, textures, uv);
-  }
-#endif
-  vec3 p = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
-  vec3 edgeCross = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
-  vec3 ng = normalize(edgeCross);
-  vec3 wo = -path.direction;
-  float cosOut = dot(ng, wo);
-  // Coordinates' scale at this vertex, for the ray offsets.
-  float magnitude = triangleMagnitude(tri.v0, tri.v1, tri.v2);
+  SurfacePoint s = surfacePointAt(
+      hit.triangle, tri, hitBarycentrics(path.origin, path.direction, tri), -path.direction);
 #ifdef PT_DEBUG_PRINTF
   if (gDebug) {
     debugPrintfEXT(
         "gpu depth %u: hit triangle %u (primitive %u) t=%g p=(%g, %g, %g) beta=(%g, %g, %g)",
-        path.depth, hit.triangle, tri.primitive, hit.t, p.x, p.y, p.z, path.beta.x, path.beta.y,
-        path.beta.z);
+        path.depth, hit.triangle, tri.primitive, hit.t, s.p.x, s.p.y, s.p.z, path.state.beta.x,
+        path.state.beta.y, path.state.beta.z);
   }
 #endif
 
-  // Add emitted light found by this ray: on the geometric normal's side, or on both.
-  float cosEmit = (kTwoSidedEmitters && material.twoSided != 0u) ? abs(cosOut) : cosOut;
-  if (tri.emitter != kNoEmitter && cosEmit > 0.0) {
-    vec3 Le = material.emission;
-    if (path.specularBounce) {
-      path.L += path.beta * Le;
-    } else if (bsdfEmissionOn()) {
-      // Weigh against the chance that light sampling had produced this point.
-      float weight = 1.0;
-      if (misOn()) {
-        float area = 0.5 * length(edgeCross);
-        Emitter emitter = loadEmitter(tri.emitter);
-        float lightPdf = emitter.pmf * hit.t * hit.t / (cosEmit * area);
-#ifndef PT_NO_BSDF_MATERIALS
-        // A sphere light's triangle: light sampling draws its cone (seen from the ray's origin).
-        if (kSphereLights && (emitter.triangle & kEmitterLight) != 0u) {
-          lightPdf = emitter.pmf *
-                     sphereLightPdf(loadLight(emitter.triangle & ~kEmitterLight), path.origin);
-        }
-#endif
-        weight = powerHeuristic(path.bsdfPdf, lightPdf);
-      }
-      path.L += path.beta * weight * Le;
-    }
-  }
+  // Add emitted light found by this ray, weighed against light sampling (MIS).
+  addEmissionFound(path.state, tri, s, hit.t, path.origin);
 
   // Stop after maxDepth scattering events.
   if (path.depth == params.maxDepth) return true;
-  uint dim = kDimFirstBounce + kDimsPerBounce * path.depth;
+  VertexKey key = VertexKey(pixel, sampleIndex, kDimFirstBounce + kDimsPerBounce * path.depth);
   ++path.depth;
 
-  // Diffuse and mirror surfaces are two-sided: shaded with the normal facing the ray.
-  vec3 n = cosOut >= 0.0 ? ng : -ng;
-  // With vertex normals, shaded about the interpolated normal (integrator.cpp says more).
-  vec3 ns = ng;
-  bool shaded = kShadingNormals && params.normalsPresent != 0u;  // ns may differ from ng
+  // Sample direct illumination from an emitter (next-event estimation): a light sample, its
+  // shadow ray, its contribution weighed against BSDF sampling (MIS).
+  if (samplesLightAt(s)) {
+    vec2 uLight = random2(sobol, pixel, sampleIndex, key.dim + kDimLightPoint, seed);
+    LightSample ls = sampleLightAt(
+        s, key, random2(sobol, pixel, sampleIndex, key.dim + kDimLightChoose, seed), uLight);
+    if (ls.found) {
 #ifndef PT_NO_BSDF_MATERIALS
-  TriangleNormals normals;
-  if (shaded) {
-    normals = loadNormals(tri.primitive);
-    ns = interpolatedNormal(normals, b, ng);
-    n = dot(ns, wo) >= 0.0 ? ns : -ns;
-  }
-  // A bump map moves the shading normal (texture.h).
-  if (kBumpMaps && params.texturesPresent != 0u && textures.displacement != kNoTexture) {
-    vec3 bumped =
-        bumpedNormal(textures.displacement, tri, uvsAt(tri.primitive), uv, ng, ns, shaded, normals);
-    if (bumped != ns) {
-      ns = bumped;
-      shaded = true;
-      n = dot(ns, wo) >= 0.0 ? ns : -ns;
+      if (kAlphaCutouts) gAlphaU = shadowAlphaRandom(uLight);
+#endif
+      vec3 direction;
+      uint shadow = traceShadowRayTo(ls.from, ls.to, direction);
+      if (shadow != kShadowOccluded) {
+        float weight;
+        vec3 contribution = lightSampleContribution(s, key, ls, path.state.beta, weight);
+        debugLightSample(path.depth, ls, weight);
+        path.state.L += addOrDefer(shadow, ls.from, direction, contribution, retrace);
+      }
     }
   }
-#endif
+
+  // Sample the BSDF for the next direction; the lobe choice takes the roulette dimension's
+  // second number.
+  vec2 uRoulette = random2(sobol, pixel, sampleIndex, key.dim + kDimRoulette, seed);
   vec3 wi;
-  if (kMirror && ((!kDiffuse && !kBsdfMaterials) || material.type == kMaterialMirror)) {
-    // Ideal reflection: the BSDF is a delta, f * cos / pdf = reflectance.
-    wi = path.direction - 2.0 * dot(path.direction, n) * n;
-    path.beta *= material.reflectance;
-    path.specularBounce = true;
-#ifndef PT_NO_BSDF_MATERIALS
-  } else if (kBsdfMaterials && (!kDiffuse || material.type != kMaterialDiffuse)) {
-    // One of bsdf.h's BSDFs, in the shading frame about the shading normal (not turned
-    // towards the ray: a dielectric tells inside from outside by it).
-    ShadingFrame frame = makeShadingFrame(ns, tri.v1 - tri.v0);
-    vec3 woLocal = toLocal(frame, wo);
-    // Sample direct illumination from an emitter, unless the BSDF has only delta lobes.
-    if (neeOn() && bsdfHasNonSpecular(material)) {
-      path.L +=
-          sampleDirectLightBsdf(p, ng, frame, material, woLocal, magnitude, path.beta,
-                                random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
-                                random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
-                                makeRandomStream(pixel, sampleIndex, dim, seed, kStreamEval),
-                                makeRandomStream(pixel, sampleIndex, dim, seed, kStreamLightPdf),
-                                misOn(), path.depth, retrace);
-    }
-    // Sample the BSDF; the lobe choice takes the roulette dimension's second number.
-    BsdfSample bs = bsdfSample(material, woLocal,
-                               random2(sobol, pixel, sampleIndex, dim + kDimRoulette, seed).y,
-                               random2(sobol, pixel, sampleIndex, dim + kDimBsdf, seed),
-                               makeRandomStream(pixel, sampleIndex, dim, seed, kStreamSample));
-    if (bs.flags == 0u) return true;
-    wi = fromLocal(frame, bs.wi);
-    path.beta *= bs.f * (absCosTheta(bs.wi) / bs.pdf);
-    path.specularBounce = (bs.flags & kBsdfSpecular) != 0u;
-    path.bsdfPdf = bs.pdfIsProportional
-                       ? bsdfPdf(material, woLocal, bs.wi,
-                                 makeRandomStream(pixel, sampleIndex, dim, seed, kStreamSamplePdf))
-                       : bs.pdf;
-    if ((bs.flags & kBsdfTransmission) != 0u) path.etaScale *= bs.eta * bs.eta;
-    // The new ray leaves from the side it goes to.
-    n = dot(ng, wi) > 0.0 ? ng : -ng;
-#endif
-  } else {
-    vec3 f = material.reflectance * kInvPi;
-    // Sample direct illumination from an emitter (next-event estimation).
-    if (neeOn() && material.reflectance != vec3(0.0)) {
-      path.L += sampleDirectLight(p, n, ng, shaded, magnitude, path.beta, f,
-                                  random2(sobol, pixel, sampleIndex, dim + kDimLightChoose, seed),
-                                  random2(sobol, pixel, sampleIndex, dim + kDimLightPoint, seed),
-                                  misOn(), path.depth, retrace);
-    }
-    // Sample the BSDF: cosine-weighted, so f * cos / pdf = reflectance.
-    wi = localToWorld(
-        sampleCosineHemisphere(random2(sobol, pixel, sampleIndex, dim + kDimBsdf, seed)), n);
-    path.bsdfPdf = dot(wi, n) * kInvPi;
-    // A direction in the tangent plane: zero contribution.
-    if (!(path.bsdfPdf > 0.0)) return true;
-    path.beta *= material.reflectance;
-    path.specularBounce = false;
+  if (!sampleBsdfAt(s, key, path.state, uRoulette.y,
+                    random2(sobol, pixel, sampleIndex, key.dim + kDimBsdf, seed), wi)) {
+    return true;
   }
-  if (maxComponent(path.beta) <= 0.0) return true;
+  if (maxComponent(path.state.beta) <= 0.0) return true;
 
   // Possibly terminate the path with Russian roulette (unbiased: survivors are scaled).
-  if (rouletteOn() && path.depth >= params.rrStartDepth) {
-    float q = max(0.0, 1.0 - maxComponent(kBsdfMaterials ? path.beta * path.etaScale : path.beta));
-    if (random1(sobol, pixel, sampleIndex, dim + kDimRoulette, seed) < q) return true;
-    path.beta /= 1.0 - q;
-  }
+  if (!survivesRoulette(path.state, path.depth, uRoulette.x)) return true;
 
   // Leave the surface on the side of the new direction.
-  if (shaded) n = dot(ng, wi) > 0.0 ? ng : -ng;
-  path.origin = offsetRayOrigin(p, n, magnitude);
+  path.origin = nextRayOrigin(s, wi);
   path.direction = wi;
   return false;
 }
@@ -758,7 +469,7 @@ void main() {
           traceRayWith(/*exact=*/true, retrace.origin, retrace.direction,
                        retrace.shadow ? 1.0 : 1.0 / 0.0, retrace.shadow, exactHit, inexact);
       if (retrace.shadow) {
-        if (!found) path.L += retrace.contribution;
+        if (!found) path.state.L += retrace.contribution;
       } else {
         path.hitReady = true;
         path.hitFound = found;
@@ -767,7 +478,7 @@ void main() {
     }
     if (!ended) continue;
     // The camera sample's weight: 1 but for the negative lobes of some filters (filter.h).
-    vec3 L = path.L * path.weight;
+    vec3 L = path.state.L * path.weight;
 #ifdef PT_DEBUG_PRINTF
     if (gDebug) {
       debugPrintfEXT("gpu sample %u: L=(%g, %g, %g)", path.sampleIndex, L.x, L.y, L.z);

@@ -17,6 +17,8 @@ using namespace glm;  // so that shared code reads as GLSL: dot, cross, floatBit
 // Parameters a shared function writes: references in C++, inout/out in GLSL.
 #define PT_INOUT(T) T&
 #define PT_OUT(T) T&
+// Large structs a shared function only reads: const references in C++ (GLSL passes by value).
+#define PT_IN(T) const T&
 // For the few small functions called several times per path vertex (the random numbers):
 // inlined whatever the compiler's heuristics say, so that independent calls overlap and
 // unused results are dropped.
@@ -35,6 +37,7 @@ inline uint bitfieldReverse(uint x) {
 #define PT_INLINE
 #define PT_INOUT(T) inout T
 #define PT_OUT(T) out T
+#define PT_IN(T) T
 #define PT_HOT_INLINE
 #endif
 
