@@ -69,6 +69,16 @@ std::vector<Case> cases(const test::TempDir& dir) {
     s.strategy = strategy;
     list.push_back({normals, s});
   }
+  // Every light kind, textures, an alpha cut-out and a bump map, every material kind, with each
+  // strategy; and the textured example scene.
+  const std::string everything =
+      (std::filesystem::path(PT_SOURCE_DIR) / "tests/data/lanes-every-feature.pbrt").string();
+  for (uint strategy : {kStrategyMis, kStrategyNee, kStrategyBsdf}) {
+    RenderSettings s = small;
+    s.strategy = strategy;
+    list.push_back({everything, s});
+  }
+  list.push_back({"textured-sky.json", small});
   // An environment image, octahedral (the pbrt file's) and lat-long, with each strategy.
   const std::string environment = environmentImageScene(dir);
   for (uint strategy : {kStrategyMis, kStrategyNee, kStrategyBsdf}) {
@@ -111,6 +121,12 @@ TEST(CpuLanes, EqualsTheReferenceBitForBit) {
     }
     if (c.config.find("shading-normals") != std::string::npos) {
       ASSERT_TRUE(data.effects.shadingNormals) << data.effects.toString();
+    }
+    if (c.config.find("every-feature") != std::string::npos) {
+      const EffectSet& fx = data.effects;
+      ASSERT_TRUE(fx.textures && fx.alphaCutouts && fx.bumpMaps && fx.twoSidedEmitters &&
+                  fx.sphereLights && fx.deltaLights && fx.environment)
+          << fx.toString();
     }
     const Camera& cam = data.params.camera;
     std::vector<uvec2> pixels;

@@ -97,6 +97,79 @@ HWY_INLINE void forEachLane(uint32_t lanes, F&& f) {
   for (; lanes != 0; lanes &= lanes - 1u) f(size_t(std::countr_zero(lanes)));
 }
 
+// The Lambertian lobe's sampling (sampling.h's sampleCosineHemisphere and localToWorld, as
+// path_vertex.h's sampleBsdfAt calls them) for all lanes at once, operation for operation: the
+// one step of a path vertex that the lanes vectorize, as it was most of a diffuse vertex's
+// arithmetic (CpuLanes.EqualsTheReferenceBitForBit holds it to the scalar definition).
+HWY_INLINE V3 operator+(V3 a, V3 b) {
+  return V3{hn::Add(a.x, b.x), hn::Add(a.y, b.y), hn::Add(a.z, b.z)};
+}
+HWY_INLINE V3 operator*(V s, V3 a) {
+  return V3{hn::Mul(s, a.x), hn::Mul(s, a.y), hn::Mul(s, a.z)};
+}
+HWY_INLINE V dot(V3 a, V3 b) {
+  return hn::Add(hn::Add(hn::Mul(a.x, b.x), hn::Mul(a.y, b.y)), hn::Mul(a.z, b.z));
+}
+HWY_INLINE V3 localToWorld(V3 local, V3 n) {
+  const V one = splat(1.0f);
+  const V s = hn::IfThenElse(hn::Ge(n.z, hn::Zero(D())), one, splat(-1.0f));
+  const V a = hn::Div(splat(-1.0f), hn::Add(s, n.z));
+  const V b = hn::Mul(hn::Mul(n.x, n.y), a);
+  const V3 t{hn::Add(one, hn::Mul(hn::Mul(hn::Mul(s, n.x), n.x), a)), hn::Mul(s, b),
+             hn::Mul(hn::Neg(s), n.x)};
+  const V3 bt{b, hn::Add(s, hn::Mul(hn::Mul(n.y, n.y), a)), hn::Neg(n.y)};
+  return (local.x * t + local.y * bt) + local.z * n;
+}
+HWY_INLINE void cosSinTwoPi(V u, V& c, V& s) {
+  const D d;
+  const V quadrant = hn::Floor(hn::Add(hn::Mul(splat(4.0f), u), splat(0.5f)));
+  const V x = hn::Mul(splat(2.0f * kPi), hn::Sub(u, hn::Mul(splat(0.25f), quadrant)));
+  const V x2 = hn::Mul(x, x);
+  const V sinX = hn::Mul(
+      x,
+      hn::Add(
+          splat(1.0f),
+          hn::Mul(
+              x2,
+              hn::Add(splat(-1.0f / 6.0f),
+                      hn::Mul(x2, hn::Add(splat(1.0f / 120.0f),
+                                          hn::Mul(x2, hn::Add(splat(-1.0f / 5040.0f),
+                                                              hn::Mul(x2, splat(1.0f /
+                                                                                362880.0f))))))))));
+  const V cosX = hn::Add(
+      splat(1.0f),
+      hn::Mul(
+          x2,
+          hn::Add(
+              splat(-0.5f),
+              hn::Mul(
+                  x2,
+                  hn::Add(
+                      splat(1.0f / 24.0f),
+                      hn::Mul(x2,
+                              hn::Add(splat(-1.0f / 720.0f),
+                                      hn::Mul(x2, hn::Add(splat(1.0f / 40320.0f),
+                                                          hn::Mul(x2, splat(-1.0f /
+                                                                            3628800.0f)))))))))));
+  // Rotate by quadrant * 90 degrees: q = int(quadrant) & 3.
+  const hn::RebindToSigned<D> di;
+  const auto q = hn::And(hn::ConvertTo(di, quadrant), hn::Set(di, 3));
+  const M q1 = hn::RebindMask(d, hn::Eq(q, hn::Set(di, 1)));
+  const M q2 = hn::RebindMask(d, hn::Eq(q, hn::Set(di, 2)));
+  const M q3 = hn::RebindMask(d, hn::Eq(q, hn::Set(di, 3)));
+  c = hn::IfThenElse(q1, hn::Neg(sinX),
+                     hn::IfThenElse(q2, hn::Neg(cosX), hn::IfThenElse(q3, sinX, cosX)));
+  s = hn::IfThenElse(q1, cosX,
+                     hn::IfThenElse(q2, hn::Neg(sinX), hn::IfThenElse(q3, hn::Neg(cosX), sinX)));
+}
+HWY_INLINE V3 sampleCosineHemisphere(V ux, V uy) {
+  const V r = hn::Sqrt(ux);
+  V c, s;
+  cosSinTwoPi(uy, c, s);
+  return V3{hn::Mul(r, c), hn::Mul(r, s),
+            hn::Sqrt(glmMax(hn::Zero(D()), hn::Sub(splat(1.0f), ux)))};
+}
+
 // The wide traversal's first steps for the rays of several lanes at once: RayPrecomputed
 // (traverse.cpp; its six divisions become six vector divisions) and intersectBox against the
 // root's box. Returns the lanes whose ray enters it, their `prepared` filled in for
@@ -189,13 +262,15 @@ struct Paths {
 };
 
 // random2 of each lane in `lanes`: its pixel, the sample, dimension dim[i] + offset (for a
-// lane outside `lanes`, numbers of no use), into u[i].
+// lane outside `lanes`, numbers of no use); .x into ux, .y into uy.
 HWY_INLINE void drawRandom2(bool sobol, const Paths& path, uint sampleIndex, uint offset, uint seed,
-                            uint32_t lanes, vec2* u) {
+                            uint32_t lanes, Lanes& ux, Lanes& uy) {
 #if HWY_TARGET == HWY_SCALAR
   forEachLane(lanes, [&](size_t i) {
-    u[i] = random2(sobol, uvec2(path.pixelX[i], path.pixelY[i]), sampleIndex, path.dim[i] + offset,
-                   seed);
+    const vec2 u = random2(sobol, uvec2(path.pixelX[i], path.pixelY[i]), sampleIndex,
+                           path.dim[i] + offset, seed);
+    ux.v[i] = u.x;
+    uy.v[i] = u.y;
   });
 #else
   (void)lanes;
@@ -203,10 +278,8 @@ HWY_INLINE void drawRandom2(bool sobol, const Paths& path, uint sampleIndex, uin
   V x, y;
   random_lanes::random2(sobol, hn::Load(du, path.pixelX), hn::Load(du, path.pixelY), sampleIndex,
                         hn::Add(hn::Load(du, path.dim), hn::Set(du, offset)), seed, x, y);
-  Lanes ux, uy;
   ux.store(x);
   uy.store(y);
-  for (size_t i = 0; i < kMaxLanes; ++i) u[i] = vec2(ux.v[i], uy.v[i]);
 #endif
 }
 
@@ -234,7 +307,12 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   // Per step, per lane: the hit, the shading point, the random numbers, the light sample.
   SurfacePoint surface[kMaxLanes];
   VertexKey key[kMaxLanes];
-  vec2 uLightChoose[kMaxLanes], uLight[kMaxLanes], uBsdf[kMaxLanes], uRoulette[kMaxLanes];
+  struct Lanes2 {
+    Lanes x, y;
+    vec2 get(size_t i) const { return vec2(x.v[i], y.v[i]); }
+  } uLightChoose, uLight, uBsdf, uRoulette;
+  Lanes3 normal, wiLambertian;  // a Lambertian lane's n, and its sampled direction
+  Lanes pdfLambertian;
   LightSample light[kMaxLanes];
   Lanes3 shadowFrom, shadowDir;
   RayPrecomputed prepared[kMaxLanes];
@@ -262,7 +340,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
     AlphaCutouts cutouts{&scene, scene.textureTables(), 0.0f};
     HitFilter filter{};
     if (alpha) {
-      cutouts.u = shadowAlphaRandom(uLight[i]);
+      cutouts.u = shadowAlphaRandom(uLight.get(i));
       filter = cutouts.filter();
     }
     const HitFilter* f = alpha ? &filter : nullptr;
@@ -325,17 +403,18 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
 
     // This event's random numbers (bounceRandom: four dimensions from dim, each for all lanes
     // at once).
-    drawRandom2(sobol, path, sampleIndex, kDimLightChoose, seed, live, uLightChoose);
-    drawRandom2(sobol, path, sampleIndex, kDimLightPoint, seed, live, uLight);
-    drawRandom2(sobol, path, sampleIndex, kDimBsdf, seed, live, uBsdf);
-    drawRandom2(sobol, path, sampleIndex, kDimRoulette, seed, live, uRoulette);
+    drawRandom2(sobol, path, sampleIndex, kDimLightChoose, seed, live, uLightChoose.x,
+                uLightChoose.y);
+    drawRandom2(sobol, path, sampleIndex, kDimLightPoint, seed, live, uLight.x, uLight.y);
+    drawRandom2(sobol, path, sampleIndex, kDimBsdf, seed, live, uBsdf.x, uBsdf.y);
+    drawRandom2(sobol, path, sampleIndex, kDimRoulette, seed, live, uRoulette.x, uRoulette.y);
 
     // Sample direct illumination from an emitter (next-event estimation): the light samples,
     // then their shadow rays, then the contributions of those found clear.
     uint32_t shadow = 0;  // lanes with a shadow ray to trace
     forEachLane(live, [&](size_t i) {
       if (!samplesLightAt(ps, surface[i])) return;
-      light[i] = sampleLightAt(ps, surface[i], key[i], uLightChoose[i], uLight[i]);
+      light[i] = sampleLightAt(ps, surface[i], key[i], uLightChoose.get(i), uLight.get(i));
       if (!light[i].found) return;
       shadowFrom.set(i, light[i].from);
       shadowDir.set(i, light[i].to - light[i].from);
@@ -354,14 +433,38 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       });
     }
 
-    // Sample the BSDF for the next direction, possibly terminate the path with Russian
-    // roulette, and leave the surface on the side of the new direction.
+    // Sample the BSDF for the next direction (Lambertian lanes all at once), possibly terminate
+    // the path with Russian roulette, and leave the surface on the side of the new direction.
+    uint32_t lambertian = 0;
+    forEachLane(live, [&](size_t i) {
+      if (surface[i].scatter != kScatterLambertian) return;
+      normal.set(i, surface[i].n);
+      lambertian |= 1u << i;
+    });
+    if (lambertian != 0) {
+      const V3 n = load(normal);
+      const V3 wi = localToWorld(sampleCosineHemisphere(uBsdf.x.load(), uBsdf.y.load()), n);
+      store(wiLambertian, wi);
+      pdfLambertian.store(hn::Mul(dot(wi, n), splat(kInvPi)));
+    }
     forEachLane(live, [&](size_t i) {
       PathState& state = path.state[i];
       vec3 wi;
-      if (!sampleBsdfAt(ps, surface[i], key[i], state, uRoulette[i].y, uBsdf[i], wi) ||
-          maxComponent(state.beta) <= 0.0f ||
-          !survivesRoulette(ps, state, path.depth[i], uRoulette[i].x)) {
+      bool scattered;
+      if (lambertian >> i & 1u) {
+        // sampleBsdfAt's Lambertian lobe, its direction and density from the lanes above.
+        wi = wiLambertian.get(i);
+        state.bsdfPdf = pdfLambertian.v[i];
+        scattered = state.bsdfPdf > 0.0f;
+        if (scattered) {
+          state.beta *= surface[i].material.reflectance;
+          state.specularBounce = false;
+        }
+      } else {
+        scattered = sampleBsdfAt(ps, surface[i], key[i], state, uRoulette.y.v[i], uBsdf.get(i), wi);
+      }
+      if (!scattered || maxComponent(state.beta) <= 0.0f ||
+          !survivesRoulette(ps, state, path.depth[i], uRoulette.x.v[i])) {
         live &= ~(1u << i);
         return;
       }
