@@ -1,6 +1,7 @@
 // Random numbers and sampling routines shared by the CPU reference and the shader, so that
 // both draw the same numbers and map them to the same points and directions.
-// Only pure functions of their arguments live here; the integrators are written separately.
+// Only pure functions of their arguments live here; what a path does with them is
+// path_vertex.h's.
 #ifndef PT_SAMPLING_H
 #define PT_SAMPLING_H
 

@@ -1,5 +1,5 @@
 // sampleRadianceLanes, the CPU reference's paths several at a time, against sampleRadiance,
-// which it transcribes: the same radiance bit for bit and the same ray count, on every
+// whose steps it runs lane by lane: the same radiance bit for bit and the same ray count, on every
 // instruction set Highway builds here, in settings that take each of its branches.
 #include <gtest/gtest.h>
 
