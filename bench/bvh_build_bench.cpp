@@ -33,6 +33,7 @@
 #include "common/check.h"
 #include "embree_scene.h"
 #include "render/prepare.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
 
 namespace pt {

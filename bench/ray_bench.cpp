@@ -51,6 +51,8 @@
 #include "vulkan/raycast.h"
 #ifdef PT_HAVE_EMBREE
 #include "embree_scene.h"
+#include "scene/load_scene.h"
+#include "scene/reader_helpers.h"
 #endif
 
 namespace pt {

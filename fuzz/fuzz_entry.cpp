@@ -15,6 +15,7 @@
 #include "common/check.h"
 #include "image/image.h"
 #include "image/texture_image.h"
+#include "scene/load_scene.h"
 #include "scene/mtl_materials.h"
 #include "scene/obj_mesh.h"
 #include "scene/ply_mesh.h"

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bvh/traverse.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
 #include "test_util.h"
 

@@ -12,6 +12,7 @@
 #include "cpu/integrator.h"
 #include "image/image.h"
 #include "render/prepare.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
 #include "test_util.h"
 #include "vulkan/backend.h"

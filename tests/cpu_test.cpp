@@ -8,6 +8,7 @@
 
 #include "cpu/integrator.h"
 #include "render/prepare.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
 #include "test_util.h"
 

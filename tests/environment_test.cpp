@@ -18,6 +18,7 @@
 #include "render/environment_map.h"
 #include "render/prepare.h"
 #include "render_compare.h"
+#include "scene/load_scene.h"
 #include "scene/pbrt/pbrt_scene.h"
 #include "scene/scene.h"
 #include "test_util.h"

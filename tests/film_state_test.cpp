@@ -16,6 +16,7 @@
 #include "image/film_state.h"
 #include "render/prepare.h"
 #include "render_compare.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
 #include "test_util.h"
 #include "vulkan/backend.h"

@@ -11,6 +11,7 @@
 #include "cpu/integrator.h"
 #include "cpu/integrator_lanes.h"
 #include "render/prepare.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
 #include "test_util.h"
 

@@ -13,6 +13,7 @@
 #include "image/texture_image.h"
 #include "render/prepare.h"
 #include "render_compare.h"
+#include "scene/load_scene.h"
 #include "scene/mtl_materials.h"
 #include "scene/scene.h"
 #include "scene/textures.h"

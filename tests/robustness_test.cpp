@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "render_compare.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
 #include "test_util.h"
 

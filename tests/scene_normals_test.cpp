@@ -6,6 +6,7 @@
 #include <string>
 
 #include "render/prepare.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
 #include "test_util.h"
 

@@ -14,6 +14,9 @@
 #include <nlohmann/json.hpp>
 
 #include "common/check.h"
+#include "render/camera.h"
+#include "scene/load_scene.h"
+#include "scene/reader_helpers.h"
 #include "scene/scene.h"
 #include "test_util.h"
 

@@ -13,6 +13,8 @@
 #include "image/image.h"
 #include "render/prepare.h"
 #include "render_compare.h"
+#include "scene/load_scene.h"
+#include "scene/reader_helpers.h"
 #include "scene/scene.h"
 #include "scene/textures.h"
 #include "test_util.h"

@@ -9,6 +9,7 @@
 #include "cli/progress.h"
 #include "common/check.h"
 #include "converge/converge.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
 
 namespace pt {

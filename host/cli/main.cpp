@@ -24,6 +24,7 @@
 #include "image/image.h"
 #include "render/prepare.h"
 #include "render/render_options.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
 #include "vulkan/backend.h"
 #include "vulkan/device_info.h"

@@ -7,6 +7,7 @@
 #include "bsdf.h"
 #include "common/check.h"
 #include "lights.h"
+#include "render/camera.h"
 #include "render/environment_map.h"
 
 namespace pt {

@@ -17,6 +17,7 @@
 
 #include "common/check.h"
 #include "scene/json_reader.h"
+#include "scene/reader_helpers.h"
 #include "scene/scene.h"
 
 namespace pt::scene_detail {

@@ -1,5 +1,5 @@
-// The scene as loaded from JSON: camera, materials and a flat triangle list in load order.
-// Knows nothing of BVHs or Vulkan; the BVH builder reorders the triangles later.
+// The scene as the readers give it: camera, materials and a flat triangle list in load order.
+// Includes no reader (scene/load_scene.h reads one) and knows nothing of BVHs or Vulkan.
 #pragma once
 
 #include <algorithm>
@@ -112,84 +112,9 @@ struct SceneLoadOptions {
   bool strict = false;
 };
 
-// Reads a scene file. Throws InputError with "<file>: <field or line>: <message>" for
-// anything malformed (see docs/scene-format.md). Mesh paths are relative to the JSON file.
-Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& options = {});
-
 // pbrt-v4's texture coordinates for the triangles of a mesh without any: (0,0), (1,0), (1,1).
 inline TriangleUVs defaultTriangleUVs() {
   return TriangleUVs{vec2(0.0f, 0.0f), vec2(1.0f, 0.0f), vec2(1.0f, 1.0f), vec2(0.0f)};
 }
-
-// A material of type `type` (kMaterial*) with the defaults of docs/scene-format.md (pbrt-v4's,
-// for the types taken from pbrt-v4) and no emission. The JSON reader and the MTL mapping both
-// start from it, so that a default is written in one place.
-Material defaultMaterial(uint type);
-
-// Makes `material` pbrt-v4's conductor of the given reflectance colour (its
-// ConductorMaterial::GetBxDF): eta = 1 and k = 2 sqrt(r) / sqrt(1 - r) per channel, with r
-// clamped to [0, 0.9999] so that white stays finite.
-void setConductorReflectance(Material& material, vec3 reflectance);
-
-// pbrt-v4's "roughness", "uroughness" and "vroughness" as a material stores them: Trowbridge-
-// Reitz alphas, mapped by RoughnessToAlpha (alpha = sqrt(roughness)) when `remap` (pbrt-v4's
-// "remaproughness", true by default). The JSON and pbrt readers both call it.
-void setRoughness(Material& material, float uRoughness, float vRoughness, bool remap);
-
-// diffusetransmission's "scale" as pbrt-v4 applies it: both colours scaled and the products
-// clamped to [0, 1].
-void scaleDiffuseTransmission(Material& material, float scale);
-
-// The most random-walk steps or walks a coated material may ask for per evaluation: far more
-// than pbrt-v4's defaults (10 and 1) need, and small enough that one evaluation stays short.
-inline constexpr std::int64_t kMaxCoatedWalk = 1000;
-
-// cos and sin of an angle in degrees, exact for multiples of 90 degrees so that axis-aligned
-// geometry stays exactly axis-aligned (cos(radians(90)) is 6e-17, not 0). Both scene readers
-// rotate with it.
-std::pair<double, double> cosSinDegrees(double degrees);
-
-// How appendTriangle ended.
-enum class Appended { kAdded, kZeroArea, kTooMany };
-
-// Appends triangle `t` (its vertices and material set; emitter and primitive are filled here)
-// to scene.triangles, as both scene readers do: not if it has zero area (the edges at v0
-// parallel to within double rounding, i.e. the sine of the angle between them at most 1e-12:
-// scale-invariant, computed in double on the float vertices the renderer will see, so thin
-// but real slivers are kept; coincident vertices too), nor beyond kNoEmitter - 1 triangles.
-// `normals`: the vertex normals in world space (any length), or null where the mesh has none;
-// each is made unit, the geometric normal standing in for one that is zero or not finite.
-// Once some triangle has normals, every triangle has an entry in scene.normals (its geometric
-// normal at all three vertices where its mesh has none).
-// `uvs`: the vertices' texture coordinates, or null where the mesh has none (scene.uvs then
-// gets pbrt-v4's defaults for it once some triangle has coordinates).
-Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3>* normals,
-                        const std::array<glm::vec2, 3>* uvs = nullptr);
-
-// Makes room for `size` elements, at least doubling the capacity when it grows, so that
-// appending shape after shape costs amortized linear time (std::vector::reserve would allocate
-// exactly `size`, and the next shape would copy everything again).
-template <typename T>
-void reserveGeometric(std::vector<T>& v, std::size_t size) {
-  if (size > v.capacity()) v.reserve(std::max(size, 2 * v.capacity()));
-}
-
-// Builds the GPU camera for a film of width x height pixels: the image is the crop of it (the
-// whole film without a crop window). Throws InputError when the crop selects no pixel of that
-// film (the readers check the file's own film; --width and --height can make another).
-Camera makeCamera(const CameraDesc& desc, int width, int height);
-
-// The pixels a crop window or pixel bounds select of a width x height film, as pbrt-v4's film
-// computes them: [x0, x1) x [y0, y1], in {x0, x1, y0, y1}; the whole film without either.
-std::array<int, 4> cropPixels(const CameraDesc& desc, int width, int height);
-
-// pbrt-v4's filter of type `type` (kFilter*) with its defaults: radius 0.5 for box, 2 for
-// triangle, 1.5 and sigma 0.5 for gaussian, 2 and B = C = 1/3 for mitchell.
-PixelFilterDesc defaultFilter(uint type);
-
-// The constants of a filter that makeCamera puts in the Camera (filter.h reads them):
-// filterWeight, filterScale, filterB, filterC, filterRootsNear/Far, filterExpX/Y. Throws
-// InputError (naming `where`) for parameters no sampler can follow. Exposed for tests.
-void setFilterConstants(Camera& camera, const PixelFilterDesc& filter, const std::string& where);
 
 }  // namespace pt

@@ -16,11 +16,13 @@
 #include <vector>
 
 #include "common/shared.h"
+#include "scene/camera_filter.h"
 #include "scene/pbrt/pbrt_graphics_state.h"
 #include "scene/pbrt/pbrt_materials.h"
 #include "scene/pbrt/pbrt_params.h"
 #include "scene/pbrt/pbrt_parser.h"
 #include "scene/pbrt/pbrt_shapes.h"
+#include "scene/reader_helpers.h"
 #include "scene/scene.h"
 #include "scene/textures.h"
 

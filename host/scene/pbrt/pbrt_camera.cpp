@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "common/check.h"
+#include "scene/camera_filter.h"
 #include "scene/json_reader.h"
 #include "scene/pbrt/pbrt_builder.h"
 

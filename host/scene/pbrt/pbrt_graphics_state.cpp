@@ -12,6 +12,7 @@
 #include <glm/matrix.hpp>
 
 #include "scene/pbrt/pbrt_builder.h"
+#include "scene/reader_helpers.h"
 
 namespace pt::pbrt {
 

@@ -10,6 +10,7 @@
 #include "scene/json_reader.h"
 #include "scene/pbrt/pbrt_builder.h"
 #include "scene/pbrt/spectra.h"
+#include "scene/reader_helpers.h"
 
 namespace pt::pbrt {
 

@@ -20,6 +20,7 @@
 #include "scene/json_reader.h"
 #include "scene/pbrt/pbrt_builder.h"
 #include "scene/ply_mesh.h"
+#include "scene/reader_helpers.h"
 
 namespace pt::pbrt {
 

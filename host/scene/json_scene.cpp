@@ -1,6 +1,6 @@
-// Scene loading: reads the JSON scene description (docs/scene-format.md) into a Scene with
+// The JSON scene reader: reads the scene description (docs/scene-format.md) into a Scene with
 // a flat triangle list, validating everything and naming the field of any error.
-#include "scene/scene.h"
+#include "scene/json_scene.h"
 
 #include <algorithm>
 #include <array>
@@ -19,12 +19,13 @@
 
 #include "common/check.h"
 #include "common/named_values.h"
+#include "scene/camera_filter.h"
 #include "scene/json_reader.h"
 #include "scene/json_textures.h"
 #include "scene/mtl_materials.h"
 #include "scene/obj_mesh.h"
-#include "scene/pbrt/pbrt_scene.h"
 #include "scene/ply_mesh.h"
+#include "scene/reader_helpers.h"
 #include "scene/textures.h"
 
 namespace pt {
@@ -935,130 +936,6 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
 
 }  // namespace
 
-std::pair<double, double> cosSinDegrees(double degrees) {
-  const double reduced = std::fmod(degrees, 360.0);  // exact
-  if (std::fmod(reduced, 90.0) == 0.0) {
-    switch (static_cast<int>(reduced < 0 ? reduced + 360.0 : reduced)) {
-      case 0:
-        return {1.0, 0.0};
-      case 90:
-        return {0.0, 1.0};
-      case 180:
-        return {-1.0, 0.0};
-      case 270:
-        return {0.0, -1.0};
-      default:
-        break;
-    }
-  }
-  const double radians = reduced * (3.14159265358979323846 / 180.0);
-  return {std::cos(radians), std::sin(radians)};
-}
-
-Material defaultMaterial(uint type) {
-  Material m{};  // every field a type does not use stays zero
-  m.type = type;
-  switch (type) {
-    case kMaterialDiffuse:
-      m.reflectance = vec3(0.8f);
-      break;
-    case kMaterialMirror:
-      m.reflectance = vec3(1.0f);
-      break;
-    case kMaterialConductor:
-      // pbrt-v4's default is copper ("metal-Cu-eta", "metal-Cu-k"): these are RGB
-      // approximations of those spectra.
-      m.eta = vec3(0.200438f, 0.924033f, 1.10221f);
-      m.k = vec3(3.91295f, 2.45285f, 2.14219f);
-      break;
-    case kMaterialDielectric:
-    case kMaterialThinDielectric:
-      m.eta = vec3(1.5f, 0.0f, 0.0f);
-      break;
-    case kMaterialDiffuseTransmission:
-      m.reflectance = vec3(0.25f);
-      m.transmittance = vec3(0.25f);
-      break;
-    case kMaterialCoatedDiffuse:
-      m.reflectance = vec3(0.5f);
-      m.eta = vec3(1.5f, 0.0f, 0.0f);
-      m.thickness = 0.01f;
-      m.maxDepth = 10;
-      m.nSamples = 1;
-      break;
-    default:
-      PT_CHECK(false, "unknown material type");
-  }
-  return m;
-}
-
-void setRoughness(Material& material, float uRoughness, float vRoughness, bool remap) {
-  material.alphaX = remap ? std::sqrt(uRoughness) : uRoughness;
-  material.alphaY = remap ? std::sqrt(vRoughness) : vRoughness;
-}
-
-void scaleDiffuseTransmission(Material& material, float scale) {
-  material.reflectance = glm::clamp(material.reflectance * scale, 0.0f, 1.0f);
-  material.transmittance = glm::clamp(material.transmittance * scale, 0.0f, 1.0f);
-}
-
-void setConductorReflectance(Material& material, vec3 reflectance) {
-  material.eta = vec3(1.0f);
-  for (int c = 0; c < 3; ++c) {
-    // Clamped below 1 so that a white reflectance gives a large finite k (pbrt-v4's rule).
-    const double r = std::clamp(static_cast<double>(reflectance[c]), 0.0, 0.9999);
-    material.k[c] = static_cast<float>(2.0 * std::sqrt(r) / std::sqrt(1.0 - r));
-  }
-}
-
-Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3>* normals,
-                        const std::array<glm::vec2, 3>* uvs) {
-  const glm::dvec3 e1 = glm::dvec3(t.v1) - glm::dvec3(t.v0);
-  const glm::dvec3 e2 = glm::dvec3(t.v2) - glm::dvec3(t.v0);
-  if (!(glm::length(glm::cross(e1, e2)) > 1e-12 * glm::length(e1) * glm::length(e2))) {
-    return Appended::kZeroArea;
-  }
-  if (scene.triangles.size() >= static_cast<std::size_t>(kNoEmitter)) return Appended::kTooMany;
-  // A normal made unit; the geometric normal where it is zero or not finite.
-  const auto unitNormal = [](glm::dvec3 n, vec3 ng) {
-    const double len = glm::length(n);
-    if (!(len > 0.0) || !std::isfinite(len)) return ng;
-    const vec3 unit = vec3(n / len);
-    return std::isfinite(unit.x) && std::isfinite(unit.y) && std::isfinite(unit.z) ? unit : ng;
-  };
-  const auto flatNormals = [](const Triangle& f) {
-    const vec3 ng = glm::normalize(glm::cross(f.v1 - f.v0, f.v2 - f.v0));
-    return TriangleNormals{ng, 0.0f, ng, 0.0f, ng, 0.0f};
-  };
-  t.emitter = kNoEmitter;
-  t.primitive = static_cast<uint>(scene.triangles.size());
-  scene.triangles.push_back(t);
-  if (normals != nullptr && scene.normals.empty()) {
-    // The first triangle with vertex normals: the triangles before it shade flat.
-    for (std::size_t k = 0; k + 1 < scene.triangles.size(); ++k) {
-      scene.normals.push_back(flatNormals(scene.triangles[k]));
-    }
-  }
-  if (normals != nullptr) {
-    const vec3 ng = flatNormals(t).n0;
-    const std::array<glm::dvec3, 3>& n = *normals;
-    scene.normals.push_back(TriangleNormals{unitNormal(n[0], ng), 0.0f, unitNormal(n[1], ng), 0.0f,
-                                            unitNormal(n[2], ng), 0.0f});
-  } else if (!scene.normals.empty()) {
-    scene.normals.push_back(flatNormals(t));
-  }
-  if (uvs != nullptr && scene.uvs.empty()) {
-    // The first triangle with texture coordinates: the triangles before it take the defaults.
-    scene.uvs.assign(scene.triangles.size() - 1, defaultTriangleUVs());
-  }
-  if (uvs != nullptr) {
-    scene.uvs.push_back(TriangleUVs{(*uvs)[0], (*uvs)[1], (*uvs)[2], vec2(0.0f)});
-  } else if (!scene.uvs.empty()) {
-    scene.uvs.push_back(defaultTriangleUVs());
-  }
-  return Appended::kAdded;
-}
-
 // ---- lights -----------------------------------------------------------------------------
 
 namespace {
@@ -1196,8 +1073,7 @@ void readLights(const JsonNode& node, const std::filesystem::path& sceneFile, Sc
 
 }  // namespace
 
-Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& options) {
-  if (path.extension() == ".pbrt") return loadPbrtScene(path, options);  // docs/pbrt-format.md
+Scene loadJsonScene(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::string text;
   std::string why;
@@ -1220,240 +1096,6 @@ Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& optio
   if (auto n = root.find("lights")) readLights(*n, path, scene);
   padMaterialTextures(scene);
   return scene;
-}
-
-Camera makeCamera(const CameraDesc& desc, int width, int height) {
-  PT_CHECK(width > 0 && height > 0, "film size must be positive");
-  // Double precision so that far-away or nearly-degenerate setups round only once.
-  const glm::dvec3 position(desc.position);
-  const glm::dvec3 forward = glm::normalize(glm::dvec3(desc.target) - position);
-  const glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(desc.up)));
-  const glm::dvec3 up = glm::cross(right, forward);
-  const double tanHalfFovY = std::tan(glm::radians(static_cast<double>(desc.vfovDegrees)) / 2.0);
-
-  Camera camera{};
-  camera.position = desc.position;
-  camera.forward = glm::vec3(forward);
-  camera.right = glm::vec3(right);
-  camera.up = glm::vec3(up);
-  camera.tanHalfFovY = static_cast<float>(tanHalfFovY);
-  camera.aspect = static_cast<float>(static_cast<double>(width) / static_cast<double>(height));
-  // The screen window: by default centred and tan(vfov / 2) high, so that windowCenter is
-  // forward itself (the pinhole's rays of the renderer before screen windows, bit for bit).
-  camera.windowCenter = camera.forward;
-  if (desc.screenWindow) {
-    const std::array<float, 4>& w = *desc.screenWindow;
-    const double halfWidth = 0.5 * (double(w[1]) - double(w[0])) * tanHalfFovY;
-    const double halfHeight = 0.5 * (double(w[3]) - double(w[2])) * tanHalfFovY;
-    const double cx = 0.5 * (double(w[0]) + double(w[1])) * tanHalfFovY;
-    const double cy = 0.5 * (double(w[2]) + double(w[3])) * tanHalfFovY;
-    PT_CHECK(halfWidth != 0.0 && halfHeight != 0.0, "screen window of no area");
-    camera.tanHalfFovY = static_cast<float>(halfHeight);
-    camera.aspect = static_cast<float>(halfWidth / halfHeight);
-    camera.windowCenter = glm::vec3(forward + cx * right + cy * up);
-  }
-  // The film, and the image: its crop.
-  const std::array<int, 4> crop = cropPixels(desc, width, height);
-  if (!(crop[1] > crop[0] && crop[3] > crop[2])) {
-    throw InputError("the crop window selects no pixel of the " + std::to_string(width) + "x" +
-                     std::to_string(height) + " film");
-  }
-  camera.filmWidth = static_cast<uint>(width);
-  camera.filmHeight = static_cast<uint>(height);
-  camera.cropX = static_cast<uint>(crop[0]);
-  camera.cropY = static_cast<uint>(crop[2]);
-  camera.width = static_cast<uint>(crop[1] - crop[0]);
-  camera.height = static_cast<uint>(crop[3] - crop[2]);
-  // The lens and the filter.
-  camera.lensRadius = desc.lensRadius;
-  camera.focalDistance = desc.focalDistance;
-  setFilterConstants(camera, desc.filter, "camera");
-  PT_CHECK(std::isfinite(camera.right.x + camera.right.y + camera.right.z + camera.forward.x +
-                         camera.forward.y + camera.forward.z + camera.tanHalfFovY),
-           "camera basis is degenerate (up parallel to the view direction?)");
-  PT_CHECK(std::isfinite(camera.windowCenter.x + camera.windowCenter.y + camera.windowCenter.z +
-                         camera.aspect + camera.tanHalfFovY),
-           "screen window beyond the float range");
-  return camera;
-}
-
-std::array<int, 4> cropPixels(const CameraDesc& desc, int width, int height) {
-  if (desc.cropWindow) {
-    // pbrt-v4's Film: the fractions ordered and clamped to [0, 1], the bounds rounded up, in
-    // float as it computes them.
-    const std::array<float, 4>& c = *desc.cropWindow;
-    auto edge = [](int size, float fraction) {
-      return static_cast<int>(
-          std::ceil(static_cast<float>(size) * std::clamp(fraction, 0.0f, 1.0f)));
-    };
-    return {edge(width, std::min(c[0], c[1])), edge(width, std::max(c[0], c[1])),
-            edge(height, std::min(c[2], c[3])), edge(height, std::max(c[2], c[3]))};
-  }
-  if (desc.pixelBounds) {
-    // pbrt-v4's Film: the corners ordered, intersected with the film.
-    const std::array<int, 4>& b = *desc.pixelBounds;
-    return {std::clamp(std::min(b[0], b[1]), 0, width), std::clamp(std::max(b[0], b[1]), 0, width),
-            std::clamp(std::min(b[2], b[3]), 0, height),
-            std::clamp(std::max(b[2], b[3]), 0, height)};
-  }
-  return {0, width, 0, height};
-}
-
-namespace {
-
-// Where the cubic c[0] t^3 + c[1] t^2 + c[2] t + c[3] changes sign strictly inside (a, b), in
-// increasing order: the cubic is monotone between the roots of its derivative, so each such
-// piece holds at most one sign change, found by bisection in double. Breakpoints between two
-// segments of the same sign (a root the cubic only touches, or rounding at a piece's end)
-// are dropped: what is left are the real sign changes, at most three.
-std::vector<double> cubicSignChanges(const std::array<double, 4>& c, double a, double b) {
-  auto p = [&](double t) { return ((c[0] * t + c[1]) * t + c[2]) * t + c[3]; };
-  std::vector<double> cuts{a, b};
-  const double qa = 3.0 * c[0], qb = 2.0 * c[1], qc = c[2];
-  if (qa != 0.0) {
-    const double disc = qb * qb - 4.0 * qa * qc;
-    if (disc > 0.0) {
-      for (double sign : {-1.0, 1.0}) cuts.push_back((-qb + sign * std::sqrt(disc)) / (2.0 * qa));
-    }
-  } else if (qb != 0.0) {
-    cuts.push_back(-qc / qb);
-  }
-  std::erase_if(cuts, [&](double t) { return !(t >= a && t <= b); });
-  std::sort(cuts.begin(), cuts.end());
-  std::vector<double> points{a};
-  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
-    double lo = cuts[i], hi = cuts[i + 1];
-    if (!(hi > lo)) continue;
-    // The sign just inside the piece's ends (a piece may end at a root).
-    const double nudge = 1e-9 * (hi - lo);
-    const double pl = p(lo) != 0.0 ? p(lo) : p(lo + nudge);
-    const double ph = p(hi) != 0.0 ? p(hi) : p(hi - nudge);
-    if (!((pl < 0.0 && ph > 0.0) || (pl > 0.0 && ph < 0.0))) continue;
-    for (int step = 0; step < 200; ++step) {
-      const double mid = 0.5 * (lo + hi);
-      ((p(mid) < 0.0) == (pl < 0.0) ? lo : hi) = mid;
-    }
-    const double root = 0.5 * (lo + hi);
-    if (root > a && root < b) points.push_back(root);
-  }
-  points.push_back(b);
-  std::vector<double> changes;
-  for (std::size_t i = 1; i + 1 < points.size(); ++i) {
-    const bool before = p(0.5 * (points[i - 1] + points[i])) < 0.0;
-    const bool after = p(0.5 * (points[i] + points[i + 1])) < 0.0;
-    if (before != after) changes.push_back(points[i]);
-  }
-  return changes;
-}
-
-[[noreturn]] void filterError(const std::string& where, const std::string& problem) {
-  throw InputError((where.empty() ? "" : where + ": ") + problem);
-}
-
-}  // namespace
-
-PixelFilterDesc defaultFilter(uint type) {
-  PixelFilterDesc filter;
-  filter.type = type;
-  const float radius = type == kFilterBox        ? 0.5f
-                       : type == kFilterGaussian ? 1.5f
-                                                 : 2.0f;  // triangle, mitchell
-  filter.radiusX = filter.radiusY = radius;
-  return filter;
-}
-
-void setFilterConstants(Camera& camera, const PixelFilterDesc& filter, const std::string& where) {
-  for (float r : {filter.radiusX, filter.radiusY}) {
-    if (!(r > 0.0f && r <= 4096.0f)) {
-      filterError(
-          where, "filter radius must be in (0, 4096] pixels, got " + scene_detail::formatNumber(r));
-    }
-  }
-  PT_CHECK(filter.type <= kFilterMitchell, "unknown filter type");
-  camera.filterType = filter.type;
-  camera.filterRadiusX = filter.radiusX;
-  camera.filterRadiusY = filter.radiusY;
-  camera.filterWeight = 1.0f;
-  camera.filterScale = 0.0f;
-  camera.filterB = camera.filterC = 0.0f;
-  camera.filterExpX = camera.filterExpY = 0.0f;
-  camera.filterRootsNear = vec3(1.0f);
-  camera.filterRootsFar = vec3(2.0f);
-  if (filter.type == kFilterGaussian) {
-    if (!(filter.sigma > 0.0f && std::isfinite(filter.sigma))) {
-      filterError(where, "gaussian filter: sigma must be a positive number, got " +
-                             scene_detail::formatNumber(filter.sigma));
-    }
-    // filter.h's constants, from the float values it works with.
-    const float k = static_cast<float>(1.0 / (double(filter.sigma) * std::sqrt(2.0)));
-    camera.filterScale = k;
-    const double twoKOverRootPi = 2.0 * double(k) / std::sqrt(3.14159265358979323846);
-    float* exps[2] = {&camera.filterExpX, &camera.filterExpY};
-    const float radii[2] = {filter.radiusX, filter.radiusY};
-    for (int axis = 0; axis < 2; ++axis) {
-      const double kr = double(k) * double(radii[axis]);
-      const double e = std::exp(-kr * kr) * twoKOverRootPi;
-      *exps[axis] = static_cast<float>(e);
-      // The CDF's whole range, erf(kr) twice minus the constant: where sigma dwarfs the
-      // radius the filter is nearly constant and this difference of nearly equal numbers falls
-      // to the erf approximation's error (3e-7), which would then shape the samples.
-      const double total = 2.0 * std::erf(kr) - 2.0 * e * double(radii[axis]);
-      if (!(total > 4e-4)) {
-        filterError(where, "gaussian filter: sigma " + scene_detail::formatNumber(filter.sigma) +
-                               " is too wide for radius " +
-                               scene_detail::formatNumber(radii[axis]) +
-                               " (the filter is within 0.1 % of a box there: use \"box\")");
-      }
-    }
-  } else if (filter.type == kFilterMitchell) {
-    const double b = filter.b, c = filter.c;
-    if (!(std::isfinite(b) && std::isfinite(c) && std::abs(b) <= 100.0 && std::abs(c) <= 100.0)) {
-      filterError(where, "mitchell filter: B and C must be numbers in [-100, 100], got " +
-                             scene_detail::formatNumber(b) + " and " +
-                             scene_detail::formatNumber(c));
-    }
-    camera.filterB = filter.b;
-    camera.filterC = filter.c;
-    // The two cubics (times 6) from the float B and C the sampler uses, their sign changes and
-    // the integrals of |f| and f over t in [0, 2].
-    const double fb = camera.filterB, fc = camera.filterC;
-    const std::array<double, 4> nearCubic = {12.0 - 9.0 * fb - 6.0 * fc,
-                                             -18.0 + 12.0 * fb + 6.0 * fc, 0.0, 6.0 - 2.0 * fb};
-    const std::array<double, 4> farCubic = {-fb - 6.0 * fc, 6.0 * fb + 30.0 * fc,
-                                            -12.0 * fb - 48.0 * fc, 8.0 * fb + 24.0 * fc};
-    const std::vector<double> nearRoots = cubicSignChanges(nearCubic, 0.0, 1.0);
-    const std::vector<double> farRoots = cubicSignChanges(farCubic, 1.0, 2.0);
-    PT_CHECK(nearRoots.size() <= 3 && farRoots.size() <= 3, "a cubic changes sign 3 times at most");
-    for (std::size_t i = 0; i < nearRoots.size(); ++i) {
-      camera.filterRootsNear[int(i)] = static_cast<float>(nearRoots[i]);
-    }
-    for (std::size_t i = 0; i < farRoots.size(); ++i) {
-      camera.filterRootsFar[int(i)] = static_cast<float>(farRoots[i]);
-    }
-    auto integral = [](const std::array<double, 4>& q, double lo, double hi) {
-      auto antiderivative = [&](double t) {
-        return t * (q[3] + t * (q[2] / 2.0 + t * (q[1] / 3.0 + t * q[0] / 4.0)));
-      };
-      return antiderivative(hi) - antiderivative(lo);
-    };
-    double absolute = 0.0, signed_ = 0.0;
-    for (int piece = 0; piece < 2; ++piece) {
-      const std::array<double, 4>& q = piece == 0 ? nearCubic : farCubic;
-      std::vector<double> points = piece == 0 ? nearRoots : farRoots;
-      points.insert(points.begin(), piece == 0 ? 0.0 : 1.0);
-      points.push_back(piece == 0 ? 1.0 : 2.0);
-      for (std::size_t i = 0; i + 1 < points.size(); ++i) {
-        const double part = integral(q, points[i], points[i + 1]);
-        absolute += std::abs(part);
-        signed_ += part;
-      }
-    }
-    // Mitchell1D integrates to 1 over [-2, 2] whatever B and C (pbrt-v4's Integral() is
-    // radius^2 / 4): 3 here, half of it times 6.
-    PT_CHECK(signed_ > 0.0, "the Mitchell filter's integral is positive");
-    const double perAxis = absolute / signed_;
-    camera.filterWeight = static_cast<float>(perAxis * perAxis);
-  }
 }
 
 }  // namespace pt

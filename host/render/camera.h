@@ -1,0 +1,15 @@
+// The GPU camera (shared.h's Camera) from a scene's CameraDesc for the film being rendered;
+// the crop and filter maths it uses is scene/camera_filter.h's.
+#pragma once
+
+#include "common/shared.h"
+#include "scene/scene.h"
+
+namespace pt {
+
+// Builds the GPU camera for a film of width x height pixels: the image is the crop of it (the
+// whole film without a crop window). Throws InputError when the crop selects no pixel of that
+// film (the readers check the file's own film; --width and --height can make another).
+Camera makeCamera(const CameraDesc& desc, int width, int height);
+
+}  // namespace pt
