@@ -8,13 +8,13 @@
 #include <climits>
 #include <cstdio>
 #include <cstring>
-#include <memory>
 #include <string>
 #include <system_error>
 
 #include <unistd.h>
 
 #include "common/check.h"
+#include "common/read_file.h"
 
 namespace pt {
 namespace {
@@ -25,10 +25,6 @@ namespace fs = std::filesystem;
 [[noreturn]] void fail(const fs::path& path, const std::string& what) {
   throw InputError(path.string() + ": " + what);
 }
-
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
 
 // Temporary files being written, for removeUnfinishedWrites(). A slot is claimed (kFilling)
 // while its path is copied in and only then published (kReady), so a signal handler never
@@ -68,15 +64,14 @@ Bytes readWholeFile(const fs::path& path, std::string_view kind) {
   if (status.type() == fs::file_type::not_found) fail(path, "not found");
   if (ec) fail(path, "cannot access: " + ec.message());
   if (fs::is_directory(status)) fail(path, "is a directory, not " + std::string(kind));
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
-  if (!file) fail(path, std::string("cannot open: ") + std::strerror(errno));
   Bytes bytes;
-  unsigned char chunk[1 << 16];
-  size_t n;
-  while ((n = std::fread(chunk, 1, sizeof(chunk), file.get())) > 0) {
-    bytes.insert(bytes.end(), chunk, chunk + n);
+  const FileReadResult read = readFile(path, bytes);
+  if (read.step == FileReadResult::kOpenFailed) {
+    fail(path, std::string("cannot open: ") + std::strerror(read.error));
   }
-  if (std::ferror(file.get())) fail(path, std::string("cannot read: ") + std::strerror(errno));
+  if (read.step == FileReadResult::kReadFailed) {
+    fail(path, std::string("cannot read: ") + std::strerror(read.error));
+  }
   return bytes;
 }
 

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -12,6 +11,7 @@
 #include <set>
 
 #include "common/check.h"
+#include "common/read_file.h"
 
 namespace pt::scene_detail {
 
@@ -261,18 +261,12 @@ bool readTextFile(const std::filesystem::path& path, std::string* text, std::str
     *why = "not a regular file";
     return false;
   }
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) {
-    *why = std::strerror(errno);
+  const FileReadResult read = readFile(path, *text);
+  if (read.step == FileReadResult::kOpenFailed) {
+    *why = std::strerror(read.error);
     return false;
   }
-  text->clear();
-  char buffer[1 << 16];
-  std::size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text->append(buffer, n);
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) {
+  if (read.step == FileReadResult::kReadFailed) {
     *why = "read error";
     return false;
   }
