@@ -360,6 +360,16 @@ PT_INLINE vec3 geometricSide(PT_IN(SurfacePoint) s, vec3 w) {
   return dot(s.ng, w) > 0.0f ? s.ng : -s.ng;
 }
 
+#ifndef PT_NO_BSDF_MATERIALS
+// f * |cos| of one of bsdf.h's materials at vertex s towards wiLocal (its shading frame), with
+// the coated material's estimate drawn from the event's kStreamEval stream.
+PT_INLINE vec3 bsdfFCos(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key, vec3 wiLocal) {
+  return bsdfF(s.material, s.woLocal, wiLocal,
+               makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed, kStreamEval)) *
+         absCosTheta(wiLocal);
+}
+#endif
+
 // Samples the light from vertex s (pbrt-v4's SampleLd): an emitter from the alias table with
 // uChoose, and with uLight a uniform point on its triangle or a sample of the analytic light
 // (lights.h, environment.h) it names; the BSDF's value towards it, and the shadow ray's ends.
@@ -395,10 +405,7 @@ PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Vertex
     } else {
       if (!(maxComponent(analytic.Li) > 0.0f)) return ls;
       ls.wiLocal = toLocal(s.frame, wi);
-      ls.f = bsdfF(s.material, s.woLocal, ls.wiLocal,
-                   makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed,
-                                    kStreamEval)) *
-             absCosTheta(ls.wiLocal);
+      ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
       if (!(maxComponent(ls.f) > 0.0f)) return ls;
     }
     ls.to = analytic.target;
@@ -434,10 +441,7 @@ PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Vertex
 #ifndef PT_NO_BSDF_MATERIALS
       if (!(cosLight > 0.0f)) return ls;
       ls.wiLocal = toLocal(s.frame, wi);
-      ls.f = bsdfF(s.material, s.woLocal, ls.wiLocal,
-                   makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed,
-                                    kStreamEval)) *
-             absCosTheta(ls.wiLocal);
+      ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
       if (!(maxComponent(ls.f) > 0.0f)) return ls;
 #endif
     }
