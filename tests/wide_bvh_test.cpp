@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -55,16 +56,40 @@ void forEachTarget(const Body& body) {
   test::forEachHighwayTarget(wideTraversalTargets(), body);
 }
 
+// The binary traversal's answers for every ray, closest hit (both tests) and any hit within
+// tMax[i]: the reference that countDifferences compares the wide traversal with. The binary
+// traversal is not dispatched by instruction set, so one set of answers serves every target.
+struct BinaryAnswers {
+  std::vector<std::optional<Hit>> closest[2];  // [0] watertight, [1] fast
+  std::vector<char> any[2];
+};
+
+constexpr Intersection kBothTests[2] = {Intersection::kWatertight, Intersection::kFast};
+
+BinaryAnswers binaryAnswers(const Bvh& bvh, const std::vector<Ray>& rays,
+                            const std::vector<float>& tMax) {
+  BinaryAnswers a;
+  for (int k = 0; k < 2; ++k) {
+    a.closest[k].reserve(rays.size());
+    a.any[k].reserve(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) {
+      a.closest[k].push_back(closestHit(bvh, rays[i], INFINITY, kBothTests[k]));
+      a.any[k].push_back(anyHit(bvh, rays[i], tMax[i], kBothTests[k]));
+    }
+  }
+  return a;
+}
+
 // Counts the rays (and reports the first few) whose wide answers differ from the binary
 // traversal's, closest hit (both tests) and any hit within tMax[i].
-int countDifferences(const Bvh& bvh, const WideBvh& wide, const std::vector<Ray>& rays,
-                     const std::vector<float>& tMax) {
+int countDifferences(const BinaryAnswers& binary, const WideBvh& wide,
+                     const std::vector<Ray>& rays, const std::vector<float>& tMax) {
   int differences = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
-    for (Intersection test : {Intersection::kWatertight, Intersection::kFast}) {
-      const bool same = sameHit(closestHit(bvh, rays[i], INFINITY, test),
-                                closestHit(wide, rays[i], INFINITY, test)) &&
-                        anyHit(bvh, rays[i], tMax[i], test) == anyHit(wide, rays[i], tMax[i], test);
+    for (int k = 0; k < 2; ++k) {
+      const Intersection test = kBothTests[k];
+      const bool same = sameHit(binary.closest[k][i], closestHit(wide, rays[i], INFINITY, test)) &&
+                        bool(binary.any[k][i]) == anyHit(wide, rays[i], tMax[i], test);
       if (!same && ++differences <= 5) {
         ADD_FAILURE() << "ray " << i << (test == Intersection::kFast ? " (fast)" : "")
                       << ": the wide traversal's answer differs from the binary one";
@@ -72,6 +97,11 @@ int countDifferences(const Bvh& bvh, const WideBvh& wide, const std::vector<Ray>
     }
   }
   return differences;
+}
+
+int countDifferences(const Bvh& bvh, const WideBvh& wide, const std::vector<Ray>& rays,
+                     const std::vector<float>& tMax) {
+  return countDifferences(binaryAnswers(bvh, rays, tMax), wide, rays, tMax);
 }
 
 // Walks the wide tree and checks it against the binary one it came from: every triangle in
@@ -345,7 +375,8 @@ TEST(WideBvh, SameAnswersOnEveryInstructionSet) {
     const Bvh bvh = buildBvh(bunny, BvhBuildOptions{leafSize, BvhBuilder::kPloc});
     const WideBvh wide = buildWideBvh(bvh);
     EXPECT_EQ(expectValidSplitLeaves(wide) > 0, leafSize > 4);
-    forEachTarget([&] { EXPECT_EQ(countDifferences(bvh, wide, rays, tMax), 0); });
+    const BinaryAnswers binary = binaryAnswers(bvh, rays, tMax);
+    forEachTarget([&] { EXPECT_EQ(countDifferences(binary, wide, rays, tMax), 0); });
   }
 }
 
