@@ -82,8 +82,8 @@ BinaryAnswers binaryAnswers(const Bvh& bvh, const std::vector<Ray>& rays,
 
 // Counts the rays (and reports the first few) whose wide answers differ from the binary
 // traversal's, closest hit (both tests) and any hit within tMax[i].
-int countDifferences(const BinaryAnswers& binary, const WideBvh& wide,
-                     const std::vector<Ray>& rays, const std::vector<float>& tMax) {
+int countDifferences(const BinaryAnswers& binary, const WideBvh& wide, const std::vector<Ray>& rays,
+                     const std::vector<float>& tMax) {
   int differences = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
     for (int k = 0; k < 2; ++k) {

@@ -3,10 +3,10 @@
 // steps for eight paths at a time: the same bits.)
 // Its steps at a path vertex are path_vertex.h's, which the shader calls too; it reads the
 // same flat arrays and draws the same random numbers, so a difference image between the two
-// backends points at a bug in what is each one's own (traversal, scheduling) or in a compiler. (The BVH it traverses in a
-// eight-wide copy, SceneData::wideBvh, whose answers are the binary tree's bit for bit, and
-// takes each triangle's normal, area and offset scale from SceneData::cpuCopies, computed once
-// as it would compute them.)
+// backends points at a bug in what is each one's own (traversal, scheduling) or in a compiler. (The
+// BVH it traverses in a eight-wide copy, SceneData::wideBvh, whose answers are the binary tree's
+// bit for bit, and takes each triangle's normal, area and offset scale from SceneData::cpuCopies,
+// computed once as it would compute them.)
 #pragma once
 
 #include <cstdint>
