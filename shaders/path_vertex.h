@@ -477,6 +477,17 @@ PT_INLINE vec3 lightSampleContribution(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Ver
 
 // ---- BSDF sampling and Russian roulette ---------------------------------------------------
 
+// The path's continuation from a Lambertian vertex s in a cosine-weighted direction of density
+// pdf (so f * cos / pdf = reflectance); false for a direction in the tangent plane, which
+// contributes nothing. (The CPU's lanes draw such directions for all lanes at once.)
+PT_INLINE bool continueLambertian(PT_IN(SurfacePoint) s, PT_INOUT(PathState) path, float pdf) {
+  path.bsdfPdf = pdf;
+  if (!(pdf > 0.0f)) return false;
+  path.beta *= s.material.reflectance;
+  path.specularBounce = false;
+  return true;
+}
+
 // Samples the BSDF at vertex s for the path's next direction wi (uLobe: the choice between
 // lobes, uBsdf: the direction) and updates the path's throughput, the sample's density (for
 // MIS at the next vertex), whether it was specular, and etaScale. False: no direction, the
@@ -509,14 +520,9 @@ PT_INLINE bool sampleBsdfAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
     return true;
   }
 #endif
-  // Lambertian: cosine-weighted, so f * cos / pdf = reflectance. A direction in the tangent
-  // plane contributes nothing.
+  // Lambertian: cosine-weighted about n.
   wi = localToWorld(sampleCosineHemisphere(uBsdf), s.n);
-  path.bsdfPdf = dot(wi, s.n) * kInvPi;
-  if (!(path.bsdfPdf > 0.0f)) return false;
-  path.beta *= s.material.reflectance;
-  path.specularBounce = false;
-  return true;
+  return continueLambertian(s, path, dot(wi, s.n) * kInvPi);
 }
 
 // Russian roulette after `depth` scattering events, with uniform number u: false when the path

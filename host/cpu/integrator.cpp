@@ -42,19 +42,28 @@ int availableCpus() {
 std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Intersection test,
                                   uvec2 pixel, uint32_t sampleIndex, uint depth) {
   if (!scene.effects.alphaCutouts) return closestHit(scene.wideBvh(), ray, INFINITY, test);
-  const AlphaCutouts cutouts{&scene, scene.textureTables(),
-                             pathAlphaRandom(pixel, sampleIndex, depth, scene.params.seed)};
+  const AlphaCutouts cutouts = AlphaCutouts::ofPathRay(scene, pixel, sampleIndex, depth);
   const HitFilter filter = cutouts.filter();
   return closestHit(scene.wideBvh(), ray, INFINITY, test, &filter);
 }
 bool occluded(const SceneData& scene, const Ray& ray, Intersection test, vec2 uLight) {
   if (!scene.effects.alphaCutouts) return anyHit(scene.wideBvh(), ray, 1.0f, test);
-  const AlphaCutouts cutouts{&scene, scene.textureTables(), shadowAlphaRandom(uLight)};
+  const AlphaCutouts cutouts = AlphaCutouts::ofShadowRay(scene, uLight);
   const HitFilter filter = cutouts.filter();
   return anyHit(scene.wideBvh(), ray, 1.0f, test, &filter);
 }
 
 }  // namespace
+
+AlphaCutouts AlphaCutouts::ofPathRay(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex,
+                                     uint depth) {
+  return AlphaCutouts{&scene, scene.textureTables(),
+                      pathAlphaRandom(pixel, sampleIndex, depth, scene.params.seed)};
+}
+
+AlphaCutouts AlphaCutouts::ofShadowRay(const SceneData& scene, vec2 uLight) {
+  return AlphaCutouts{&scene, scene.textureTables(), shadowAlphaRandom(uLight)};
+}
 
 bool AlphaCutouts::accept(const void* context, uint32_t triangle, const Hit& hit) {
   const AlphaCutouts& a = *static_cast<const AlphaCutouts*>(context);

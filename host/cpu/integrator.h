@@ -44,6 +44,11 @@ struct AlphaCutouts {
   const SceneData* scene;
   TextureTables tables;
   float u;
+  // The cut-outs of a path's ray after `depth` scattering events, and of the shadow ray of a
+  // light sample drawn with uLight.
+  static AlphaCutouts ofPathRay(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex,
+                                uint depth);
+  static AlphaCutouts ofShadowRay(const SceneData& scene, vec2 uLight);
   static bool accept(const void* context, uint32_t triangle, const Hit& hit);
   HitFilter filter() const { return HitFilter{accept, this}; }
 };

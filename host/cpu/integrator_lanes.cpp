@@ -319,11 +319,11 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   // The ray's closest hit with cut-outs passed by, where the scene has them (integrator.cpp's
   // closestSurface and occluded).
   auto closest = [&](size_t i, bool degenerate, bool enters, Hit& found) {
-    AlphaCutouts cutouts{&scene, scene.textureTables(), 0.0f};
+    AlphaCutouts cutouts{};
     HitFilter filter{};
     if (alpha) {
-      cutouts.u =
-          pathAlphaRandom(uvec2(path.pixelX[i], path.pixelY[i]), sampleIndex, path.depth[i], seed);
+      cutouts = AlphaCutouts::ofPathRay(scene, uvec2(path.pixelX[i], path.pixelY[i]), sampleIndex,
+                                        path.depth[i]);
       filter = cutouts.filter();
     }
     const HitFilter* f = alpha ? &filter : nullptr;
@@ -337,10 +337,10 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
                                                         intersection, found, f);
   };
   auto blocked = [&](size_t i, bool degenerate, bool enters) {
-    AlphaCutouts cutouts{&scene, scene.textureTables(), 0.0f};
+    AlphaCutouts cutouts{};
     HitFilter filter{};
     if (alpha) {
-      cutouts.u = shadowAlphaRandom(uLight.get(i));
+      cutouts = AlphaCutouts::ofShadowRay(scene, uLight.get(i));
       filter = cutouts.filter();
     }
     const HitFilter* f = alpha ? &filter : nullptr;
@@ -454,12 +454,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       if (lambertian >> i & 1u) {
         // sampleBsdfAt's Lambertian lobe, its direction and density from the lanes above.
         wi = wiLambertian.get(i);
-        state.bsdfPdf = pdfLambertian.v[i];
-        scattered = state.bsdfPdf > 0.0f;
-        if (scattered) {
-          state.beta *= surface[i].material.reflectance;
-          state.specularBounce = false;
-        }
+        scattered = continueLambertian(surface[i], state, pdfLambertian.v[i]);
       } else {
         scattered = sampleBsdfAt(ps, surface[i], key[i], state, uRoulette.y.v[i], uBsdf.get(i), wi);
       }
