@@ -125,7 +125,7 @@ PT_INLINE float mitchellEvalQ(vec4 q, float t) {
   return t * (q.w + t * (q.z + t * (q.y + t * q.x)));
 }
 
-PT_INLINE MitchellCdf makeMitchellCdf(Camera cam) {
+PT_INLINE MitchellCdf makeMitchellCdf(PT_IN(Camera) cam) {
   MitchellCdf m;
   m.nearQ = mitchellNearQ(cam.filterB, cam.filterC);
   m.farQ = mitchellFarQ(cam.filterB, cam.filterC);
@@ -206,7 +206,7 @@ PT_INLINE float finishMitchellAxis(MitchellAxis a) {
 }
 
 // The sign of Mitchell1D at t (its value times 6, whose sign it is).
-PT_INLINE float mitchellSign(Camera cam, float t) {
+PT_INLINE float mitchellSign(PT_IN(Camera) cam, float t) {
   float a = abs(t);
   float b = cam.filterB;
   float c = cam.filterC;
@@ -227,7 +227,7 @@ struct FilmSample {
 
 // A film point for pixel filter `cam.filterType` from two uniform numbers: distributed in
 // proportion to |f| about the pixel's centre, with its weight.
-PT_INLINE FilmSample sampleFilm(Camera cam, vec2 u) {
+PT_INLINE FilmSample sampleFilm(PT_IN(Camera) cam, vec2 u) {
   vec2 radius = vec2(cam.filterRadiusX, cam.filterRadiusY);
   FilmSample s;
   s.point = sampleBoxFilter(u, radius);
@@ -306,7 +306,8 @@ struct CameraSample {
 // forward, at focalDistance times its screen-window point (whose forward component is 1); the
 // ray leaves from a uniform point of the lens's disk (radius lensRadius, in the plane of right
 // and up) towards that point. So everything on the plane in focus is sharp.
-PT_INLINE CameraSample generateCameraRay(Camera cam, uvec2 filmPixel, vec2 uFilter, vec2 uLens) {
+PT_INLINE CameraSample generateCameraRay(PT_IN(Camera) cam, uvec2 filmPixel, vec2 uFilter,
+                                         vec2 uLens) {
   FilmSample film = sampleFilm(cam, uFilter);
   vec3 w = cameraFilmVector(cam, vec2(filmPixel) + film.point);
   CameraSample s;

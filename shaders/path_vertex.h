@@ -207,39 +207,46 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
     if (PT_HAS_TEXTURES) s.material = resolveMaterial(PT_SCENE_TEXTURES s.material, textures, uv);
   }
 #endif
+  // The normals in locals, stored into s once: reading them back from s would wait on its
+  // stores (a store-to-load stall on the CPU).
   TriangleShading shading = triangleShadingAt(PT_SCENE_ARG index, tri);
-  s.p = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
-  s.ng = shading.normal;
-  s.magnitude = shading.magnitude;
-  s.area = shading.area;
-  s.wo = wo;
-  s.cosOut = dot(s.ng, wo);
+  vec3 ng = shading.normal;
+  float cosOut = dot(ng, wo);
   // Lambertian and mirror surfaces are two-sided: shaded with the normal facing the ray. With
   // vertex normals, about the interpolated normal. (pbrt-v4 does not guard against the light
   // leaks a shading normal can cause, and nor do we: BSDFs are evaluated about ns whichever
   // side of the geometric surface wi is on; rays leave on the side of ng they go to.)
-  s.n = s.cosOut >= 0.0f ? s.ng : -s.ng;
-  s.ns = s.ng;
-  s.shadingNormals = PT_HAS_SHADING_NORMALS && PT_PARAMS.normalsPresent != 0u;
+  vec3 n = cosOut >= 0.0f ? ng : -ng;
+  vec3 ns = ng;
+  bool shadingNormals = PT_HAS_SHADING_NORMALS && PT_PARAMS.normalsPresent != 0u;
 #ifndef PT_NO_BSDF_MATERIALS
   TriangleNormals normals;
-  if (s.shadingNormals) {
+  if (shadingNormals) {
     normals = loadNormals(PT_SCENE_ARG tri.primitive);
-    s.ns = interpolatedNormal(normals, b, s.ng);
-    s.n = dot(s.ns, wo) >= 0.0f ? s.ns : -s.ns;
+    ns = interpolatedNormal(normals, b, ng);
+    n = dot(ns, wo) >= 0.0f ? ns : -ns;
   }
   // A bump map moves the shading normal (texture.h).
   if (PT_HAS_BUMP_MAPS && textured && textures.displacement != kNoTexture) {
-    vec3 bumped = bumpedNormal(PT_SCENE_TEXTURES textures.displacement, tri,
-                               uvsAt(PT_SCENE_TEXTURES tri.primitive), uv, s.ng, s.ns,
-                               s.shadingNormals, normals);
-    if (bumped != s.ns) {
-      s.ns = bumped;
-      s.shadingNormals = true;
-      s.n = dot(s.ns, wo) >= 0.0f ? s.ns : -s.ns;
+    vec3 bumped =
+        bumpedNormal(PT_SCENE_TEXTURES textures.displacement, tri,
+                     uvsAt(PT_SCENE_TEXTURES tri.primitive), uv, ng, ns, shadingNormals, normals);
+    if (bumped != ns) {
+      ns = bumped;
+      shadingNormals = true;
+      n = dot(ns, wo) >= 0.0f ? ns : -ns;
     }
   }
 #endif
+  s.p = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
+  s.ng = ng;
+  s.ns = ns;
+  s.n = n;
+  s.wo = wo;
+  s.cosOut = cosOut;
+  s.magnitude = shading.magnitude;
+  s.area = shading.area;
+  s.shadingNormals = shadingNormals;
   // The switches fold the type tests away where a scene has one kind of surface.
   uint type = s.material.type;
   if (PT_HAS_MIRROR && ((!PT_HAS_DIFFUSE && !PT_HAS_BSDF_MATERIALS) || type == kMaterialMirror)) {
@@ -253,7 +260,7 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
   if (s.scatter == kScatterBsdf) {
     // The frame about the shading normal, not turned towards the ray: a dielectric tells
     // inside from outside by it.
-    s.frame = makeShadingFrame(s.ns, tri.v1 - tri.v0);
+    s.frame = makeShadingFrame(ns, tri.v1 - tri.v0);
     s.woLocal = toLocal(s.frame, wo);
   }
 #endif

@@ -208,7 +208,7 @@ PT_INLINE float maxComponent(vec3 v) {
 // The point of the screen window (on the plane at unit distance along forward, relative to
 // the camera's position) that film point (x, y) in [0, filmWidth) x [0, filmHeight), row 0 at
 // the top, maps to (see struct Camera).
-PT_INLINE vec3 cameraFilmVector(Camera cam, vec2 filmPoint) {
+PT_INLINE vec3 cameraFilmVector(PT_IN(Camera) cam, vec2 filmPoint) {
   float u = 2.0f * filmPoint.x / float(cam.filmWidth) - 1.0f;
   float v = 1.0f - 2.0f * filmPoint.y / float(cam.filmHeight);
   return cam.windowCenter + (u * cam.tanHalfFovY * cam.aspect) * cam.right +
@@ -216,7 +216,7 @@ PT_INLINE vec3 cameraFilmVector(Camera cam, vec2 filmPoint) {
 }
 
 // Unit direction of the pinhole's ray through film point (x, y) (cameraFilmVector).
-PT_INLINE vec3 cameraDirection(Camera cam, vec2 filmPoint) {
+PT_INLINE vec3 cameraDirection(PT_IN(Camera) cam, vec2 filmPoint) {
   return normalize(cameraFilmVector(cam, filmPoint));
 }
 

@@ -170,6 +170,21 @@ HWY_INLINE V3 sampleCosineHemisphere(V ux, V uy) {
             hn::Sqrt(glmMax(hn::Zero(D()), hn::Sub(splat(1.0f), ux)))};
 }
 
+// The pinhole's ray direction through film points (x, y) for all lanes at once (sampling.h's
+// cameraDirection, operation for operation; glm's normalize(v) is v * (1 / sqrt(dot(v, v)))).
+HWY_INLINE V3 cameraDirection(const Camera& cam, V filmX, V filmY) {
+  const V u =
+      hn::Sub(hn::Div(hn::Mul(splat(2.0f), filmX), splat(float(cam.filmWidth))), splat(1.0f));
+  const V v =
+      hn::Sub(splat(1.0f), hn::Div(hn::Mul(splat(2.0f), filmY), splat(float(cam.filmHeight))));
+  auto broadcast = [](vec3 a) { return V3{splat(a.x), splat(a.y), splat(a.z)}; };
+  const V3 w =
+      (broadcast(cam.windowCenter) +
+       hn::Mul(hn::Mul(u, splat(cam.tanHalfFovY)), splat(cam.aspect)) * broadcast(cam.right)) +
+      hn::Mul(v, splat(cam.tanHalfFovY)) * broadcast(cam.up);
+  return hn::Div(splat(1.0f), hn::Sqrt(dot(w, w))) * w;
+}
+
 // The wide traversal's first steps for the rays of several lanes at once: RayPrecomputed
 // (traverse.cpp; its six divisions become six vector divisions) and intersectBox against the
 // root's box. Returns the lanes whose ray enters it, their `prepared` filled in for
@@ -351,9 +366,18 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
            wide_traversal::anyHitFromRoot(copies.wide, prepared[i], 1.0f, intersection, f);
   };
 
+  // The box filter of one pixel and a pinhole: the film point is the pixel's corner plus the
+  // uniform numbers (sampleBoxFilter with radius 1/2 adds them exactly), the weight 1, so the
+  // camera rays are set up in lanes. Other filters and the thin lens take filter.h's
+  // generateCameraRay lane by lane.
+  const bool cameraInLanes = camera.filterType == kFilterBox && camera.filterRadiusX == 0.5f &&
+                             camera.filterRadiusY == 0.5f && !(camera.lensRadius > 0.0f);
+  Lanes filmX, filmY;
+
   for (;;) {
     // Free lanes start the next pixels' paths: the camera ray through a point of the pixel's
     // filter (and lens).
+    uint32_t starting = 0;
     for (size_t i = 0; i < lanes && nextPixel < count; ++i) {
       if (active >> i & 1u) continue;
       const uvec2 pixel = pixels[nextPixel];
@@ -363,6 +387,10 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       path.pixelX[i] = filmPixel.x;
       path.pixelY[i] = filmPixel.y;
       path.depth[i] = 0;
+      path.dim[i] = 0;
+      path.state[i] = startPathState();
+      starting |= 1u << i;
+      if (cameraInLanes) continue;
       const vec2 uLens = camera.lensRadius > 0.0f
                              ? random2(sobol, filmPixel, sampleIndex, kDimLens, seed)
                              : vec2(0.0f);
@@ -371,9 +399,24 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       path.origin.set(i, ray.origin);
       path.direction.set(i, ray.direction);
       path.weight[i] = ray.weight;
-      path.state[i] = startPathState();
-      active |= 1u << i;
     }
+    if (starting != 0 && cameraInLanes) {
+      drawRandom2(sobol, path, sampleIndex, kDimPixel, seed, starting, filmX, filmY);
+      const hn::RebindToSigned<D> di;
+      const hn::RebindToUnsigned<D> du;
+      const V x =
+          hn::Add(hn::ConvertTo(D(), hn::BitCast(di, hn::Load(du, path.pixelX))), filmX.load());
+      const V y =
+          hn::Add(hn::ConvertTo(D(), hn::BitCast(di, hn::Load(du, path.pixelY))), filmY.load());
+      Lanes3 direction;
+      store(direction, cameraDirection(camera, x, y));
+      forEachLane(starting, [&](size_t i) {
+        path.origin.set(i, camera.position);
+        path.direction.set(i, direction.get(i));
+        path.weight[i] = 1.0f;
+      });
+    }
+    active |= starting;
     if (active == 0) break;
 
     // Find the closest surface along each ray; a lane whose ray leaves the scene is done. The
