@@ -11,25 +11,13 @@
 
 #include "bvh/traverse.h"
 #include "common/shared.h"
+#include "sanitizer_build.h"
 
 namespace pt::test {
 
-// Whether this is the sanitizer build (docs/errors.md), which looks for memory errors and
-// undefined behaviour rather than wrong answers and runs the traversals about 20x slower.
-#if defined(__SANITIZE_ADDRESS__)
-inline constexpr bool kSanitizerBuild = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-inline constexpr bool kSanitizerBuild = true;
-#else
-inline constexpr bool kSanitizerBuild = false;
-#endif
-#else
-inline constexpr bool kSanitizerBuild = false;
-#endif
-
-// Rays per brute-force comparison: 100k in the normal build; the sanitizer build checks the
-// first 20k of the same rays.
+// Rays per brute-force comparison: 100k in the normal build; the sanitizer build, which looks
+// for memory errors and undefined behaviour rather than wrong answers and runs the traversals
+// about 20x slower, checks the first 20k of the same rays.
 inline constexpr int kBruteForceRays = kSanitizerBuild ? 20000 : 100000;
 // The watertightness probes (a million rays aimed at vertices and edges) take every ray in the
 // normal build and every fifth in the sanitizer build, their thresholds scaled alike.

@@ -12,6 +12,7 @@
 #include "common/check.h"
 #include "common/memory.h"
 #include "image/image.h"
+#include "sanitizer_build.h"
 #include "test_util.h"
 
 namespace pt {
@@ -73,16 +74,9 @@ TEST(MemoryLimit, AvailableMemoryIsPlausible) {
 }
 
 // The sanitizers reserve terabytes of address space, so `ulimit -v` cannot apply to them.
-#if defined(__SANITIZE_ADDRESS__)
-#define PT_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define PT_TEST_ASAN 1
-#endif
-#endif
 
 TEST(MemoryLimit, HugeFilmIsRefusedBeforeAllocating) {
-#ifdef PT_TEST_ASAN
+#if PT_TEST_SANITIZED
   GTEST_SKIP() << "ulimit -v does not work under AddressSanitizer";
 #else
   // 16384 x 16384 pixels at well over 40 bytes each: tens of GiB, refused under a 2 GiB
@@ -105,7 +99,7 @@ TEST(MemoryLimit, HugeFilmIsRefusedBeforeAllocating) {
 }
 
 TEST(MemoryLimit, HugeFilmFromTheSceneNamesTheScene) {
-#ifdef PT_TEST_ASAN
+#if PT_TEST_SANITIZED
   GTEST_SKIP() << "ulimit -v does not work under AddressSanitizer";
 #else
   // The size written in the scene file (16384 is the most it accepts): refused before the BVH

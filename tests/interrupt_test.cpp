@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "image/film_state.h"
+#include "sanitizer_build.h"
 #include "test_util.h"
 
 extern char** environ;
@@ -41,11 +42,6 @@ double secondsSince(Clock::time_point t) {
 
 // pt started in the background with fork and exec (no shell: signals go to pt itself), its
 // streams into files of a directory of its own.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;  // AddressSanitizer (PT_SANITIZE): everything runs slower
-#else
-constexpr bool kSanitized = false;
-#endif
 
 class PtProcess {
  public:
@@ -249,7 +245,7 @@ TEST(Interrupt, SigtermStopsTheSameWay) {
                 "--height", "32", "--spp", "1000000", "--out", (dir / "a.pfm").string()});
   // Late enough that a pass is complete (else nothing is written, by design); a sanitizer
   // build starts several times slower.
-  sleepFor(kSanitized ? 5.0 : 0.5);
+  sleepFor(test::kSanitizerBuild ? 5.0 : 0.5);
   pt.signal(SIGTERM);
   const PtResult r = pt.wait();
   ASSERT_EQ(r.status, 5) << r.err;

@@ -3,18 +3,12 @@
 #pragma once
 
 #include "common/shared.h"
+#include "sanitizer_build.h"
 
 // Sanitized builds (ASan + UBSan at -O1) and unoptimized ones run the sampling tests
 // (bsdf_test.cpp, materials_test.cpp) on fewer samples: the tests keep their significance, they
 // only lose some power.
-#if defined(__SANITIZE_ADDRESS__)
-#define PT_BSDF_TEST_SLOW 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define PT_BSDF_TEST_SLOW 1
-#endif
-#endif
-#if !defined(PT_BSDF_TEST_SLOW) && !defined(__OPTIMIZE__)
+#if PT_TEST_SANITIZED || !defined(__OPTIMIZE__)
 #define PT_BSDF_TEST_SLOW 1
 #endif
 
