@@ -134,7 +134,7 @@ std::string describe(const Material& m) {
   std::ostringstream s;
   static const char* const kNames[] = {"diffuse",      "mirror",         "conductor",
                                        "dielectric",   "thindielectric", "diffusetransmission",
-                                       "coateddiffuse"};
+                                       "coateddiffuse", "interface"};
   s << (m.type < kMaterialTypeCount ? kNames[m.type] : "?") << " alpha " << m.alphaX << "/"
     << m.alphaY << " eta " << m.eta.x;
   if (m.type == kMaterialConductor) s << "," << m.eta.y << "," << m.eta.z << " k " << m.k.x;

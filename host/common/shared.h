@@ -38,6 +38,13 @@ static_assert(offsetof(Material, nSamples) == 88 && offsetof(Material, reserved1
 static_assert(sizeof(TriangleNormals) == 48);
 static_assert(offsetof(TriangleNormals, n1) == 16 && offsetof(TriangleNormals, n2) == 32);
 
+static_assert(sizeof(Medium) == 144 && sizeof(Medium) == 16 * kMediumTexels);
+static_assert(offsetof(Medium, type) == 12 && offsetof(Medium, g) == 28);
+static_assert(offsetof(Medium, emissive) == 44 && offsetof(Medium, density) == 60);
+static_assert(offsetof(Medium, majorants) == 76 && offsetof(Medium, emission) == 92);
+static_assert(offsetof(Medium, toMedium0) == 96 && offsetof(Medium, toMedium2) == 128);
+static_assert(sizeof(MediumInterface) == 8);
+
 static_assert(sizeof(Emitter) == 16);
 static_assert(offsetof(Emitter, pmf) == 4 && offsetof(Emitter, aliasThreshold) == 8);
 static_assert(offsetof(Emitter, alias) == 12);
@@ -55,7 +62,8 @@ static_assert(offsetof(Camera, filterRootsFar) == 144 && offsetof(Camera, filter
 // RenderParams after its Camera, whatever the Camera's size (a multiple of 16 bytes).
 inline constexpr std::size_t kParamsBase = sizeof(Camera);
 static_assert(kParamsBase % 16 == 0);
-static_assert(sizeof(RenderParams) == kParamsBase + 128);
+static_assert(sizeof(RenderParams) == kParamsBase + 144);
+static_assert(offsetof(RenderParams, cameraMedium) == kParamsBase + 128);
 static_assert(offsetof(RenderParams, maxDepth) == kParamsBase);
 static_assert(offsetof(RenderParams, seed) == kParamsBase + 12);
 static_assert(offsetof(RenderParams, russianRoulette) == kParamsBase + 20);

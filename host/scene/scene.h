@@ -101,6 +101,15 @@ struct Scene {
   // At most one image environment (not in `lights`: prepareScene adds its Light); constant
   // infinite lights in `lights` add to its radiance.
   std::optional<EnvironmentImage> environment;
+  // Participating media (shaders/medium.h), all empty in a scene without any: the media,
+  // their names (parallel, for messages), the floats of their grids (Medium::density,
+  // majorants and emission index into it; the majorant grids are prepareScene's), and per
+  // triangle, parallel to `triangles`, the media on its two sides.
+  std::vector<Medium> media;
+  std::vector<std::string> mediumNames;
+  std::vector<float> mediumGrids;
+  std::vector<MediumInterface> mediumInterfaces;
+  uint cameraMedium = kNoMedium;  // the medium the camera is in
   std::vector<std::string> warnings;  // e.g. dropped zero-area triangles, one line each
 };
 
