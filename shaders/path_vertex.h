@@ -83,6 +83,10 @@ struct PathScene {
   const TriangleNormals* normals;  // by Triangle::primitive; null without vertex normals
   TextureTables textures;
   const vec4* environmentTexels;
+  // Participating media (medium.h, volume_vertex.h); null in a scene without any.
+  const Medium* media;
+  const float* mediumGrids;                  // grid floats, majorant grids included
+  const MediumInterface* mediumInterfaces;  // by Triangle::primitive
 };
 #define PT_SCENE_PARAM const PathScene &scene,
 #define PT_SCENE_ARG scene,
@@ -269,15 +273,36 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
 
 // ---- Emission found by a ray -------------------------------------------------------------
 
+// The density with which light sampling from `from` would have chosen the point of emissive
+// triangle tri (shading point s, at distance t from `from`, seen at cosine cosEmit), per solid
+// angle: uniform on the triangle, or the cone of a sphere light.
+PT_INLINE float emitterPdfFound(PT_SCENE_PARAM PT_IN(Triangle) tri, PT_IN(SurfacePoint) s,
+                                float cosEmit, float t, vec3 from) {
+  Emitter emitter = loadEmitter(PT_SCENE_ARG tri.emitter);
+  float lightPdf = emitter.pmf * t * t / (cosEmit * s.area);
+#ifndef PT_NO_BSDF_MATERIALS
+  // A sphere light's triangle: light sampling draws its cone (seen from the ray's origin).
+  if (PT_HAS_SPHERE_LIGHTS && (emitter.triangle & kEmitterLight) != 0u) {
+    lightPdf = emitter.pmf * sphereLightPdf(loadLight(PT_SCENE_ARG emitter.triangle & ~kEmitterLight),
+                                            from);
+  }
+#endif
+  return lightPdf;
+}
+
+// The cosine at which the surface at s emits towards the ray that found it: on its geometric
+// normal's side, or on both; not above zero where it does not.
+PT_INLINE float emissionCosine(PT_IN(SurfacePoint) s) {
+  return (PT_HAS_TWO_SIDED_EMITTERS && s.material.twoSided != 0u) ? abs(s.cosOut) : s.cosOut;
+}
+
 // Adds the emission of the surface the path's ray found (triangle tri, `t` along the unit ray
-// from rayOrigin) where it emits towards the ray: on its geometric normal's side, or on both.
-// At full weight after a specular bounce (or from the camera); else weighed against the chance
-// that light sampling had produced the same point (MIS), or not counted (light sampling
-// alone).
+// from rayOrigin) where it emits towards the ray. At full weight after a specular bounce (or
+// from the camera); else weighed against the chance that light sampling had produced the same
+// point (MIS), or not counted (light sampling alone).
 PT_INLINE void addEmissionFound(PT_SCENE_PARAM PT_INOUT(PathState) path, PT_IN(Triangle) tri,
                                 PT_IN(SurfacePoint) s, float t, vec3 rayOrigin) {
-  float cosEmit =
-      (PT_HAS_TWO_SIDED_EMITTERS && s.material.twoSided != 0u) ? abs(s.cosOut) : s.cosOut;
+  float cosEmit = emissionCosine(s);
   if (tri.emitter == kNoEmitter || !(cosEmit > 0.0f)) return;
   vec3 Le = s.material.emission;
   if (path.specularBounce) {
@@ -285,42 +310,44 @@ PT_INLINE void addEmissionFound(PT_SCENE_PARAM PT_INOUT(PathState) path, PT_IN(T
   } else if (bsdfEmissionOn(PT_SCENE_ONLY)) {
     float weight = 1.0f;
     if (misOn(PT_SCENE_ONLY)) {
-      // Light sampling's density of this point: uniform on the triangle, per solid angle.
-      Emitter emitter = loadEmitter(PT_SCENE_ARG tri.emitter);
-      float lightPdf = emitter.pmf * t * t / (cosEmit * s.area);
-#ifndef PT_NO_BSDF_MATERIALS
-      // A sphere light's triangle: light sampling draws its cone (seen from the ray's origin).
-      if (PT_HAS_SPHERE_LIGHTS && (emitter.triangle & kEmitterLight) != 0u) {
-        lightPdf =
-            emitter.pmf *
-            sphereLightPdf(loadLight(PT_SCENE_ARG emitter.triangle & ~kEmitterLight), rayOrigin);
-      }
-#endif
-      weight = powerHeuristic(path.bsdfPdf, lightPdf);
+      weight = powerHeuristic(path.bsdfPdf,
+                              emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, t, rayOrigin));
     }
     path.L += path.beta * weight * Le;
   }
 }
 
+#ifndef PT_NO_BSDF_MATERIALS
+// The infinite light's radiance along `direction` (an image's by direction) and light
+// sampling's density of that direction (the light's pmf included).
+struct EnvironmentFound {
+  vec3 Le;
+  float lightPdf;
+};
+PT_INLINE EnvironmentFound environmentFound(PT_SCENE_PARAM vec3 direction) {
+  EnvironmentFound e = EnvironmentFound(PT_PARAMS.environment, PT_PARAMS.environmentPdf);
+  if (PT_HAS_ENVIRONMENT_IMAGE && PT_PARAMS.environmentWidth != 0u) {
+    // The image: the direction's texel, and its density times the light's pmf.
+    EnvironmentLookup l = environmentLookup(environmentMap(PT_SCENE_ONLY), direction);
+    e.Le = l.Le;
+    e.lightPdf = PT_PARAMS.environmentPdf * l.pdf;
+  }
+  return e;
+}
+#endif
+
 // Adds the infinite light's radiance seen by a ray that leaves the scene along `direction`
-// (none without one; an image's by direction), weighed as emission found on a surface is.
+// (none without one), weighed as emission found on a surface is.
 PT_INLINE void addEnvironmentFound(PT_SCENE_PARAM PT_INOUT(PathState) path, vec3 direction) {
 #ifndef PT_NO_BSDF_MATERIALS
   if (!PT_HAS_ENVIRONMENT || PT_PARAMS.environmentEmitter == kNoEmitter) return;
-  vec3 Le = PT_PARAMS.environment;
-  float lightPdf = PT_PARAMS.environmentPdf;
-  if (PT_HAS_ENVIRONMENT_IMAGE && PT_PARAMS.environmentWidth != 0u) {
-    // The image: the direction's texel, and its density times the light's pmf.
-    EnvironmentLookup e = environmentLookup(environmentMap(PT_SCENE_ONLY), direction);
-    Le = e.Le;
-    lightPdf = PT_PARAMS.environmentPdf * e.pdf;
-  }
+  EnvironmentFound e = environmentFound(PT_SCENE_ARG direction);
   if (path.specularBounce) {
-    path.L += path.beta * Le;
+    path.L += path.beta * e.Le;
   } else if (bsdfEmissionOn(PT_SCENE_ONLY)) {
     float weight = 1.0f;
-    if (misOn(PT_SCENE_ONLY)) weight = powerHeuristic(path.bsdfPdf, lightPdf);
-    path.L += path.beta * weight * Le;
+    if (misOn(PT_SCENE_ONLY)) weight = powerHeuristic(path.bsdfPdf, e.lightPdf);
+    path.L += path.beta * weight * e.Le;
   }
 #endif
 }
@@ -377,20 +404,27 @@ PT_INLINE vec3 bsdfFCos(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key, vec
 }
 #endif
 
-// Samples the light from vertex s (pbrt-v4's SampleLd): an emitter from the alias table with
-// uChoose, and with uLight a uniform point on its triangle or a sample of the analytic light
-// (lights.h, environment.h) it names; the BSDF's value towards it, and the shadow ray's ends.
-// The shadow ray leaves along n from a Lambertian surface without shading normals, else from
-// the side of the geometric surface the light is on.
-PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
-                                    vec2 uChoose, vec2 uLight) {
-  LightSample ls = noLightSample();
+// An emitter sampled from point p (the first half of pbrt-v4's SampleLd): chosen from the
+// alias table with uChoose, and with uLight a uniform point on its triangle or a sample of the
+// analytic light (lights.h, environment.h) it names.
+struct EmitterSample {
+  bool found;      // false: the light contributes nothing (it faces away, or no radiance)
+  vec3 wi;         // unit direction from p towards it
+  vec3 to;         // the shadow ray's end: offset from the light's point, or beyond the scene
+  vec3 Li;         // radiance arriving (a delta light's weight)
+  float lightPdf;  // the probability of the emitter times the density of the sample
+  bool delta;      // a point, spot or distant light
+  bool triangle;   // an emissive triangle (the Lambertian product is grouped otherwise)
+  uint emitter;    // Emitter::triangle of the emitter chosen (for --debug-pixel)
+};
+
+PT_INLINE EmitterSample sampleEmitter(PT_SCENE_PARAM vec3 p, vec2 uChoose, vec2 uLight) {
+  EmitterSample e =
+      EmitterSample(false, vec3(0.0f), vec3(0.0f), vec3(0.0f), 0.0f, false, true, 0u);
   uint slot = aliasTableSlot(uChoose.x, PT_PARAMS.emitterCount);
   Emitter emitter =
       loadEmitter(PT_SCENE_ARG aliasTablePick(slot, loadEmitter(PT_SCENE_ARG slot), uChoose.y));
-  ls.emitter = emitter.triangle;
-  bool lambertian = s.scatter != kScatterBsdf;
-  vec3 wi;
+  e.emitter = emitter.triangle;
 #ifndef PT_NO_BSDF_MATERIALS
   if (PT_HAS_ANALYTIC_LIGHTS && (emitter.triangle & kEmitterLight) != 0u) {
     // An analytic light: the environment image's sample for an infinite light that has one,
@@ -400,66 +434,96 @@ PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Vertex
     if (PT_HAS_ENVIRONMENT_IMAGE && light.type == kLightInfinite &&
         PT_PARAMS.environmentWidth != 0u) {
       analytic =
-          sampleEnvironmentLight(environmentMap(PT_SCENE_ONLY), s.p, uLight, PT_PARAMS.sceneRadius);
+          sampleEnvironmentLight(environmentMap(PT_SCENE_ONLY), p, uLight, PT_PARAMS.sceneRadius);
     } else {
-      analytic = sampleAnalyticLight(light, s.p, uLight, PT_PARAMS.sceneRadius);
+      analytic = sampleAnalyticLight(light, p, uLight, PT_PARAMS.sceneRadius);
     }
-    wi = analytic.wi;
-    if (lambertian) {
-      ls.cosTheta = dot(s.n, wi);
-      if (!(ls.cosTheta > 0.0f) || !(maxComponent(analytic.Li) > 0.0f)) return ls;
-      ls.f = s.material.reflectance * kInvPi * ls.cosTheta;
-    } else {
-      if (!(maxComponent(analytic.Li) > 0.0f)) return ls;
-      ls.wiLocal = toLocal(s.frame, wi);
-      ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
-      if (!(maxComponent(ls.f) > 0.0f)) return ls;
-    }
-    ls.to = analytic.target;
-    ls.Li = analytic.Li;
-    ls.lightPdf = emitter.pmf * analytic.pdf;
-    ls.delta = analytic.delta;
-  } else
+    e.triangle = false;
+    e.wi = analytic.wi;
+    e.found = maxComponent(analytic.Li) > 0.0f;
+    e.to = analytic.target;
+    e.Li = analytic.Li;
+    e.lightPdf = emitter.pmf * analytic.pdf;
+    e.delta = analytic.delta;
+    return e;
+  }
 #endif
-  {
-    // An emissive triangle: a uniform point on it.
-    Triangle light = loadTriangle(PT_SCENE_ARG emitter.triangle);
-    TriangleShading lightShading = triangleShadingAt(PT_SCENE_ARG emitter.triangle, light);
-    Material lightMaterial = loadMaterial(PT_SCENE_ARG light.material);
-    vec2 b = sampleTriangleBarycentrics(uLight);
-    vec3 point = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
-    vec3 lightNormal = lightShading.normal;  // it emits on this side
-    vec3 toLight = point - s.p;
-    float dist2 = dot(toLight, toLight);
-    wi = toLight / sqrt(dist2);
-    float cosLight = -dot(lightNormal, wi);  // > 0: the point sees the emitting side
-    // A two-sided light seen from its back: the side the point sees is the emitting one, its
-    // normal turned towards the point (for the cosine and the shadow ray's offset).
-    if (PT_HAS_TWO_SIDED_EMITTERS && lightMaterial.twoSided != 0u && cosLight < 0.0f) {
-      cosLight = -cosLight;
-      lightNormal = -lightNormal;
-    }
-    if (lambertian) {
-      ls.cosTheta = dot(s.n, wi);
-      if (!(cosLight > 0.0f && ls.cosTheta > 0.0f)) return ls;
+  // An emissive triangle: a uniform point on it.
+  Triangle light = loadTriangle(PT_SCENE_ARG emitter.triangle);
+  TriangleShading lightShading = triangleShadingAt(PT_SCENE_ARG emitter.triangle, light);
+  Material lightMaterial = loadMaterial(PT_SCENE_ARG light.material);
+  vec2 b = sampleTriangleBarycentrics(uLight);
+  vec3 point = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
+  vec3 lightNormal = lightShading.normal;  // it emits on this side
+  vec3 toLight = point - p;
+  float dist2 = dot(toLight, toLight);
+  e.wi = toLight / sqrt(dist2);
+  float cosLight = -dot(lightNormal, e.wi);  // > 0: the point sees the emitting side
+  // A two-sided light seen from its back: the side the point sees is the emitting one, its
+  // normal turned towards the point (for the cosine and the shadow ray's offset).
+  if (PT_HAS_TWO_SIDED_EMITTERS && lightMaterial.twoSided != 0u && cosLight < 0.0f) {
+    cosLight = -cosLight;
+    lightNormal = -lightNormal;
+  }
+  e.found = cosLight > 0.0f;
+  e.to = offsetRayOrigin(point, lightNormal, lightShading.magnitude);
+  e.Li = lightMaterial.emission;
+  e.lightPdf = emitter.pmf * dist2 / (cosLight * lightShading.area);
+  return e;
+}
+
+// Samples the light from vertex s (pbrt-v4's SampleLd): an emitter (sampleEmitter), the BSDF's
+// value towards it, and the shadow ray's ends. The shadow ray leaves along n from a Lambertian
+// surface without shading normals, else from the side of the geometric surface the light is
+// on.
+PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
+                                    vec2 uChoose, vec2 uLight) {
+  LightSample ls = noLightSample();
+  EmitterSample e = sampleEmitter(PT_SCENE_ARG s.p, uChoose, uLight);
+  ls.emitter = e.emitter;
+  if (!e.found) return ls;
+  bool lambertian = s.scatter != kScatterBsdf;
+  vec3 wi = e.wi;
+  if (lambertian) {
+    ls.cosTheta = dot(s.n, wi);
+    if (!(ls.cosTheta > 0.0f)) return ls;
+    // With an emissive triangle, the cosine is the contribution's `scale` (the order of the
+    // renderer's images).
+    if (e.triangle) {
       ls.f = s.material.reflectance * kInvPi;
       ls.scale = ls.cosTheta;
     } else {
-#ifndef PT_NO_BSDF_MATERIALS
-      if (!(cosLight > 0.0f)) return ls;
-      ls.wiLocal = toLocal(s.frame, wi);
-      ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
-      if (!(maxComponent(ls.f) > 0.0f)) return ls;
-#endif
+      ls.f = s.material.reflectance * kInvPi * ls.cosTheta;
     }
-    ls.to = offsetRayOrigin(point, lightNormal, lightShading.magnitude);
-    ls.Li = lightMaterial.emission;
-    ls.lightPdf = emitter.pmf * dist2 / (cosLight * lightShading.area);
+  } else {
+#ifndef PT_NO_BSDF_MATERIALS
+    ls.wiLocal = toLocal(s.frame, wi);
+    ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
+    if (!(maxComponent(ls.f) > 0.0f)) return ls;
+#endif
   }
+  ls.to = e.to;
+  ls.Li = e.Li;
+  ls.lightPdf = e.lightPdf;
+  ls.delta = e.delta;
   vec3 side = (lambertian && !s.shadingNormals) ? s.n : geometricSide(s, wi);
   ls.from = offsetRayOrigin(s.p, side, s.magnitude);
   ls.found = true;
   return ls;
+}
+
+// BSDF sampling's density of a light sample's direction (for MIS).
+PT_INLINE float lightSampleBsdfPdf(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
+                                   PT_IN(LightSample) ls) {
+  float bsdfDensity = ls.cosTheta * kInvPi;
+#ifndef PT_NO_BSDF_MATERIALS
+  if (s.scatter == kScatterBsdf) {
+    bsdfDensity = bsdfPdf(
+        s.material, s.woLocal, ls.wiLocal,
+        makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed, kStreamLightPdf));
+  }
+#endif
+  return bsdfDensity;
 }
 
 // The contribution of a light sample whose shadow ray was found clear, with the path's
@@ -469,15 +533,7 @@ PT_INLINE vec3 lightSampleContribution(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Ver
                                        PT_IN(LightSample) ls, vec3 beta, PT_OUT(float) weight) {
   weight = 1.0f;
   if (misOn(PT_SCENE_ONLY) && !ls.delta) {
-    float bsdfDensity = ls.cosTheta * kInvPi;
-#ifndef PT_NO_BSDF_MATERIALS
-    if (s.scatter == kScatterBsdf) {
-      bsdfDensity = bsdfPdf(
-          s.material, s.woLocal, ls.wiLocal,
-          makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed, kStreamLightPdf));
-    }
-#endif
-    weight = powerHeuristic(ls.lightPdf, bsdfDensity);
+    weight = powerHeuristic(ls.lightPdf, lightSampleBsdfPdf(PT_SCENE_ARG s, key, ls));
   }
   return beta * ls.f * ls.Li * (ls.scale * weight / ls.lightPdf);
 }

@@ -90,6 +90,11 @@ layout(set = 0,
 #ifndef PT_NO_BSDF_MATERIALS
 layout(set = 0, binding = PT_BINDING_ENVIRONMENT) uniform usamplerBuffer environmentTexels;
 #endif
+#ifdef PT_VOLPATH
+layout(set = 0, binding = PT_BINDING_MEDIA) uniform usamplerBuffer mediumTexels;
+layout(set = 0, binding = PT_BINDING_MEDIUM_GRIDS) uniform usamplerBuffer mediumGridTexels;
+layout(set = 0, binding = PT_BINDING_MEDIUM_INTERFACES) uniform usamplerBuffer interfaceTexels;
+#endif
 layout(std430, set = 0, binding = PT_BINDING_ACCUM) buffer AccumBuffer {
   AccumPixel accum[];
 };
@@ -250,6 +255,33 @@ Light loadLight(uint i) {
 #define PT_HAS_BSDF_MATERIALS kBsdfMaterials
 #include "path_vertex.h"
 
+#ifdef PT_VOLPATH
+// What medium.h and volume_vertex.h read, from the media bindings.
+Medium loadMedium(uint i) {
+  int at = int(kMediumTexels * i);
+  uvec4 a = texelFetch(mediumTexels, at);
+  uvec4 b = texelFetch(mediumTexels, at + 1);
+  uvec4 c = texelFetch(mediumTexels, at + 2);
+  uvec4 d = texelFetch(mediumTexels, at + 3);
+  uvec4 e = texelFetch(mediumTexels, at + 4);
+  uvec4 f = texelFetch(mediumTexels, at + 5);
+  return Medium(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), uintBitsToFloat(b.w),
+                uintBitsToFloat(c.xyz), c.w, uintBitsToFloat(d.xyz), d.w, uintBitsToFloat(e.xyz),
+                e.w, f.xyz, f.w, uintBitsToFloat(texelFetch(mediumTexels, at + 6)),
+                uintBitsToFloat(texelFetch(mediumTexels, at + 7)),
+                uintBitsToFloat(texelFetch(mediumTexels, at + 8)));
+}
+float mediumGridFloat(uint i) {
+  return uintBitsToFloat(texelFetch(mediumGridTexels, int(i >> 2u))[i & 3u]);
+}
+MediumInterface loadMediumInterface(uint primitive) {
+  uvec4 a = texelFetch(interfaceTexels, int(primitive >> 1u));
+  return (primitive & 1u) != 0u ? MediumInterface(a.z, a.w) : MediumInterface(a.x, a.y);
+}
+#define PT_MEDIUM_LOOP_TICK() gLoopIterations++
+#include "volume_vertex.h"
+#endif
+
 // A ray whose first traversal gave up at an edge function of exactly zero (traceRayWith in
 // bvh.glsl), traced again with the exact test once the bounce is done (main): a shadow ray,
 // whose light sample then adds `contribution` to the path's radiance unless occluded, or the
@@ -305,6 +337,13 @@ void debugLightSample(uint depth, LightSample ls, float weight) {
 #endif
 }
 
+// The radiance a path has gathered.
+#ifdef PT_VOLPATH
+#define PATH_RADIANCE(path) path.vol.path.L
+#else
+#define PATH_RADIANCE(path) path.state.L
+#endif
+
 // What sampleRadiance (host/cpu/integrator.cpp) keeps across its loop: one sample's path,
 // between two bounces.
 struct Path {
@@ -312,7 +351,12 @@ struct Path {
   uint depth;   // scattering events so far
   vec3 origin;  // the ray to trace next
   vec3 direction;
+#ifdef PT_VOLPATH
+  VolumePath vol;   // PathState and what media add (volume_vertex.h)
+  uint crossings;   // interface surfaces crossed since the last scattering event
+#else
   PathState state;  // L, beta, etaScale, bsdfPdf, specularBounce (path_vertex.h)
+#endif
   float weight;     // the camera sample's weight (filter.h): multiplies L at the end
   bool hitReady;    // the ray's closest hit is hitFound and hit already (see Retrace)
   bool hitFound;
@@ -334,13 +378,21 @@ Path startPath(uvec2 pixel, uint sampleIndex) {
   path.origin = camera.origin;
   path.direction = camera.direction;
   path.weight = camera.weight;
+#ifdef PT_VOLPATH
+  path.vol = startVolumePath(pixel, sampleIndex, camera.origin);
+  path.crossings = 0u;
+#else
   path.state = startPathState();
+#endif
   path.hitReady = false;
   path.hitFound = false;
   path.hit = HitData(0.0, 0u);
   return path;
 }
 
+#ifdef PT_VOLPATH
+#include "volpath.glsl"
+#else
 // One iteration of sampleRadiance's loop (the same steps of path_vertex.h): traces the path's
 // ray, adds the emission it finds, samples a light, scatters. Returns true when the path has
 // ended, its radiance then being path.state.L once `retrace` is done (main).
@@ -431,6 +483,7 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   path.direction = wi;
   return false;
 }
+#endif
 
 void main() {
   params = paramsBuffer;
@@ -469,7 +522,7 @@ void main() {
           traceRayWith(/*exact=*/true, retrace.origin, retrace.direction,
                        retrace.shadow ? 1.0 : 1.0 / 0.0, retrace.shadow, exactHit, inexact);
       if (retrace.shadow) {
-        if (!found) path.state.L += retrace.contribution;
+        if (!found) PATH_RADIANCE(path) += retrace.contribution;
       } else {
         path.hitReady = true;
         path.hitFound = found;
@@ -478,7 +531,7 @@ void main() {
     }
     if (!ended) continue;
     // The camera sample's weight: 1 but for the negative lobes of some filters (filter.h).
-    vec3 L = path.state.L * path.weight;
+    vec3 L = PATH_RADIANCE(path) * path.weight;
 #ifdef PT_DEBUG_PRINTF
     if (gDebug) {
       debugPrintfEXT("gpu sample %u: L=(%g, %g, %g)", path.sampleIndex, L.x, L.y, L.z);

@@ -445,7 +445,11 @@ PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v =
 #define PT_BINDING_TEXTURES 11           // TextureNode[], texels
 #define PT_BINDING_IMAGES 12             // the image buffer: uint words (R32_UINT texels)
 #define PT_BINDING_MATERIAL_TEXTURES 13  // MaterialTextures[], texels
-#define PT_BINDING_COUNT 14
+// Participating media (the volume variant reads them): one dummy entry each without media.
+#define PT_BINDING_MEDIA 14              // Medium[], texels
+#define PT_BINDING_MEDIUM_GRIDS 15       // the grids' floats, four to a texel
+#define PT_BINDING_MEDIUM_INTERFACES 16  // MediumInterface[] by primitive, two to a texel
+#define PT_BINDING_COUNT 17
 
 // Specialization constant ids: the effect set. An effect switched off is compiled out.
 #define PT_SPEC_DIFFUSE 0        // bool: Lambertian surfaces occur

@@ -21,6 +21,7 @@
 #include "common/check.h"
 #include "cpu/bounce_random.h"
 #include "cpu/integrator_lanes.h"
+#include "cpu/volpath.h"
 #include "filter.h"
 #include "path_vertex.h"
 
@@ -36,16 +37,8 @@ int availableCpus() {
   return int(std::max(1u, std::thread::hardware_concurrency()));
 }
 
-// The scene's ray queries: the closest hit along a path's `ray`, and whether anything lies on a
-// shadow ray's segment t in [0, 1) whose light sample drew uLight, cut-outs passed by where the
-// scene has them.
-std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Intersection test,
-                                  uvec2 pixel, uint32_t sampleIndex, uint depth) {
-  if (!scene.effects.alphaCutouts) return closestHit(scene.wideBvh(), ray, INFINITY, test);
-  const AlphaCutouts cutouts = AlphaCutouts::ofPathRay(scene, pixel, sampleIndex, depth);
-  const HitFilter filter = cutouts.filter();
-  return closestHit(scene.wideBvh(), ray, INFINITY, test, &filter);
-}
+// Whether anything lies on a shadow ray's segment t in [0, 1) whose light sample drew uLight,
+// cut-outs passed by where the scene has them.
 bool occluded(const SceneData& scene, const Ray& ray, Intersection test, vec2 uLight) {
   if (!scene.effects.alphaCutouts) return anyHit(scene.wideBvh(), ray, 1.0f, test);
   const AlphaCutouts cutouts = AlphaCutouts::ofShadowRay(scene, uLight);
@@ -54,6 +47,22 @@ bool occluded(const SceneData& scene, const Ray& ray, Intersection test, vec2 uL
 }
 
 }  // namespace
+
+std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Intersection test,
+                                  uvec2 pixel, uint32_t sampleIndex, uint depth) {
+  if (!scene.effects.alphaCutouts) return closestHit(scene.wideBvh(), ray, INFINITY, test);
+  const AlphaCutouts cutouts = AlphaCutouts::ofPathRay(scene, pixel, sampleIndex, depth);
+  const HitFilter filter = cutouts.filter();
+  return closestHit(scene.wideBvh(), ray, INFINITY, test, &filter);
+}
+
+std::optional<Hit> closestShadowHit(const SceneData& scene, const Ray& ray, Intersection test,
+                                    vec2 uLight) {
+  if (!scene.effects.alphaCutouts) return closestHit(scene.wideBvh(), ray, 1.0f, test);
+  const AlphaCutouts cutouts = AlphaCutouts::ofShadowRay(scene, uLight);
+  const HitFilter filter = cutouts.filter();
+  return closestHit(scene.wideBvh(), ray, 1.0f, test, &filter);
+}
 
 AlphaCutouts AlphaCutouts::ofPathRay(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex,
                                      uint depth) {
@@ -95,6 +104,9 @@ void printLightSample(const SceneData& scene, uint depth, const LightSample& ls,
 
 vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex, uint64_t& rays,
                     bool debugPrint) {
+  if (scene.params.mediaPresent != 0u) {
+    return sampleRadianceVolume(scene, imagePixel, sampleIndex, rays, debugPrint);
+  }
   const RenderParams& params = scene.params;
   const PathScene ps = scene.pathScene();  // the arrays path_vertex.h reads
   // The film's pixel, which the random numbers and the camera ray are of: a crop renders its

@@ -38,6 +38,13 @@ Ray cameraRay(const Camera& camera, vec2 filmPoint);
 vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
                     bool debugPrint = false);
 
+// The closest surface along a path's ray after `depth` scattering events, and on a shadow ray's
+// segment t in [0, 1) whose light sample drew uLight; alpha cut-outs passed by.
+std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Intersection test,
+                                  uvec2 pixel, uint32_t sampleIndex, uint depth);
+std::optional<Hit> closestShadowHit(const SceneData& scene, const Ray& ray, Intersection test,
+                                    vec2 uLight);
+
 // Alpha cut-outs (texture.h's alphaKeepsHit) as the traversal's filter of one ray's hits; u is
 // the ray's number (texture.h's pathAlphaRandom, shadowAlphaRandom).
 struct AlphaCutouts {

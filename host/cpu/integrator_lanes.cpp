@@ -27,6 +27,7 @@
 #include "cpu/integrator.h"
 #include "cpu/integrator_lanes.h"
 #include "cpu/random_lanes-inl.h"
+#include "cpu/volpath.h"
 #include "filter.h"
 #include "path_vertex.h"
 
@@ -531,6 +532,13 @@ HWY_EXPORT(sampleRadianceLanesImpl);
 
 void sampleRadianceLanes(const SceneData& scene, const uvec2* pixels, size_t count,
                          uint32_t sampleIndex, vec3* out, uint64_t& rays) {
+  // Scenes with media: the volume integrator, path by path.
+  if (scene.params.mediaPresent != 0u) {
+    for (size_t i = 0; i < count; ++i) {
+      out[i] = sampleRadianceVolume(scene, pixels[i], sampleIndex, rays);
+    }
+    return;
+  }
   HWY_DYNAMIC_DISPATCH(sampleRadianceLanesImpl)(scene, pixels, count, sampleIndex, out, rays);
 }
 

@@ -9,6 +9,7 @@
 #include "lights.h"
 #include "render/camera.h"
 #include "render/environment_map.h"
+#include "render/prepare_media.h"
 
 namespace pt {
 
@@ -50,6 +51,7 @@ std::string EffectSet::toString() const {
   add(textures, "textures");
   add(alphaCutouts, "alpha");
   add(bumpMaps, "bump");
+  add(media, "media");
   add(lightSampling, "nee");
   add(mis, "mis");
   add(russianRoulette, "rr");
@@ -335,6 +337,8 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     data.environmentFile = scene.environment->file;
   }
 
+  prepareMedia(scene, data.shift, data);
+
   // Effects: which material kinds occur on triangles, and whether light sampling can matter.
   EffectSet& fx = data.effects;
   // What evaluating a texture needs: several nodes, an image lookup.
@@ -350,7 +354,7 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   for (const Triangle& tri : data.bvh.triangles) used[tri.material] = 1;
   bool lightSampled = false;  // some surface has a BSDF with a non-delta lobe
   for (size_t i = 0; i < used.size(); ++i) {
-    if (!used[i]) continue;
+    if (!used[i] || data.materials[i].type == kMaterialInterface) continue;
     const Material& m = data.materials[i];
     // A texture's value is known only at a hit: a parameter with one counts as non-zero.
     const MaterialTextures* t = data.materialTextures.empty() ? nullptr : &data.materialTextures[i];
@@ -392,6 +396,10 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     if (m.type == kMaterialCoatedDiffuse) fx.coatedDiffuse = true;
     if (m.type > kMaterialMirror && bsdfHasNonSpecular(m)) lightSampled = true;
   }
+  // Light is sampled from the points where a medium scatters.
+  for (const Medium& m : data.media) {
+    if (m.sigmaS != vec3(0.0f)) lightSampled = true;
+  }
   const bool scatters = p.maxDepth > 0;
   fx.lightSampling = (fx.diffuse || lightSampled) && scatters && !data.emitters.empty() &&
                      p.strategy != kStrategyBsdf;
@@ -412,7 +420,8 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   fx.sobol = p.samplerType == kSamplerSobol;
   fx.mis = fx.lightSampling && fx.bsdfEmission && p.strategy == kStrategyMis;
   fx.russianRoulette =
-      p.russianRoulette != 0 && scatters && (fx.diffuse || fx.mirror || fx.hasBsdfMaterials());
+      p.russianRoulette != 0 && scatters &&
+      (fx.diffuse || fx.mirror || fx.hasBsdfMaterials() || fx.media);
   return data;
 }
 

@@ -73,6 +73,7 @@ struct EffectSet {
   bool textures = false;          // some material has a parameter given by a texture
   bool alphaCutouts = false;      // some material has an alpha texture (any-hit tests)
   bool bumpMaps = false;          // some material has a displacement texture
+  bool media = false;             // participating media: the volume integrator (volpath)
   uint textureFeatures = 0;       // kTextureUses*: what the used materials' textures need
   bool lightSampling = false;     // next-event estimation (needs emitters, a diffuse surface)
   bool bsdfEmission = false;      // emission found by BSDF-sampled rays is counted (MIS/BSDF)
@@ -145,6 +146,12 @@ struct SceneData {
   // without one, and its file (for messages).
   std::vector<vec4> environmentTexels;
   std::string environmentFile;
+  // Participating media (shaders/medium.h), all empty in a scene without any: the media, the
+  // floats of their grids followed by their majorant grids, and the media on the two sides of
+  // each triangle by Triangle::primitive.
+  std::vector<Medium> media;
+  std::vector<float> mediumGrids;
+  std::vector<MediumInterface> mediumInterfaces;
   RenderParams params{};
   int spp = 0;
   EffectSet effects;
@@ -171,7 +178,10 @@ struct SceneData {
                      lights.data(),
                      normals.empty() ? nullptr : normals.data(),
                      textureTables(),
-                     environmentTexels.data()};
+                     environmentTexels.data(),
+                     media.empty() ? nullptr : media.data(),
+                     mediumGrids.empty() ? nullptr : mediumGrids.data(),
+                     mediumInterfaces.empty() ? nullptr : mediumInterfaces.data()};
   }
 };
 

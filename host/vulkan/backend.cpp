@@ -11,9 +11,10 @@
 #include <cstring>
 
 #include "common/check.h"
-#include "pathtrace_base_spv.h"   // kPathtraceBaseSpv: the same without bsdf.h's materials
-#include "pathtrace_debug_spv.h"  // kPathtraceDebugSpv: the same shader with debugPrintfEXT
-#include "pathtrace_spv.h"        // kPathtraceSpv: SPIR-V compiled at build time
+#include "pathtrace_base_spv.h"    // kPathtraceBaseSpv: the same without bsdf.h's materials
+#include "pathtrace_debug_spv.h"   // kPathtraceDebugSpv: the same shader with debugPrintfEXT
+#include "pathtrace_spv.h"         // kPathtraceSpv: SPIR-V compiled at build time
+#include "pathtrace_volume_spv.h"  // kPathtraceVolumeSpv: the volume integrator (media)
 #include "vulkan/context.h"
 #include "vulkan/gpu_bvh.h"
 #include "vulkan/resources.h"
@@ -75,6 +76,11 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   std::vector<uint32_t> imageWords = orDummy(scene.imageWords);
   imageWords.resize((imageWords.size() + 3) / 4 * 4, 0u);
   const std::vector<MaterialTextures> materialTextures = orDummy(scene.materialTextures);
+  const std::vector<Medium> media = orDummy(scene.media);
+  std::vector<float> mediumGrids = orDummy(scene.mediumGrids);
+  mediumGrids.resize((mediumGrids.size() + 3) / 4 * 4, 0.0f);
+  std::vector<MediumInterface> mediumInterfaces = orDummy(scene.mediumInterfaces);
+  mediumInterfaces.resize((mediumInterfaces.size() + 1) / 2 * 2, MediumInterface{});
   const GpuBvh bvh = buildGpuBvh(scene.bvh);
   const std::vector<uint32_t> traversal = gpuTraversalTexels(bvh, scene.bvh.triangles);
   // In PT_BINDING_* order, followed by the accumulation and the counters.
@@ -92,12 +98,18 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       {"texture image", imageWords.data(), imageWords.size() * sizeof(uint32_t), true},
       {"material texture", materialTextures.data(),
        materialTextures.size() * sizeof(MaterialTextures), true},
+      {"medium", media.data(), media.size() * sizeof(Medium), true},
+      {"medium grid", mediumGrids.data(), mediumGrids.size() * sizeof(float), true},
+      {"medium interface", mediumInterfaces.data(),
+       mediumInterfaces.size() * sizeof(MediumInterface), true},
   };
   static_assert(PT_BINDING_PARAMS == 0 && PT_BINDING_NODES == 1 && PT_BINDING_TRIANGLES == 2 &&
                 PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 && PT_BINDING_NORMALS == 5 &&
                 PT_BINDING_LIGHTS == 6 && PT_BINDING_ACCUM == 7 && PT_BINDING_COUNTERS == 8 &&
                 PT_BINDING_ENVIRONMENT == 9 && PT_BINDING_UVS == 10 && PT_BINDING_TEXTURES == 11 &&
-                PT_BINDING_IMAGES == 12 && PT_BINDING_MATERIAL_TEXTURES == 13);
+                PT_BINDING_IMAGES == 12 && PT_BINDING_MATERIAL_TEXTURES == 13 &&
+                PT_BINDING_MEDIA == 14 && PT_BINDING_MEDIUM_GRIDS == 15 &&
+                PT_BINDING_MEDIUM_INTERFACES == 16);
   static_assert(std::size(uploads) + 2 == PT_BINDING_COUNT, "every binding is a buffer");
 
   // Every size is checked before anything is allocated: a scene too large for the device is
@@ -182,10 +194,13 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
                     fx.environment || fx.twoSidedEmitters || fx.sphereLights || fx.textures ||
                     fx.alphaCutouts || fx.bumpMaps || camera.filterType != kFilterBox ||
                     camera.lensRadius > 0.0f;
-  const std::span<const uint32_t> spirv = options.context.debugPrintf
-                                              ? std::span<const uint32_t>(kPathtraceDebugSpv)
-                                          : full ? std::span<const uint32_t>(kPathtraceSpv)
-                                                 : std::span<const uint32_t>(kPathtraceBaseSpv);
+  // Scenes with media take the volume integrator's variant (also under --debug-pixel, whose
+  // printing it leaves out).
+  const std::span<const uint32_t> spirv =
+      fx.media                     ? std::span<const uint32_t>(kPathtraceVolumeSpv)
+      : options.context.debugPrintf ? std::span<const uint32_t>(kPathtraceDebugSpv)
+      : full                        ? std::span<const uint32_t>(kPathtraceSpv)
+                                    : std::span<const uint32_t>(kPathtraceBaseSpv);
   return makeComputeProgram(ctx, spirv, bound, sizeof(PassConstants), &specInfo);
 }
 

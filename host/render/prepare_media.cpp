@@ -1,0 +1,83 @@
+#include "render/prepare_media.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/check.h"
+
+namespace pt {
+
+std::vector<float> majorantGrid(const Medium& m, const std::vector<float>& grids) {
+  const uint r = kMajorantGridRes;
+  const size_t voxels = size_t(m.size.x) * m.size.y * m.size.z;
+  // The largest value over the voxels whose interpolation reaches cell (x, y, z): a cell's
+  // unit-cube bounds [i / r, (i + 1) / r] touch the voxel centres from floor(lo * n - 0.5)
+  // to floor(hi * n - 0.5) + 1 (pbrt-v4's SampledGrid::MaxValue).
+  auto voxelRange = [&](uint cell, uint n, int& first, int& last) {
+    const float lo = float(cell) / float(r) * float(n) - 0.5f;
+    const float hi = float(cell + 1) / float(r) * float(n) - 0.5f;
+    first = std::max(int(std::floor(lo)), 0);
+    last = std::min(int(std::floor(hi)) + 1, int(n) - 1);
+  };
+  auto voxelValue = [&](size_t index) {
+    if (m.type == kMediumUniformGrid) return grids[m.density + index];
+    float best = 0.0f;
+    for (uint c = 0; c < 3; ++c) {
+      const float a = grids[m.density + 3 * index + c];
+      const float s = grids[m.density + 3 * voxels + 3 * index + c];
+      best = std::max(best, m.sigmaA[int(c)] * a + m.sigmaS[int(c)] * s);
+    }
+    return best;
+  };
+  std::vector<float> out(size_t(r) * r * r, 0.0f);
+  for (uint z = 0; z < r; ++z) {
+    int z0, z1;
+    voxelRange(z, m.size.z, z0, z1);
+    for (uint y = 0; y < r; ++y) {
+      int y0, y1;
+      voxelRange(y, m.size.y, y0, y1);
+      for (uint x = 0; x < r; ++x) {
+        int x0, x1;
+        voxelRange(x, m.size.x, x0, x1);
+        float best = 0.0f;
+        for (int k = z0; k <= z1; ++k) {
+          for (int j = y0; j <= y1; ++j) {
+            for (int i = x0; i <= x1; ++i) {
+              const size_t index = (size_t(k) * m.size.y + size_t(j)) * m.size.x + size_t(i);
+              best = std::max(best, voxelValue(index));
+            }
+          }
+        }
+        out[(size_t(z) * r + y) * r + x] = best;
+      }
+    }
+  }
+  return out;
+}
+
+void prepareMedia(Scene& scene, vec3 shift, SceneData& data) {
+  if (scene.media.empty()) return;
+  data.media = std::move(scene.media);
+  data.mediumGrids = std::move(scene.mediumGrids);
+  for (Medium& m : data.media) {
+    if (m.type == kMediumHomogeneous) continue;
+    // The medium's transform took world points; the renderer's points are shifted.
+    m.toMedium0.w += dot(vec3(m.toMedium0), shift);
+    m.toMedium1.w += dot(vec3(m.toMedium1), shift);
+    m.toMedium2.w += dot(vec3(m.toMedium2), shift);
+    const std::vector<float> majorants = majorantGrid(m, data.mediumGrids);
+    m.majorants = uint32_t(data.mediumGrids.size());
+    data.mediumGrids.insert(data.mediumGrids.end(), majorants.begin(), majorants.end());
+  }
+  PT_CHECK(scene.mediumInterfaces.empty() ||
+           scene.mediumInterfaces.size() == data.bvh.triangles.size());
+  data.mediumInterfaces = std::move(scene.mediumInterfaces);
+  if (data.mediumInterfaces.empty()) {
+    data.mediumInterfaces.assign(data.bvh.triangles.size(), MediumInterface{kNoMedium, kNoMedium});
+  }
+  data.params.cameraMedium = scene.cameraMedium;
+  data.params.mediaPresent = 1u;
+  data.effects.media = true;
+}
+
+}  // namespace pt

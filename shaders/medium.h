@@ -1,0 +1,226 @@
+// Participating media, written once for the CPU reference and the shader (C++ through GLM,
+// GLSL through #include): pbrt-v4's homogeneous, uniform-grid and RGB-grid media (its
+// HomogeneousMedium, GridMedium and RGBGridMedium: the coefficients at a point, and the
+// majorants over a ray's segments that delta and ratio tracking sample against), in RGB where
+// pbrt-v4 is spectral. Their Henyey-Greenstein phase function is bsdf.h's (the coated
+// material's medium uses it too). What a path does in a medium is volume_vertex.h's.
+//
+// What the functions read: in C++ the PathScene's media and grid floats (path_vertex.h); in
+// GLSL the includer defines loadMedium(i) and mediumGridFloat(i) before including this.
+// PT_MEDIUM_LOOP_TICK() is called once per step of the grid's majorant walk (the shader counts
+// its loops for lavapipe's cap).
+#ifndef PT_MEDIUM_H
+#define PT_MEDIUM_H
+
+#include "path_vertex.h"
+
+#ifndef PT_MEDIUM_LOOP_TICK
+#define PT_MEDIUM_LOOP_TICK()
+#endif
+
+#ifdef __cplusplus
+namespace pt {
+inline const Medium& loadMedium(const PathScene& scene, uint i) {
+  return scene.media[i];
+}
+inline float mediumGridFloat(const PathScene& scene, uint i) {
+  return scene.mediumGrids[i];
+}
+#endif
+
+// A medium's coefficients at a point (pbrt-v4's MediumProperties; the phase function is
+// Henyey-Greenstein of the medium's g).
+struct MediumProperties {
+  vec3 sigmaA;  // absorption
+  vec3 sigmaS;  // scattering
+  vec3 Le;      // emitted radiance
+};
+
+// A point of world space in the medium's space (grids only).
+PT_INLINE vec3 toMediumSpace(PT_IN(Medium) m, vec3 p) {
+  return vec3(dot(vec3(m.toMedium0), p) + m.toMedium0.w, dot(vec3(m.toMedium1), p) + m.toMedium1.w,
+              dot(vec3(m.toMedium2), p) + m.toMedium2.w);
+}
+PT_INLINE vec3 toMediumDirection(PT_IN(Medium) m, vec3 d) {
+  return vec3(dot(vec3(m.toMedium0), d), dot(vec3(m.toMedium1), d), dot(vec3(m.toMedium2), d));
+}
+
+// ---- Grids --------------------------------------------------------------------------------
+// pbrt-v4's SampledGrid: values at the centres of size.x * size.y * size.z voxels over the
+// bounds, x fastest, interpolated trilinearly; zero beyond the outermost centres' neighbours.
+
+// Component `c` (of `components` per voxel) of voxel v of the grid that starts at float
+// `first`, or 0 outside the grid.
+PT_INLINE float gridVoxel(PT_SCENE_PARAM uint first, uvec3 size, uint components, uint c,
+                          ivec3 v) {
+  if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(size)))) return 0.0f;
+  uint index = (uint(v.z) * size.y + uint(v.y)) * size.x + uint(v.x);
+  return mediumGridFloat(PT_SCENE_ARG first + index * components + c);
+}
+
+// The grid's value at point u of the unit cube (the bounds' offset coordinates), trilinearly.
+PT_INLINE float gridLookup(PT_SCENE_PARAM uint first, uvec3 size, uint components, uint c,
+                           vec3 u) {
+  vec3 s = u * vec3(size) - 0.5f;
+  vec3 f = floor(s);
+  ivec3 i = ivec3(f);
+  vec3 d = s - f;
+  float c00 = mix(gridVoxel(PT_SCENE_ARG first, size, components, c, i),
+                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 0, 0)), d.x);
+  float c10 = mix(gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 1, 0)),
+                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 1, 0)), d.x);
+  float c01 = mix(gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 0, 1)),
+                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 0, 1)), d.x);
+  float c11 = mix(gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 1, 1)),
+                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 1, 1)), d.x);
+  return mix(mix(c00, c10, d.y), mix(c01, c11, d.y), d.z);
+}
+PT_INLINE vec3 gridLookupRgb(PT_SCENE_PARAM uint first, uvec3 size, vec3 u) {
+  return vec3(gridLookup(PT_SCENE_ARG first, size, 3u, 0u, u),
+              gridLookup(PT_SCENE_ARG first, size, 3u, 1u, u),
+              gridLookup(PT_SCENE_ARG first, size, 3u, 2u, u));
+}
+
+// ---- The coefficients at a point ------------------------------------------------------------
+
+// Medium m's coefficients at world point p. A grid is zero outside its bounds. uniformgrid:
+// sigma_a and sigma_s times the density, Le times its grid (or constant without one); rgbgrid:
+// the RGB grids times sigma_a and sigma_s (its scale), its Le grid times Le (its Lescale).
+PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, vec3 p) {
+  if (m.type == kMediumHomogeneous) return MediumProperties(m.sigmaA, m.sigmaS, m.Le);
+  vec3 u = (toMediumSpace(m, p) - m.boundsMin) / (m.boundsMax - m.boundsMin);
+  MediumProperties mp = MediumProperties(vec3(0.0f), vec3(0.0f), vec3(0.0f));
+  if (m.type == kMediumUniformGrid) {
+    float d = gridLookup(PT_SCENE_ARG m.density, m.size, 1u, 0u, u);
+    mp.sigmaA = m.sigmaA * d;
+    mp.sigmaS = m.sigmaS * d;
+    if (m.emissive != 0u) {
+      mp.Le = m.emission == kNoGrid ? m.Le
+                                    : m.Le * gridLookup(PT_SCENE_ARG m.emission, m.size, 1u, 0u, u);
+    }
+  } else {
+    uint voxels = m.size.x * m.size.y * m.size.z;
+    mp.sigmaA = m.sigmaA * gridLookupRgb(PT_SCENE_ARG m.density, m.size, u);
+    mp.sigmaS = m.sigmaS * gridLookupRgb(PT_SCENE_ARG m.density + 3u * voxels, m.size, u);
+    if (m.emissive != 0u && m.emission != kNoGrid) {
+      mp.Le = m.Le * gridLookupRgb(PT_SCENE_ARG m.emission, m.size, u);
+    }
+  }
+  return mp;
+}
+
+// ---- Majorants along a ray ----------------------------------------------------------------
+// A ray's parameter range in one medium, cut into segments of constant majorant sigma_maj >=
+// sigma_a + sigma_s in every channel: one segment for a homogeneous medium (sigma_maj =
+// sigma_t, no null collisions); for a grid, the cells of its majorant grid the ray crosses
+// (a 3D DDA, pbrt-v4's DDAMajorantIterator), each the largest coefficient its voxels reach, so
+// that thin regions are crossed in long steps. t is the ray's own parameter (o + t d, d of any
+// length).
+
+struct MajorantSegment {
+  float tMin;
+  float tMax;
+  vec3 sigmaMaj;
+};
+
+struct MajorantWalk {
+  uint medium;
+  uint type;       // the medium's kMedium*
+  bool done;
+  float tMin;      // where the next segment starts
+  float tMax;      // where the walk ends
+  vec3 sigmaMaj;   // homogeneous: sigma_t; grid: what a cell's majorant grid value multiplies
+  ivec3 cell;      // grid: the current cell of the majorant grid
+  vec3 nextT;      // grid: t where the ray crosses into the next cell along each axis
+  vec3 deltaT;     // grid: t from one crossing to the next along each axis
+  ivec3 step;      // grid: +1 or -1 per axis
+  uint majorants;  // grid: the first float of its majorant grid
+};
+
+// The walk of ray (o, d) over t in [0, tMax) through medium `index`.
+PT_INLINE MajorantWalk startMajorantWalk(PT_SCENE_PARAM uint index, vec3 o, vec3 d, float tMax) {
+  Medium m = loadMedium(PT_SCENE_ARG index);
+  MajorantWalk w = MajorantWalk(index, m.type, false, 0.0f, tMax, m.sigmaA + m.sigmaS, ivec3(0),
+                                vec3(0.0f), vec3(0.0f), ivec3(0), m.majorants);
+  if (m.type == kMediumHomogeneous) return w;
+  if (m.type == kMediumRgbGrid) w.sigmaMaj = vec3(1.0f);
+  // The ray in the grid's unit cube.
+  vec3 extent = m.boundsMax - m.boundsMin;
+  vec3 o01 = (toMediumSpace(m, o) - m.boundsMin) / extent;
+  vec3 d01 = toMediumDirection(m, d) / extent;
+  // Its overlap with the cube (the slabs' test; an axis the ray runs along is inside or not).
+  float t0 = 0.0f;
+  float t1 = tMax;
+  for (int a = 0; a < 3; ++a) {
+    if (d01[a] == 0.0f) {
+      if (o01[a] < 0.0f || o01[a] > 1.0f) t1 = -1.0f;
+      continue;
+    }
+    float tNear = (0.0f - o01[a]) / d01[a];
+    float tFar = (1.0f - o01[a]) / d01[a];
+    if (tNear > tFar) {
+      float swap = tNear;
+      tNear = tFar;
+      tFar = swap;
+    }
+    t0 = max(t0, tNear);
+    t1 = min(t1, tFar);
+  }
+  if (!(t0 < t1)) {
+    w.done = true;
+    return w;
+  }
+  w.tMin = t0;
+  w.tMax = t1;
+  // The cell it enters and where it leaves that cell along each axis.
+  float res = float(kMajorantGridRes);
+  vec3 g = (o01 + t0 * d01) * res;
+  for (int a = 0; a < 3; ++a) {
+    w.cell[a] = clamp(int(floor(g[a])), 0, int(kMajorantGridRes) - 1);
+    if (d01[a] == 0.0f) {
+      w.nextT[a] = 1e30f;
+      w.deltaT[a] = 1e30f;
+      w.step[a] = 0;
+    } else if (d01[a] > 0.0f) {
+      w.nextT[a] = t0 + (float(w.cell[a] + 1) / res - (o01[a] + t0 * d01[a])) / d01[a];
+      w.deltaT[a] = 1.0f / (res * d01[a]);
+      w.step[a] = 1;
+    } else {
+      w.nextT[a] = t0 + (float(w.cell[a]) / res - (o01[a] + t0 * d01[a])) / d01[a];
+      w.deltaT[a] = -1.0f / (res * d01[a]);
+      w.step[a] = -1;
+    }
+  }
+  return w;
+}
+
+// The walk's next segment; false when it has none left.
+PT_INLINE bool nextMajorantSegment(PT_SCENE_PARAM PT_INOUT(MajorantWalk) w,
+                                   PT_OUT(MajorantSegment) seg) {
+  if (w.done) return false;
+  PT_MEDIUM_LOOP_TICK();
+  if (w.type == kMediumHomogeneous) {
+    // The whole range.
+    seg = MajorantSegment(w.tMin, w.tMax, w.sigmaMaj);
+    w.done = true;
+    return true;
+  }
+  // The axis whose crossing comes first leaves the cell.
+  int a = w.nextT.x < w.nextT.y ? (w.nextT.x < w.nextT.z ? 0 : 2) : (w.nextT.y < w.nextT.z ? 1 : 2);
+  float tExit = min(w.nextT[a], w.tMax);
+  uint r = kMajorantGridRes;
+  float cellMajorant = mediumGridFloat(
+      PT_SCENE_ARG w.majorants + (uint(w.cell.z) * r + uint(w.cell.y)) * r + uint(w.cell.x));
+  seg = MajorantSegment(w.tMin, tExit, w.sigmaMaj * cellMajorant);
+  w.tMin = tExit;
+  w.cell[a] += w.step[a];
+  w.nextT[a] += w.deltaT[a];
+  if (tExit >= w.tMax || w.cell[a] < 0 || w.cell[a] >= int(r)) w.done = true;
+  return true;
+}
+
+#ifdef __cplusplus
+}  // namespace pt
+#endif
+
+#endif  // PT_MEDIUM_H

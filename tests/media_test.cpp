@@ -1,0 +1,495 @@
+// Participating media (shaders/medium.h, volume_vertex.h; the CPU's volpath.cpp and the
+// shader's volpath.glsl): closed forms on both backends (Beer-Lambert through a slab, a white
+// furnace of a scattering medium, energy lost where the albedo is below one, a camera inside
+// an absorbing medium without boundary), the samplers against their densities (the phase
+// function, free-flight distances through homogeneous and grid media), CPU and lavapipe
+// agreement, and the hard cases.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "chi2.h"
+#include "render/prepare.h"
+#include "render/prepare_media.h"
+#include "render_compare.h"
+#include "test_util.h"
+#include "volume_vertex.h"
+
+namespace pt {
+namespace {
+
+constexpr uint kVacuum = kNoMedium;
+
+Medium homogeneous(vec3 sigmaA, vec3 sigmaS, float g = 0.0f) {
+  Medium m{};
+  m.type = kMediumHomogeneous;
+  m.sigmaA = sigmaA;
+  m.sigmaS = sigmaS;
+  m.g = g;
+  m.density = m.majorants = m.emission = kNoGrid;
+  return m;
+}
+
+// A uniformgrid medium over [lo, hi] (identity transform) with the given densities (x fastest),
+// appended to scene.mediumGrids.
+Medium uniformGrid(Scene& scene, vec3 lo, vec3 hi, uvec3 size, const std::vector<float>& density,
+                   vec3 sigmaA, vec3 sigmaS) {
+  Medium m = homogeneous(sigmaA, sigmaS);
+  m.type = kMediumUniformGrid;
+  m.boundsMin = lo;
+  m.boundsMax = hi;
+  m.size = size;
+  m.density = uint(scene.mediumGrids.size());
+  scene.mediumGrids.insert(scene.mediumGrids.end(), density.begin(), density.end());
+  m.toMedium0 = vec4(1, 0, 0, 0);
+  m.toMedium1 = vec4(0, 1, 0, 0);
+  m.toMedium2 = vec4(0, 0, 1, 0);
+  return m;
+}
+
+// Appends triangles with one medium interface for all of them, numbering their primitives.
+void addShape(Scene& scene, std::vector<Triangle> tris, uint material, MediumInterface media) {
+  for (Triangle& t : tris) {
+    t.material = material;
+    t.primitive = uint(scene.triangles.size());
+    scene.triangles.push_back(t);
+    scene.mediumInterfaces.push_back(media);
+  }
+}
+
+// Quad c -/+ u -/+ v (normal cross(u, v)), as test_util's addQuad.
+std::vector<Triangle> quad(vec3 c, vec3 u, vec3 v) {
+  Scene s;
+  test::addQuad(s, c, u, v, 0);
+  return s.triangles;
+}
+
+// The box [lo, hi] with outward normals.
+std::vector<Triangle> box(vec3 lo, vec3 hi) {
+  const vec3 c = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
+  const vec3 x(h.x, 0, 0), y(0, h.y, 0), z(0, 0, h.z);
+  std::vector<Triangle> tris;
+  for (const auto& q : {quad(c + x, y, z), quad(c - x, z, y), quad(c + y, z, x),
+                        quad(c - y, x, z), quad(c + z, x, y), quad(c - z, y, x)}) {
+    tris.insert(tris.end(), q.begin(), q.end());
+  }
+  return tris;
+}
+
+// A sphere with outward normals (test_util's faces inward).
+std::vector<Triangle> sphere(vec3 centre, float radius) {
+  std::vector<Triangle> tris = test::makeSphere(centre, radius, 24, 48);
+  for (Triangle& t : tris) std::swap(t.v1, t.v2);
+  return tris;
+}
+
+CameraDesc camera(vec3 position, vec3 target, float vfov, int size) {
+  CameraDesc c;
+  c.position = position;
+  c.target = target;
+  c.up = vec3(0, 1, 0);
+  c.vfovDegrees = vfov;
+  c.width = c.height = size;
+  return c;
+}
+
+Light environment(float radiance) {
+  Light sky{};
+  sky.type = kLightInfinite;
+  sky.radiance = vec3(radiance);
+  return sky;
+}
+
+SceneData prepare(Scene scene, int maxDepth = 64) {
+  scene.integrator.maxDepth = maxDepth;
+  return prepareScene(std::move(scene), RenderSettings{});
+}
+
+// ---- Closed forms ---------------------------------------------------------------------------
+
+// A slab of absorbing medium, 1 thick along z, between the camera and an emitter of radiance 1
+// that fills the view: each camera ray arrives with exp(-sigma_a / |cos|). Each sample is 0 or
+// T / mean(T) (the hero channel passes or not), so every pixel is within its own noise of the
+// closed form and the image's mean within a fraction of a percent.
+TEST(Media, BeerLambertThroughAnAbsorbingSlab) {
+  const vec3 sigma(0.2f, 0.5f, 1.0f);
+  Scene scene;
+  scene.camera = camera(vec3(0, 0, -5), vec3(0, 0, 0), 20.0f, 16);
+  scene.materials = {Material{vec3(0.0f), kMaterialInterface, vec3(0.0f), 0},
+                     Material{vec3(0.0f), kMaterialDiffuse, vec3(1.0f), 0}};
+  scene.media = {homogeneous(sigma, vec3(0.0f))};
+  addShape(scene, box(vec3(-3, -3, -0.5f), vec3(3, 3, 0.5f)), 0, MediumInterface{0, kVacuum});
+  addShape(scene, quad(vec3(0, 0, 2), vec3(0, 3, 0), vec3(3, 0, 0)), 1,
+           MediumInterface{kVacuum, kVacuum});
+  const SceneData data = prepare(scene, 5);
+  ASSERT_TRUE(data.effects.media);
+  constexpr int kSpp = 256;
+  const Comparison cmp = renderBoth(data, kSpp);
+  expectAgreement(cmp);
+  const Image expected = pixelAverages(data.params.camera, [&](const Ray& r) {
+    const vec3 d = normalize(r.direction);
+    return glm::dvec3(exp(-sigma / std::fabs(d.z)));
+  });
+  for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+    glm::dvec3 mean(0.0), expectedMean(0.0);
+    for (size_t i = 0; i < expected.pixels.size(); ++i) {
+      const vec3 e = expected.pixels[i];
+      const double meanT = (e.x + e.y + e.z) / 3.0;
+      for (int c = 0; c < 3; ++c) {
+        const double sd = e[c] * std::sqrt(1.0 / meanT - 1.0) / std::sqrt(double(kSpp));
+        EXPECT_NEAR(image->pixels[i][c], e[c], 5.0 * sd + 1e-4) << "pixel " << i << " channel "
+                                                                << c;
+      }
+      mean += glm::dvec3(image->pixels[i]);
+      expectedMean += glm::dvec3(e);
+    }
+    const double n = double(expected.pixels.size());
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c] / n, expectedMean[c] / n, 0.012);
+  }
+}
+
+// The camera inside an absorbing medium that has no boundary, looking at an emitter 3 away:
+// exp(-sigma_a d) with d the distance along each ray.
+TEST(Media, CameraInsideAMediumWithoutBoundary) {
+  const vec3 sigma(0.1f, 0.2f, 0.4f);
+  Scene scene;
+  scene.camera = camera(vec3(0, 0, -3), vec3(0, 0, 0), 20.0f, 8);
+  scene.materials = {Material{vec3(0.0f), kMaterialDiffuse, vec3(2.0f), 0}};
+  scene.media = {homogeneous(sigma, vec3(0.0f))};
+  scene.cameraMedium = 0;
+  addShape(scene, quad(vec3(0, 0, 0), vec3(0, 3, 0), vec3(3, 0, 0)), 0,
+           MediumInterface{kVacuum, kVacuum});
+  const SceneData data = prepare(scene, 5);
+  const Comparison cmp = renderBoth(data, 256);
+  expectAgreement(cmp);
+  const Image expected = pixelAverages(data.params.camera, [&](const Ray& r) {
+    const vec3 d = normalize(r.direction);
+    return glm::dvec3(2.0f * exp(-sigma * (3.0f / d.z)));
+  });
+  expectNearClosedForm(cmp, expected, 0.0, 0.25);
+  for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+    glm::dvec3 mean(0.0), expectedMean(0.0);
+    for (size_t i = 0; i < expected.pixels.size(); ++i) {
+      mean += glm::dvec3(image->pixels[i]);
+      expectedMean += glm::dvec3(expected.pixels[i]);
+    }
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c] / expectedMean[c], 1.0, 0.01);
+  }
+}
+
+// A sphere of scattering medium bounded by an interface (index 1: no surface) under a
+// constant environment of radiance 1. At albedo 1 no energy is lost or gained: every pixel is
+// an estimate of 1, the sphere's as the environment's. At albedo 0.5 the sphere is darker and
+// no pixel brighter than the environment beyond noise.
+struct FurnaceResult {
+  Comparison cmp;
+  std::vector<size_t> sphere;  // pixels whose camera rays all cross the sphere
+};
+FurnaceResult furnace(vec3 sigmaA, vec3 sigmaS, float g, int spp) {
+  constexpr int kSize = 12;
+  Scene scene;
+  scene.camera = camera(vec3(0, 0, -4), vec3(0, 0, 0), 30.0f, kSize);
+  scene.materials = {Material{vec3(0.0f), kMaterialInterface, vec3(0.0f), 0}};
+  scene.lights = {environment(1.0f)};
+  scene.media = {homogeneous(sigmaA, sigmaS, g)};
+  addShape(scene, sphere(vec3(0.0f), 1.0f), 0, MediumInterface{0, kVacuum});
+  FurnaceResult r;
+  const SceneData data = prepare(scene, 256);
+  r.cmp = renderBoth(data, spp);
+  // The pixels whose four corners' rays pass well inside the unit sphere.
+  const Camera& cam = data.params.camera;
+  const auto inside = [&](float x, float y) {
+    const Ray ray = cameraRay(cam, vec2(x, y));
+    const vec3 d = normalize(ray.direction);
+    const vec3 o = ray.origin + data.shift;
+    const float b = dot(o, d);
+    return b * b - (dot(o, o) - 0.95f) > 0.0f;
+  };
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) {
+      const float fx = float(x), fy = float(y);
+      if (inside(fx, fy) && inside(fx + 1, fy) && inside(fx, fy + 1) && inside(fx + 1, fy + 1)) {
+        r.sphere.push_back(size_t(y) * kSize + size_t(x));
+      }
+    }
+  }
+  return r;
+}
+
+TEST(Media, WhiteFurnaceOfAScatteringMediumRendersTheEnvironment) {
+  const FurnaceResult r = furnace(vec3(0.0f), vec3(0.5f, 1.0f, 2.0f), 0.6f, 160);
+  ASSERT_GE(r.sphere.size(), 50u);
+  expectAgreement(r.cmp);
+  for (const Image* image : {&r.cmp.cpuImage, &r.cmp.gpuImage}) {
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0.0, sumSquares = 0.0;
+      for (size_t i : r.sphere) {
+        const double v = image->pixels[i][c];
+        sum += v;
+        sumSquares += v * v;
+      }
+      const double n = double(r.sphere.size());
+      const double mean = sum / n;
+      const double se = std::sqrt(std::max(0.0, sumSquares / n - mean * mean) / n);
+      EXPECT_LT(se, 0.015) << "channel " << c;
+      EXPECT_NEAR(mean, 1.0, 4.0 * se + 1e-3) << "channel " << c;
+    }
+    // Outside the sphere: the environment, exactly.
+    EXPECT_EQ(image->at(0, 0), vec3(1.0f));
+  }
+}
+
+TEST(Media, AMediumOfAlbedoBelowOneLosesEnergy) {
+  const FurnaceResult r = furnace(vec3(0.5f), vec3(0.5f), 0.0f, 32);
+  expectAgreement(r.cmp);
+  for (const Image* image : {&r.cmp.cpuImage, &r.cmp.gpuImage}) {
+    double sum = 0.0;
+    for (size_t i : r.sphere) {
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_LT(image->pixels[i][c], 1.0f) << "pixel " << i;
+        sum += image->pixels[i][c];
+      }
+    }
+    EXPECT_LT(sum / (3.0 * double(r.sphere.size())), 0.6);
+  }
+}
+
+// An emissive, absorbing slab seen against black: pbrt-v4's emission is sigma_a Le per unit
+// length, so a ray of length d through it gathers Le (1 - exp(-sigma_a d)).
+TEST(Media, EmissiveSlabGathersItsEmission) {
+  const vec3 sigma(0.3f, 1.0f, 3.0f);
+  const vec3 Le(2.0f, 1.0f, 0.5f);
+  Scene scene;
+  scene.camera = camera(vec3(0, 0, -5), vec3(0, 0, 0), 20.0f, 8);
+  scene.materials = {Material{vec3(0.0f), kMaterialInterface, vec3(0.0f), 0}};
+  Medium m = homogeneous(sigma, vec3(0.0f));
+  m.Le = Le;
+  m.emissive = 1u;
+  scene.media = {m};
+  addShape(scene, box(vec3(-3, -3, -0.5f), vec3(3, 3, 0.5f)), 0, MediumInterface{0, kVacuum});
+  const SceneData data = prepare(scene, 5);
+  const Comparison cmp = renderBoth(data, 128);
+  expectAgreement(cmp);
+  const Image expected = pixelAverages(data.params.camera, [&](const Ray& r) {
+    const vec3 d = normalize(r.direction);
+    return glm::dvec3(Le * (1.0f - exp(-sigma / d.z)));
+  });
+  expectNearClosedForm(cmp, expected, 0.0, 0.2);
+  for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+    glm::dvec3 mean(0.0), expectedMean(0.0);
+    for (size_t i = 0; i < expected.pixels.size(); ++i) {
+      mean += glm::dvec3(image->pixels[i]);
+      expectedMean += glm::dvec3(expected.pixels[i]);
+    }
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c] / expectedMean[c], 1.0, 0.02) << c;
+  }
+}
+
+// ---- Hard cases -------------------------------------------------------------------------------
+
+// No NaN, nothing invalid or cut short, and the backends agree, on scenes at the edges: a
+// medium of coefficient 0 (vacuum exactly), of 1e6 (opaque: nothing behind it, exactly), a
+// scattering medium of 1e6 (paths end at maxDepth), a ray grazing an interface.
+TEST(Media, ZeroAndHugeCoefficientsStayFinite) {
+  Scene base;
+  base.camera = camera(vec3(0, 0, -5), vec3(0, 0, 0), 20.0f, 8);
+  base.materials = {Material{vec3(0.0f), kMaterialInterface, vec3(0.0f), 0},
+                    Material{vec3(0.0f), kMaterialDiffuse, vec3(1.0f, 2.0f, 3.0f), 0}};
+  addShape(base, quad(vec3(0, 0, 2), vec3(0, 3, 0), vec3(3, 0, 0)), 1,
+           MediumInterface{kVacuum, kVacuum});
+  {
+    SCOPED_TRACE("sigma 0 around the camera");
+    Scene scene = base;
+    scene.media = {homogeneous(vec3(0.0f), vec3(0.0f))};
+    scene.cameraMedium = 0;
+    const Comparison cmp = renderBoth(prepare(scene, 5), 4);
+    for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+      for (const vec3& p : image->pixels) EXPECT_EQ(p, vec3(1.0f, 2.0f, 3.0f));
+    }
+  }
+  {
+    SCOPED_TRACE("sigma_a 1e6 in front of the emitter");
+    Scene scene = base;
+    scene.media = {homogeneous(vec3(1e6f), vec3(0.0f))};
+    addShape(scene, box(vec3(-3, -3, -0.5f), vec3(3, 3, 0.5f)), 0, MediumInterface{0, kVacuum});
+    const Comparison cmp = renderBoth(prepare(scene, 5), 4);
+    EXPECT_EQ(cmp.gpu.invalidSamples, 0u);
+    EXPECT_EQ(cmp.gpu.truncatedSamples, 0u);
+    for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+      for (const vec3& p : image->pixels) EXPECT_EQ(p, vec3(0.0f));
+    }
+  }
+  {
+    SCOPED_TRACE("sigma_s 1e6 under an environment, and a ray along the slab's face");
+    Scene scene = base;
+    scene.lights = {environment(1.0f)};
+    scene.media = {homogeneous(vec3(0.0f), vec3(1e6f), 0.5f)};
+    addShape(scene, box(vec3(-0.3f, -3, -0.5f), vec3(3, 3, 0.5f)), 0,
+             MediumInterface{0, kVacuum});
+    scene.camera = camera(vec3(-0.3f, 0, -5), vec3(-0.3f, 0, 0), 10.0f, 8);
+    const Comparison cmp = renderBoth(prepare(scene, 64), 4);
+    EXPECT_EQ(cmp.gpu.invalidSamples, 0u);
+    EXPECT_EQ(cmp.gpu.truncatedSamples, 0u);
+    EXPECT_EQ(cmp.diff.nonFinitePixels, 0u);
+    for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
+      for (const vec3& p : image->pixels) {
+        EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+        EXPECT_GE(std::min(p.x, std::min(p.y, p.z)), 0.0f);
+      }
+    }
+  }
+}
+
+// A glass of tea inside fog: the camera in the fog, a dielectric sphere whose inside is an
+// absorbing medium, an interface sphere of a chromatic scattering medium, a grid medium with
+// empty cells, an area light and a floor. The backends agree.
+TEST(Media, NestedMediaAgreeOnBothBackends) {
+  Scene scene;
+  scene.camera = camera(vec3(0, 1, -6), vec3(0, 0.5f, 0), 35.0f, 24);
+  Material glass{};
+  glass.type = kMaterialDielectric;
+  glass.eta = vec3(1.33f);
+  scene.materials = {Material{vec3(0.0f), kMaterialInterface, vec3(0.0f), 0},
+                     Material{vec3(0.6f), kMaterialDiffuse, vec3(0.0f), 0},
+                     Material{vec3(0.0f), kMaterialDiffuse, vec3(12.0f, 10.0f, 8.0f), 0}, glass};
+  scene.media = {homogeneous(vec3(0.01f), vec3(0.08f), 0.3f),            // 0: fog
+                 homogeneous(vec3(0.1f, 0.6f, 2.0f), vec3(0.0f)),        // 1: tea
+                 homogeneous(vec3(0.05f), vec3(1.5f, 0.8f, 0.3f), -0.4f)};  // 2: smoke
+  std::vector<float> density(4 * 4 * 4, 0.0f);
+  for (int i = 0; i < 64; i += 3) density[size_t(i)] = 2.0f;  // empty cells between
+  scene.media.push_back(uniformGrid(scene, vec3(1.2f, 0, -1), vec3(2.8f, 1.6f, 0.6f),
+                                    uvec3(4, 4, 4), density, vec3(0.1f), vec3(0.9f)));
+  scene.cameraMedium = 0;
+  const uint fog = 0, tea = 1, smoke = 2, grid = 3;
+  addShape(scene, box(vec3(-6, -0.5f, -8), vec3(6, 6, 6)), 0, MediumInterface{fog, kVacuum});
+  addShape(scene, quad(vec3(0, 0, 0), vec3(0, 0, 5), vec3(5, 0, 0)), 1,
+           MediumInterface{kVacuum, kVacuum});
+  addShape(scene, quad(vec3(0, 4, 0), vec3(1, 0, 0), vec3(0, 0, 1)), 2,
+           MediumInterface{kVacuum, kVacuum});
+  addShape(scene, sphere(vec3(-1.2f, 0.8f, 0), 0.8f), 3, MediumInterface{tea, fog});
+  addShape(scene, sphere(vec3(0.3f, 0.6f, -1.5f), 0.6f), 0, MediumInterface{smoke, fog});
+  addShape(scene, box(vec3(1.2f, 0, -1), vec3(2.8f, 1.6f, 0.6f)), 0, MediumInterface{grid, fog});
+  const SceneData data = prepare(scene, 16);
+  const Comparison cmp = renderBoth(data, 8);
+  expectAgreement(cmp);
+}
+
+// ---- Samplers against their densities -------------------------------------------------------
+
+// The phase function's directions against its density, for wo along a fixed direction.
+test::Chi2Result phaseChi2(float g, float pdfG) {
+  constexpr int kSamples = 200000;
+  const vec3 wo = normalize(vec3(0.3f, -0.2f, 0.9f));
+  RandomStream rng{uvec4(1u, 2u, uint(std::fabs(g) * 1000.0f), 7u)};
+  auto draw = [&] {
+    float pdf;
+    return sampleHenyeyGreenstein(wo, g, nextRandom2(rng), pdf);
+  };
+  std::vector<glm::vec3> pilot;
+  for (int i = 0; i < 4000; ++i) pilot.push_back(draw());
+  const test::SphereGrid grid = test::focusedGrid(pilot, 20, 40);
+  std::vector<double> observed(size_t(grid.cellCount()), 0.0);
+  for (int i = 0; i < kSamples; ++i) {
+    float pdf;
+    const vec3 wi = sampleHenyeyGreenstein(wo, g, nextRandom2(rng), pdf);
+    EXPECT_NEAR(pdf, henyeyGreenstein(dot(wo, wi), g), 1e-3f * pdf);
+    observed[size_t(grid.cellOf(wi))] += 1.0;
+  }
+  const auto density = [&](vec3 w) { return double(henyeyGreenstein(dot(wo, w), pdfG)); };
+  return test::pearsonChi2(observed, test::expectedCounts(grid, density, kSamples));
+}
+
+TEST(Media, PhaseFunctionSamplerPassesChiSquare) {
+  for (float g : {-0.9f, -0.5f, 0.0f, 0.3f, 0.9f}) {
+    SCOPED_TRACE(g);
+    const test::Chi2Result good = phaseChi2(g, g);
+    EXPECT_GE(good.pValue, test::sidakSignificance(1e-3, 5))
+        << "chi2 " << good.statistic << ", " << good.dof << " dof";
+  }
+  // A density of another asymmetry is told apart.
+  const test::Chi2Result bad = phaseChi2(0.3f, 0.4f);
+  EXPECT_LT(bad.pValue, 1e-6);
+}
+
+// Where delta tracking scatters a path: through a purely scattering medium of coefficient
+// sigma(t) along the ray, the first scattering point has the density sigma(t) exp(-integral
+// of sigma), whatever the majorants. Histogrammed over [0, tMax) with the escapes in a last
+// cell, against that density integrated per cell; `wrongScale` multiplies the expected
+// coefficient (1: the right one).
+struct FlightSetup {
+  std::vector<Medium> media;
+  std::vector<float> grids;
+  RenderParams params{};
+};
+
+test::Chi2Result flightChi2(const FlightSetup& setup, float tMax, double (*opticalDepth)(double),
+                            double wrongScale) {
+  PathScene ps{};
+  ps.params = &setup.params;
+  ps.media = setup.media.data();
+  ps.mediumGrids = setup.grids.data();
+  constexpr int kCells = 40, kSamples = 100000;
+  std::vector<double> observed(kCells + 1, 0.0), expected(kCells + 1, 0.0);
+  for (int i = 0; i < kSamples; ++i) {
+    VolumePath v{};
+    v.path = startPathState();
+    v.rU = v.rL = vec3(1.0f);
+    v.hero = uint(i % 3);
+    v.medium = 0;
+    v.rng = RandomStream{uvec4(uint(i), 11u, 13u, 0u)};
+    vec3 p;
+    float g;
+    const uint flight = trackFlight(ps, v, vec3(0.0f), vec3(1, 0, 0), tMax, p, g);
+    EXPECT_NE(flight, kFlightEnded);  // nothing absorbs
+    const int cell = flight == kFlightScattered ? std::min(kCells - 1, int(p.x / tMax * kCells))
+                                                : kCells;
+    observed[size_t(cell)] += 1.0;
+  }
+  for (int c = 0; c < kCells; ++c) {
+    const double t0 = tMax * c / kCells, t1 = tMax * (c + 1) / kCells;
+    expected[size_t(c)] = kSamples * (std::exp(-wrongScale * opticalDepth(t0)) -
+                                      std::exp(-wrongScale * opticalDepth(t1)));
+  }
+  expected[kCells] = kSamples * std::exp(-wrongScale * opticalDepth(tMax));
+  return test::pearsonChi2(observed, expected);
+}
+
+TEST(Media, FreeFlightDistancesFollowTheTransmittance) {
+  {
+    SCOPED_TRACE("homogeneous");
+    FlightSetup s;
+    s.media = {homogeneous(vec3(0.0f), vec3(0.7f))};
+    s.params.maxDepth = 64;
+    const auto depth = [](double t) { return 0.7 * t; };
+    EXPECT_GE(flightChi2(s, 3.0f, depth, 1.0).pValue, 1e-4);
+    EXPECT_LT(flightChi2(s, 3.0f, depth, 1.1).pValue, 1e-6);
+  }
+  {
+    // A grid over x in [0, 4] of 16 voxels whose density rises by 0.25 a voxel from 0: the
+    // majorant grid's cells hold their largest values, so most tentative collisions are null.
+    SCOPED_TRACE("grid");
+    FlightSetup s;
+    Scene scene;
+    std::vector<float> density;
+    for (int x = 0; x < 16; ++x) density.push_back(0.25f * float(x));
+    Medium m = uniformGrid(scene, vec3(0, -1, -1), vec3(4, 1, 1), uvec3(16, 1, 1), density,
+                           vec3(0.0f), vec3(0.5f));
+    s.grids = scene.mediumGrids;
+    const std::vector<float> majorants = majorantGrid(m, s.grids);
+    m.majorants = uint(s.grids.size());
+    s.grids.insert(s.grids.end(), majorants.begin(), majorants.end());
+    s.media = {m};
+    s.params.maxDepth = 64;
+    // Voxel k's centre is at x = 0.125 + 0.25 k, its value 0.25 k: between the outer centres
+    // the density is x - 0.125, below the first 0 (interpolated with the zero outside the
+    // grid); sigma_s = 0.5 of it, so the optical depth to t is 0.25 (t - 0.125)^2.
+    const auto depth = [](double t) { return t <= 0.125 ? 0.0 : 0.25 * (t - 0.125) * (t - 0.125); };
+    EXPECT_GE(flightChi2(s, 3.5f, depth, 1.0).pValue, 1e-4);
+    EXPECT_LT(flightChi2(s, 3.5f, depth, 1.1).pValue, 1e-6);
+  }
+}
+
+}  // namespace
+}  // namespace pt
