@@ -58,6 +58,11 @@ PT_INLINE float gridVoxel(PT_SCENE_PARAM uint first, uvec3 size, uint components
   return mediumGridFloat(PT_SCENE_ARG first + index * components + c);
 }
 
+// a + t (b - a), written out: GLM's mix and the shader compiler's round differently.
+PT_INLINE float lerpValue(float t, float a, float b) {
+  return a + t * (b - a);
+}
+
 // The grid's value at point u of the unit cube (the bounds' offset coordinates), trilinearly.
 PT_INLINE float gridLookup(PT_SCENE_PARAM uint first, uvec3 size, uint components, uint c,
                            vec3 u) {
@@ -65,15 +70,15 @@ PT_INLINE float gridLookup(PT_SCENE_PARAM uint first, uvec3 size, uint component
   vec3 f = floor(s);
   ivec3 i = ivec3(f);
   vec3 d = s - f;
-  float c00 = mix(gridVoxel(PT_SCENE_ARG first, size, components, c, i),
-                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 0, 0)), d.x);
-  float c10 = mix(gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 1, 0)),
-                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 1, 0)), d.x);
-  float c01 = mix(gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 0, 1)),
-                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 0, 1)), d.x);
-  float c11 = mix(gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 1, 1)),
-                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 1, 1)), d.x);
-  return mix(mix(c00, c10, d.y), mix(c01, c11, d.y), d.z);
+  float c00 = lerpValue(d.x, gridVoxel(PT_SCENE_ARG first, size, components, c, i),
+                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 0, 0)));
+  float c10 = lerpValue(d.x, gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 1, 0)),
+                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 1, 0)));
+  float c01 = lerpValue(d.x, gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 0, 1)),
+                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 0, 1)));
+  float c11 = lerpValue(d.x, gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 1, 1)),
+                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 1, 1)));
+  return lerpValue(d.z, lerpValue(d.y, c00, c10), lerpValue(d.y, c01, c11));
 }
 PT_INLINE vec3 gridLookupRgb(PT_SCENE_PARAM uint first, uvec3 size, vec3 u) {
   return vec3(gridLookup(PT_SCENE_ARG first, size, 3u, 0u, u),

@@ -359,7 +359,7 @@ TEST(Media, NestedMediaAgreeOnBothBackends) {
                  homogeneous(vec3(0.05f), vec3(1.5f, 0.8f, 0.3f), -0.4f)};  // 2: smoke
   std::vector<float> density(4 * 4 * 4, 0.0f);
   for (int i = 0; i < 64; i += 3) density[size_t(i)] = 2.0f;  // empty cells between
-  scene.media.push_back(uniformGrid(scene, vec3(1.2f, 0, -1), vec3(2.8f, 1.6f, 0.6f),
+  scene.media.push_back(uniformGrid(scene, vec3(1.2f, 0.05f, -1), vec3(2.8f, 1.6f, 0.6f),
                                     uvec3(4, 4, 4), density, vec3(0.1f), vec3(0.9f)));
   scene.cameraMedium = 0;
   const uint fog = 0, tea = 1, smoke = 2, grid = 3;
@@ -370,7 +370,7 @@ TEST(Media, NestedMediaAgreeOnBothBackends) {
            MediumInterface{kVacuum, kVacuum});
   addShape(scene, sphere(vec3(-1.2f, 0.8f, 0), 0.8f), 3, MediumInterface{tea, fog});
   addShape(scene, sphere(vec3(0.3f, 0.6f, -1.5f), 0.6f), 0, MediumInterface{smoke, fog});
-  addShape(scene, box(vec3(1.2f, 0, -1), vec3(2.8f, 1.6f, 0.6f)), 0, MediumInterface{grid, fog});
+  addShape(scene, box(vec3(1.2f, 0.05f, -1), vec3(2.8f, 1.6f, 0.6f)), 0, MediumInterface{grid, fog});
   const SceneData data = prepare(scene, 16);
   const Comparison cmp = renderBoth(data, 8);
   expectAgreement(cmp);
