@@ -497,10 +497,13 @@ KeyValues vulkanImageSettings(const VulkanRenderOptions& options) {
                                               ? std::span<const uint32_t>(kPathtraceDebugSpv)
                                               : std::span<const uint32_t>(kPathtraceSpv);
   const std::span<const uint32_t> base(kPathtraceBaseSpv);
+  const std::span<const uint32_t> volume(kPathtraceVolumeSpv);
   return {{"samples_per_fold", std::to_string(vulkanBatchSize(options))},
           {"specialize", options.specialize ? "on" : "off"},
-          {"shader", hexHash(hashBytes(spirv.data(), spirv.size_bytes(),
-                                       hashBytes(base.data(), base.size_bytes())))}};
+          {"shader", hexHash(hashBytes(
+                         spirv.data(), spirv.size_bytes(),
+                         hashBytes(base.data(), base.size_bytes(),
+                                   hashBytes(volume.data(), volume.size_bytes()))))}};
 }
 
 uint32_t vulkanBatchSize(const VulkanRenderOptions& options) {
