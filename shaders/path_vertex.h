@@ -49,6 +49,7 @@
 #define PT_HAS_TEXTURES true
 #define PT_HAS_BUMP_MAPS true
 #define PT_HAS_BSDF_MATERIALS true
+#define PT_HAS_MEDIA true
 #endif
 
 #ifdef __cplusplus
@@ -177,6 +178,8 @@ struct VertexKey {
 PT_CONST uint kScatterLambertian = 0u;
 PT_CONST uint kScatterMirror = 1u;
 PT_CONST uint kScatterBsdf = 2u;
+// A point in a medium (volume_vertex.h): the phase function of asymmetry material.g.
+PT_CONST uint kScatterPhase = 3u;
 
 // A path's vertex on a surface: what light sampling, BSDF sampling and the next ray read.
 struct SurfacePoint {
@@ -404,27 +407,21 @@ PT_INLINE vec3 bsdfFCos(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key, vec
 }
 #endif
 
-// An emitter sampled from point p (the first half of pbrt-v4's SampleLd): chosen from the
-// alias table with uChoose, and with uLight a uniform point on its triangle or a sample of the
-// analytic light (lights.h, environment.h) it names.
-struct EmitterSample {
-  bool found;      // false: the light contributes nothing (it faces away, or no radiance)
-  vec3 wi;         // unit direction from p towards it
-  vec3 to;         // the shadow ray's end: offset from the light's point, or beyond the scene
-  vec3 Li;         // radiance arriving (a delta light's weight)
-  float lightPdf;  // the probability of the emitter times the density of the sample
-  bool delta;      // a point, spot or distant light
-  bool triangle;   // an emissive triangle (the Lambertian product is grouped otherwise)
-  uint emitter;    // Emitter::triangle of the emitter chosen (for --debug-pixel)
-};
-
-PT_INLINE EmitterSample sampleEmitter(PT_SCENE_PARAM vec3 p, vec2 uChoose, vec2 uLight) {
-  EmitterSample e =
-      EmitterSample(false, vec3(0.0f), vec3(0.0f), vec3(0.0f), 0.0f, false, true, 0u);
+// Samples the light from vertex s (pbrt-v4's SampleLd): an emitter from the alias table with
+// uChoose, and with uLight a uniform point on its triangle or a sample of the analytic light
+// (lights.h, environment.h) it names; the BSDF's value towards it (at a point of a medium, the
+// phase function's), and the shadow ray's ends. The shadow ray leaves along n from a
+// Lambertian surface without shading normals, else from the side of the geometric surface the
+// light is on (a medium's point has no offset).
+PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
+                                    vec2 uChoose, vec2 uLight) {
+  LightSample ls = noLightSample();
   uint slot = aliasTableSlot(uChoose.x, PT_PARAMS.emitterCount);
   Emitter emitter =
       loadEmitter(PT_SCENE_ARG aliasTablePick(slot, loadEmitter(PT_SCENE_ARG slot), uChoose.y));
-  e.emitter = emitter.triangle;
+  ls.emitter = emitter.triangle;
+  bool lambertian = s.scatter < kScatterBsdf;  // mirrors sample no light
+  vec3 wi;
 #ifndef PT_NO_BSDF_MATERIALS
   if (PT_HAS_ANALYTIC_LIGHTS && (emitter.triangle & kEmitterLight) != 0u) {
     // An analytic light: the environment image's sample for an infinite light that has one,
@@ -434,78 +431,68 @@ PT_INLINE EmitterSample sampleEmitter(PT_SCENE_PARAM vec3 p, vec2 uChoose, vec2 
     if (PT_HAS_ENVIRONMENT_IMAGE && light.type == kLightInfinite &&
         PT_PARAMS.environmentWidth != 0u) {
       analytic =
-          sampleEnvironmentLight(environmentMap(PT_SCENE_ONLY), p, uLight, PT_PARAMS.sceneRadius);
+          sampleEnvironmentLight(environmentMap(PT_SCENE_ONLY), s.p, uLight, PT_PARAMS.sceneRadius);
     } else {
-      analytic = sampleAnalyticLight(light, p, uLight, PT_PARAMS.sceneRadius);
+      analytic = sampleAnalyticLight(light, s.p, uLight, PT_PARAMS.sceneRadius);
     }
-    e.triangle = false;
-    e.wi = analytic.wi;
-    e.found = maxComponent(analytic.Li) > 0.0f;
-    e.to = analytic.target;
-    e.Li = analytic.Li;
-    e.lightPdf = emitter.pmf * analytic.pdf;
-    e.delta = analytic.delta;
-    return e;
-  }
+    wi = analytic.wi;
+    if (lambertian) {
+      ls.cosTheta = dot(s.n, wi);
+      if (!(ls.cosTheta > 0.0f) || !(maxComponent(analytic.Li) > 0.0f)) return ls;
+      ls.f = s.material.reflectance * kInvPi * ls.cosTheta;
+    } else if (PT_HAS_MEDIA && s.scatter == kScatterPhase) {
+      if (!(maxComponent(analytic.Li) > 0.0f)) return ls;
+      ls.f = vec3(henyeyGreenstein(dot(s.wo, wi), s.material.g));
+    } else {
+      if (!(maxComponent(analytic.Li) > 0.0f)) return ls;
+      ls.wiLocal = toLocal(s.frame, wi);
+      ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
+      if (!(maxComponent(ls.f) > 0.0f)) return ls;
+    }
+    ls.to = analytic.target;
+    ls.Li = analytic.Li;
+    ls.lightPdf = emitter.pmf * analytic.pdf;
+    ls.delta = analytic.delta;
+  } else
 #endif
-  // An emissive triangle: a uniform point on it.
-  Triangle light = loadTriangle(PT_SCENE_ARG emitter.triangle);
-  TriangleShading lightShading = triangleShadingAt(PT_SCENE_ARG emitter.triangle, light);
-  Material lightMaterial = loadMaterial(PT_SCENE_ARG light.material);
-  vec2 b = sampleTriangleBarycentrics(uLight);
-  vec3 point = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
-  vec3 lightNormal = lightShading.normal;  // it emits on this side
-  vec3 toLight = point - p;
-  float dist2 = dot(toLight, toLight);
-  e.wi = toLight / sqrt(dist2);
-  float cosLight = -dot(lightNormal, e.wi);  // > 0: the point sees the emitting side
-  // A two-sided light seen from its back: the side the point sees is the emitting one, its
-  // normal turned towards the point (for the cosine and the shadow ray's offset).
-  if (PT_HAS_TWO_SIDED_EMITTERS && lightMaterial.twoSided != 0u && cosLight < 0.0f) {
-    cosLight = -cosLight;
-    lightNormal = -lightNormal;
-  }
-  e.found = cosLight > 0.0f;
-  e.to = offsetRayOrigin(point, lightNormal, lightShading.magnitude);
-  e.Li = lightMaterial.emission;
-  e.lightPdf = emitter.pmf * dist2 / (cosLight * lightShading.area);
-  return e;
-}
-
-// Samples the light from vertex s (pbrt-v4's SampleLd): an emitter (sampleEmitter), the BSDF's
-// value towards it, and the shadow ray's ends. The shadow ray leaves along n from a Lambertian
-// surface without shading normals, else from the side of the geometric surface the light is
-// on.
-PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
-                                    vec2 uChoose, vec2 uLight) {
-  LightSample ls = noLightSample();
-  EmitterSample e = sampleEmitter(PT_SCENE_ARG s.p, uChoose, uLight);
-  ls.emitter = e.emitter;
-  if (!e.found) return ls;
-  bool lambertian = s.scatter != kScatterBsdf;
-  vec3 wi = e.wi;
-  if (lambertian) {
-    ls.cosTheta = dot(s.n, wi);
-    if (!(ls.cosTheta > 0.0f)) return ls;
-    // With an emissive triangle, the cosine is the contribution's `scale` (the order of the
-    // renderer's images).
-    if (e.triangle) {
+  {
+    // An emissive triangle: a uniform point on it.
+    Triangle light = loadTriangle(PT_SCENE_ARG emitter.triangle);
+    TriangleShading lightShading = triangleShadingAt(PT_SCENE_ARG emitter.triangle, light);
+    Material lightMaterial = loadMaterial(PT_SCENE_ARG light.material);
+    vec2 b = sampleTriangleBarycentrics(uLight);
+    vec3 point = (1.0f - b.x - b.y) * light.v0 + b.x * light.v1 + b.y * light.v2;
+    vec3 lightNormal = lightShading.normal;  // it emits on this side
+    vec3 toLight = point - s.p;
+    float dist2 = dot(toLight, toLight);
+    wi = toLight / sqrt(dist2);
+    float cosLight = -dot(lightNormal, wi);  // > 0: the point sees the emitting side
+    // A two-sided light seen from its back: the side the point sees is the emitting one, its
+    // normal turned towards the point (for the cosine and the shadow ray's offset).
+    if (PT_HAS_TWO_SIDED_EMITTERS && lightMaterial.twoSided != 0u && cosLight < 0.0f) {
+      cosLight = -cosLight;
+      lightNormal = -lightNormal;
+    }
+    if (lambertian) {
+      ls.cosTheta = dot(s.n, wi);
+      if (!(cosLight > 0.0f && ls.cosTheta > 0.0f)) return ls;
       ls.f = s.material.reflectance * kInvPi;
       ls.scale = ls.cosTheta;
+    } else if (PT_HAS_MEDIA && s.scatter == kScatterPhase) {
+      if (!(cosLight > 0.0f)) return ls;
+      ls.f = vec3(henyeyGreenstein(dot(s.wo, wi), s.material.g));
     } else {
-      ls.f = s.material.reflectance * kInvPi * ls.cosTheta;
-    }
-  } else {
 #ifndef PT_NO_BSDF_MATERIALS
-    ls.wiLocal = toLocal(s.frame, wi);
-    ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
-    if (!(maxComponent(ls.f) > 0.0f)) return ls;
+      if (!(cosLight > 0.0f)) return ls;
+      ls.wiLocal = toLocal(s.frame, wi);
+      ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
+      if (!(maxComponent(ls.f) > 0.0f)) return ls;
 #endif
+    }
+    ls.to = offsetRayOrigin(point, lightNormal, lightShading.magnitude);
+    ls.Li = lightMaterial.emission;
+    ls.lightPdf = emitter.pmf * dist2 / (cosLight * lightShading.area);
   }
-  ls.to = e.to;
-  ls.Li = e.Li;
-  ls.lightPdf = e.lightPdf;
-  ls.delta = e.delta;
   vec3 side = (lambertian && !s.shadingNormals) ? s.n : geometricSide(s, wi);
   ls.from = offsetRayOrigin(s.p, side, s.magnitude);
   ls.found = true;

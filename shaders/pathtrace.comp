@@ -253,6 +253,11 @@ Light loadLight(uint i) {
 #define PT_HAS_TEXTURES kTextures
 #define PT_HAS_BUMP_MAPS kBumpMaps
 #define PT_HAS_BSDF_MATERIALS kBsdfMaterials
+#ifdef PT_VOLPATH
+#define PT_HAS_MEDIA true
+#else
+#define PT_HAS_MEDIA false
+#endif
 #include "path_vertex.h"
 
 #ifdef PT_VOLPATH

@@ -73,8 +73,9 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
       ++path.vol.depth;
       if (neeOn()) {
         vec2 uLight = random2(sobol, pixel, sampleIndex, key.dim + kDimLightPoint, seed);
-        LightSample ls = sampleLightInMedium(
-            p, -d, g, random2(sobol, pixel, sampleIndex, key.dim + kDimLightChoose, seed), uLight);
+        LightSample ls = sampleLightAt(
+            mediumPoint(p, -d, g), key,
+            random2(sobol, pixel, sampleIndex, key.dim + kDimLightChoose, seed), uLight);
         if (ls.found) {
 #ifndef PT_NO_BSDF_MATERIALS
           if (kAlphaCutouts) gAlphaU = shadowAlphaRandom(uLight);

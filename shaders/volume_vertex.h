@@ -292,23 +292,22 @@ PT_INLINE bool trackShadowSegment(PT_SCENE_PARAM PT_INOUT(ShadowTransmittance) t
 
 // ---- Light sampling and emission found, weighed over the channels --------------------------
 
-// A light sample from point p in a medium, seen from direction wo, with the phase function of
-// asymmetry g as the BSDF: f is its value (and its density), the shadow ray leaves p itself.
-PT_INLINE LightSample sampleLightInMedium(PT_SCENE_PARAM vec3 p, vec3 wo, float g, vec2 uChoose,
-                                          vec2 uLight) {
-  LightSample ls = noLightSample();
-  EmitterSample e = sampleEmitter(PT_SCENE_ARG p, uChoose, uLight);
-  ls.emitter = e.emitter;
-  if (!e.found) return ls;
-  float phase = henyeyGreenstein(dot(wo, e.wi), g);
-  ls.f = vec3(phase);  // also the density of the phase function's sample of wi
-  ls.from = p;
-  ls.to = e.to;
-  ls.Li = e.Li;
-  ls.lightPdf = e.lightPdf;
-  ls.delta = e.delta;
-  ls.found = phase > 0.0f;
-  return ls;
+// A point of a medium as light sampling (path_vertex.h's sampleLightAt) sees it: scattering by
+// the phase function of asymmetry g, seen from direction wo, with no ray offset.
+PT_INLINE SurfacePoint mediumPoint(vec3 p, vec3 wo, float g) {
+  SurfacePoint s;
+  s.material.g = g;
+  s.p = p;
+  s.ng = wo;
+  s.ns = wo;
+  s.n = wo;
+  s.wo = wo;
+  s.cosOut = 1.0f;
+  s.magnitude = 0.0f;  // the shadow ray leaves p itself
+  s.area = 0.0f;
+  s.shadingNormals = true;
+  s.scatter = kScatterPhase;
+  return s;
 }
 
 // The contribution of light sample ls whose shadow ray carried `tr`, where the path's vertex

@@ -89,7 +89,8 @@ vec3 sampleRadianceVolume(const SceneData& scene, uvec2 imagePixel, uint32_t sam
         ++v.depth;
         const BounceRandom u = bounceRandomSimd(sobol, pixel, sampleIndex, key.dim, seed);
         if (neeOn(ps)) {
-          const LightSample ls = sampleLightInMedium(ps, p, -d, g, u.lightChoose, u.lightPoint);
+          const LightSample ls =
+              sampleLightAt(ps, mediumPoint(p, -d, g), key, u.lightChoose, u.lightPoint);
           if (ls.found) {
             ShadowTransmittance tr = startShadowTransmittance(ps, key);
             if (traceShadowThroughMedia(scene, ps, ls, v.medium, v.hero, u.lightPoint, tr, rays)) {
