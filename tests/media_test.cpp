@@ -113,7 +113,7 @@ SceneData prepare(Scene scene, int maxDepth = 64) {
 // that fills the view: each camera ray arrives with exp(-sigma_a / |cos|). Each sample is 0 or
 // T / mean(T) (the hero channel passes or not), so every pixel is within its own noise of the
 // closed form and the image's mean within a fraction of a percent.
-TEST(Media, BeerLambertThroughAnAbsorbingSlab) {
+TEST(MediaBothBackends, BeerLambertThroughAnAbsorbingSlab) {
   const vec3 sigma(0.2f, 0.5f, 1.0f);
   Scene scene;
   scene.camera = camera(vec3(0, 0, -5), vec3(0, 0, 0), 20.0f, 16);
@@ -152,7 +152,7 @@ TEST(Media, BeerLambertThroughAnAbsorbingSlab) {
 
 // The camera inside an absorbing medium that has no boundary, looking at an emitter 3 away:
 // exp(-sigma_a d) with d the distance along each ray.
-TEST(Media, CameraInsideAMediumWithoutBoundary) {
+TEST(MediaBothBackends, CameraInsideAMediumWithoutBoundary) {
   const vec3 sigma(0.1f, 0.2f, 0.4f);
   Scene scene;
   scene.camera = camera(vec3(0, 0, -3), vec3(0, 0, 0), 20.0f, 8);
@@ -218,7 +218,7 @@ FurnaceResult furnace(vec3 sigmaA, vec3 sigmaS, float g, int spp) {
   return r;
 }
 
-TEST(Media, WhiteFurnaceOfAScatteringMediumRendersTheEnvironment) {
+TEST(MediaBothBackends, WhiteFurnaceOfAScatteringMediumRendersTheEnvironment) {
   const FurnaceResult r = furnace(vec3(0.0f), vec3(0.5f, 1.0f, 2.0f), 0.6f, 160);
   ASSERT_GE(r.sphere.size(), 50u);
   expectAgreement(r.cmp);
@@ -241,7 +241,7 @@ TEST(Media, WhiteFurnaceOfAScatteringMediumRendersTheEnvironment) {
   }
 }
 
-TEST(Media, AMediumOfAlbedoBelowOneLosesEnergy) {
+TEST(MediaBothBackends, AMediumOfAlbedoBelowOneLosesEnergy) {
   const FurnaceResult r = furnace(vec3(0.5f), vec3(0.5f), 0.0f, 32);
   expectAgreement(r.cmp);
   for (const Image* image : {&r.cmp.cpuImage, &r.cmp.gpuImage}) {
@@ -258,7 +258,7 @@ TEST(Media, AMediumOfAlbedoBelowOneLosesEnergy) {
 
 // An emissive, absorbing slab seen against black: pbrt-v4's emission is sigma_a Le per unit
 // length, so a ray of length d through it gathers Le (1 - exp(-sigma_a d)).
-TEST(Media, EmissiveSlabGathersItsEmission) {
+TEST(MediaBothBackends, EmissiveSlabGathersItsEmission) {
   const vec3 sigma(0.3f, 1.0f, 3.0f);
   const vec3 Le(2.0f, 1.0f, 0.5f);
   Scene scene;
@@ -292,7 +292,7 @@ TEST(Media, EmissiveSlabGathersItsEmission) {
 // No NaN, nothing invalid or cut short, and the backends agree, on scenes at the edges: a
 // medium of coefficient 0 (vacuum exactly), of 1e6 (opaque: nothing behind it, exactly), a
 // scattering medium of 1e6 (paths end at maxDepth), a ray grazing an interface.
-TEST(Media, ZeroAndHugeCoefficientsStayFinite) {
+TEST(MediaBothBackends, ZeroAndHugeCoefficientsStayFinite) {
   Scene base;
   base.camera = camera(vec3(0, 0, -5), vec3(0, 0, 0), 20.0f, 8);
   base.materials = {Material{vec3(0.0f), kMaterialInterface, vec3(0.0f), 0},
@@ -344,10 +344,10 @@ TEST(Media, ZeroAndHugeCoefficientsStayFinite) {
 
 // A glass of tea inside fog: the camera in the fog, a dielectric sphere whose inside is an
 // absorbing medium, an interface sphere of a chromatic scattering medium, a grid medium with
-// empty cells, an area light and a floor. The backends agree.
-TEST(Media, NestedMediaAgreeOnBothBackends) {
+// empty cells, an area light and a floor.
+Scene nestedMediaScene(int size) {
   Scene scene;
-  scene.camera = camera(vec3(0, 1, -6), vec3(0, 0.5f, 0), 35.0f, 24);
+  scene.camera = camera(vec3(0, 1, -6), vec3(0, 0.5f, 0), 35.0f, size);
   Material glass{};
   glass.type = kMaterialDielectric;
   glass.eta = vec3(1.33f);
@@ -371,9 +371,27 @@ TEST(Media, NestedMediaAgreeOnBothBackends) {
   addShape(scene, sphere(vec3(-1.2f, 0.8f, 0), 0.8f), 3, MediumInterface{tea, fog});
   addShape(scene, sphere(vec3(0.3f, 0.6f, -1.5f), 0.6f), 0, MediumInterface{smoke, fog});
   addShape(scene, box(vec3(1.2f, 0.05f, -1), vec3(2.8f, 1.6f, 0.6f)), 0, MediumInterface{grid, fog});
-  const SceneData data = prepare(scene, 16);
-  const Comparison cmp = renderBoth(data, 8);
+  return scene;
+}
+
+// The backends agree on it.
+TEST(MediaBothBackends, NestedMediaAgree) {
+  const Comparison cmp = renderBoth(prepare(nestedMediaScene(24), 16), 8);
   expectAgreement(cmp);
+}
+
+// The CPU's volume integrator alone (the sanitizer build runs this one): finite, nothing
+// invalid, and the same image from one thread and from two.
+TEST(Media, VolumeIntegratorOnTheCpu) {
+  const SceneData data = prepare(nestedMediaScene(12), 16);
+  Film one(12, 12), two(12, 12);
+  EXPECT_EQ(renderCpu(data, test::cpuOptions(1, 2), one).invalidSamples, 0u);
+  EXPECT_EQ(renderCpu(data, test::cpuOptions(2, 2), two).invalidSamples, 0u);
+  const Image a = one.resolve(), b = two.resolve();
+  EXPECT_EQ(a.pixels, b.pixels);
+  double sum = 0.0;
+  for (const vec3& p : a.pixels) sum += double(p.x + p.y + p.z);
+  EXPECT_GT(sum, 0.0);
 }
 
 // ---- Samplers against their densities -------------------------------------------------------
