@@ -63,6 +63,8 @@ Material defaultMaterial(uint type) {
       m.maxDepth = 10;
       m.nSamples = 1;
       break;
+    case kMaterialInterface:
+      break;  // no surface: nothing to set
     default:
       PT_CHECK(false, "unknown material type");
   }

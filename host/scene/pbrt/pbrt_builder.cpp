@@ -10,6 +10,8 @@
 
 #include "common/check.h"
 #include "scene/json_reader.h"
+#include "scene/media.h"
+#include "scene/reader_helpers.h"
 
 namespace pt::pbrt {
 
@@ -57,17 +59,9 @@ void Builder::handle(Statement& s) {
     requireWorld(s);
     objectInstance(s);
   } else if (d == "MakeNamedMedium") {
-    Params p(*this, s, &gs_.mediumAttributes, "MakeNamedMedium");
-    p.markAllUsed();
-    warnOnce("MakeNamedMedium", s.location,
-             "MakeNamedMedium ignored: participating media are not simulated");
+    makeNamedMedium(s);  // anywhere, as in pbrt-v4
   } else if (d == "MediumInterface") {
-    bool any = false;
-    for (const std::string& name : s.strings) any = any || !name.empty();
-    if (any) {
-      warnOnce("MediumInterface", s.location,
-               "MediumInterface ignored: participating media are not simulated");
-    }
+    mediumInterface(s);
   } else {
     PT_CHECK(false, "pbrt directive without a handler: " + d);
   }
@@ -101,20 +95,31 @@ Scene Builder::finish(const Location& end) {
                              scene_detail::didYouMean(use.name, names));
     }
     for (const InstanceShape& shape : it->second.shapes) {
-      emit(transformMesh(shape.mesh, use.m), shape.slot, use.location,
+      emit(transformMesh(shape.mesh, use.m), shape.slot, shape.mediumInterface, use.location,
            "ObjectInstance " + singleQuoted(use.name));
     }
   }
   reportDropped();
-  // Materials: each slot resolved; interface materials named before their definition drop
-  // their triangles now, and only the materials some triangle uses are kept.
+  // Media: each interface a shape took, by medium index; the camera's medium.
+  const std::vector<MediumInterface> interfaces = resolveMedia();
+  scene_.cameraMedium = interfaces[cameraInterface_].outside;
+  // Materials: each slot resolved, and only the materials some triangle uses are kept. The
+  // triangles of "interface" materials stay where they bound a medium (their two sides
+  // differ), as surfaces of kMaterialInterface; the others change nothing and are dropped.
   std::vector<Material> materials(slots_.size());
   std::vector<std::string> names(slots_.size());
-  std::vector<bool> keep(slots_.size(), true);
+  std::vector<bool> isInterface(slots_.size(), false);
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     const MaterialDef& def = resolve(slots_[i].ref);
     if (def.kind == MaterialDef::Kind::kInterface) {
-      keep[i] = false;
+      isInterface[i] = true;
+      materials[i] = defaultMaterial(kMaterialInterface);
+      names[i] = def.label.empty() ? "interface" : def.label;
+      if (slots_[i].emission) {
+        warnOnce("interface area light", slots_[i].ref.location,
+                 "an area light on shapes with the \"interface\" material is ignored, as "
+                 "pbrt-v4 ignores it");
+      }
       continue;
     }
     materials[i] = def.material;
@@ -127,19 +132,24 @@ Scene Builder::finish(const Location& end) {
   }
   std::vector<bool> used(slots_.size(), false);
   std::size_t kept = 0;
+  scene_.mediumInterfaces.resize(scene_.triangles.size());
   for (std::size_t i = 0; i < scene_.triangles.size(); ++i) {
     Triangle t = scene_.triangles[i];
-    if (!keep[t.material]) continue;
+    const MediumInterface mi = interfaces[triangleInterfaces_[i]];
+    if (isInterface[t.material] && mi.inside == mi.outside) continue;
     used[t.material] = true;
     t.primitive = static_cast<uint>(kept);
     scene_.triangles[kept] = t;
     if (!scene_.normals.empty()) scene_.normals[kept] = scene_.normals[i];
     if (!scene_.uvs.empty()) scene_.uvs[kept] = scene_.uvs[i];
+    scene_.mediumInterfaces[kept] = mi;
     ++kept;
   }
   scene_.triangles.resize(kept);
   if (!scene_.normals.empty()) scene_.normals.resize(kept);
   if (!scene_.uvs.empty()) scene_.uvs.resize(kept);
+  scene_.mediumInterfaces.resize(kept);
+  keepUsedMedia(scene_);  // none used: every media field empty, as before media existed
   std::vector<uint> remap(slots_.size(), 0);
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     if (!used[i]) continue;
@@ -147,12 +157,12 @@ Scene Builder::finish(const Location& end) {
     scene_.materials.push_back(materials[i]);
     scene_.materialNames.push_back(names[i]);
     MaterialTextures textures = resolve(slots_[i].ref).textures;
-    textures.alpha = slots_[i].alpha;
+    textures.alpha = isInterface[i] ? kNoTexture : slots_[i].alpha;
     setMaterialTextures(scene_, scene_.materials.size() - 1, textures);
   }
   for (Triangle& t : scene_.triangles) t.material = remap[t.material];
   for (auto& [sphere, slot] : sphereLights_) {
-    if (!used[slot]) continue;  // all its triangles dropped
+    if (!used[slot] || isInterface[slot]) continue;  // no triangle emits
     sphere.material = remap[slot];
     scene_.lights.push_back(sphere);
   }

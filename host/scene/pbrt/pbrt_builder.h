@@ -19,6 +19,7 @@
 #include "scene/camera_filter.h"
 #include "scene/pbrt/pbrt_graphics_state.h"
 #include "scene/pbrt/pbrt_materials.h"
+#include "scene/pbrt/pbrt_media.h"
 #include "scene/pbrt/pbrt_params.h"
 #include "scene/pbrt/pbrt_parser.h"
 #include "scene/pbrt/pbrt_shapes.h"
@@ -95,6 +96,11 @@ class Builder {
   void objectBegin(const Statement& s);
   void objectEnd(const Statement& s);
   void objectInstance(const Statement& s);
+  void makeNamedMedium(Statement& s);
+  void mediumInterface(const Statement& s);
+  // The media of every MediumInterface a shape or the camera took, by index (unknown names
+  // are errors); the named media's transforms set in the scene.
+  std::vector<MediumInterface> resolveMedia();
 
   // Spectrum and float parameters, with textures and named spectra resolved to constants.
   std::optional<vec3> spectrum(const Params& p, std::string_view name, Use use,
@@ -121,7 +127,8 @@ class Builder {
   const MaterialDef& resolve(const MaterialRef& ref);
   const MaterialDef& followMix(const MaterialDef& def);
   bool isKnownInterface(const MaterialRef& ref) const;
-  void emit(const Mesh& mesh, uint slot, const Location& where, const std::string& context);
+  void emit(const Mesh& mesh, uint slot, std::size_t mediumInterface, const Location& where,
+            const std::string& context);
 
   std::filesystem::path mainFile_;
   bool strict_ = false;  // warnings are errors
@@ -164,6 +171,11 @@ class Builder {
   std::map<std::string, Texture> floatTextures_, spectrumTextures_;
   TextureBuilder textures_{scene_};
   std::map<std::pair<const Texture*, bool>, uint> builtTextures_;
+
+  std::map<std::string, NamedMedium> namedMedia_;
+  std::vector<MediumNames> mediumInterfaces_{MediumNames{}};  // GraphicsState::mediumInterface
+  std::vector<std::size_t> triangleInterfaces_;  // per triangle of scene_, its interface's index
+  std::size_t cameraInterface_ = 0;  // the interface current at Camera: its outside medium
 
   std::map<std::string, Instance> instances_;
   std::string activeInstance_;  // empty: not inside ObjectBegin

@@ -53,6 +53,9 @@ void Builder::options(Statement& s) {
     // coordinate system of its inverse.
     cameraFromWorld_ = gs_.ctm;
     cameraLocation_ = s.location;
+    // pbrt-v4: the camera is in the outside medium of the current MediumInterface.
+    cameraInterface_ = gs_.mediumInterface;
+    mediumInterfaces_[cameraInterface_].used = true;
     coordinateSystems_["camera"] = Xform{gs_.ctm.inverse, gs_.ctm.m};
     if (type != "perspective") {
       warnOnce("Camera", s.location,

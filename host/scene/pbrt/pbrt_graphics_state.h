@@ -73,6 +73,9 @@ struct GraphicsState {
   bool reverseOrientation = false;
   MaterialRef material;
   std::optional<AreaLight> areaLight;
+  // The current MediumInterface: an index into the builder's table of them (0: vacuum on both
+  // sides, pbrt-v4's start).
+  std::size_t mediumInterface = 0;
   std::vector<Param> shapeAttributes, lightAttributes, materialAttributes, mediumAttributes,
       textureAttributes;
 };
@@ -82,6 +85,7 @@ struct GraphicsState {
 struct InstanceShape {
   Mesh mesh;  // oriented, in the world space of the definition
   uint slot;
+  std::size_t mediumInterface;  // the definition's, as pbrt-v4 keeps it for every use
   Location location;
   std::string context;
 };

@@ -105,12 +105,9 @@ void Builder::shape(Statement& s) {
     ++skippedShapes_;
     return;
   }
-  if (isKnownInterface(gs_.material)) {
-    warnOnce("interface", s.location,
-             "shapes with the \"interface\" material are left out (they bound media, which are "
-             "not simulated)");
-    return;
-  }
+  // The shape's triangles take the current MediumInterface; those of an "interface" material
+  // are kept only where it is a transition (finish).
+  mediumInterfaces_[gs_.mediumInterface].used = true;
   if (gs_.reverseOrientation) reverseMesh(mesh);
   Mesh world = transformMesh(mesh, gs_.ctm.m);
   if (!activeInstance_.empty()) {
@@ -118,12 +115,17 @@ void Builder::shape(Statement& s) {
       warnOnce("instance area light", s.location,
                "area lights in object instances are ignored, as pbrt-v4 ignores them");
     }
-    instances_[activeInstance_].shapes.push_back(
-        InstanceShape{std::move(world), slotFor(gs_.material, alpha), s.location, context});
+    instances_[activeInstance_].shapes.push_back(InstanceShape{
+        std::move(world), slotFor(gs_.material, alpha), gs_.mediumInterface, s.location, context});
     return;
   }
   uint slot;
-  if (gs_.areaLight) {
+  if (gs_.areaLight && isKnownInterface(gs_.material)) {
+    warnOnce("interface area light", s.location,
+             "an area light on shapes with the \"interface\" material is ignored, as pbrt-v4 "
+             "ignores it");
+    slot = slotFor(gs_.material, alpha);
+  } else if (gs_.areaLight) {
     const AreaLight& light = *gs_.areaLight;
     double scale = light.scale;
     if (light.power > 0.0) {
@@ -168,7 +170,7 @@ void Builder::shape(Statement& s) {
   } else {
     slot = slotFor(gs_.material, alpha);
   }
-  emit(world, slot, s.location, context);
+  emit(world, slot, gs_.mediumInterface, s.location, context);
 }
 
 // The shape's triangles in object space; false when it is skipped (warned).
@@ -391,7 +393,8 @@ bool Builder::buildShape(const std::string& type, const Params& p, const Stateme
 
 // Appends an oriented world-space mesh to the scene: mirrored with the camera if need be,
 // rounded to float, zero-area triangles dropped as the JSON reader drops them.
-void Builder::emit(const Mesh& mesh, uint slot, const Location& where, const std::string& context) {
+void Builder::emit(const Mesh& mesh, uint slot, std::size_t mediumInterface, const Location& where,
+                   const std::string& context) {
   std::size_t dropped = 0;
   Scene& scene = scene_;
   // Room for the shape, growing geometrically: reserving the exact size for every shape
@@ -426,6 +429,7 @@ void Builder::emit(const Mesh& mesh, uint slot, const Location& where, const std
     if (appended == Appended::kTooMany) {
       fail(where, "too many triangles in the scene (at most 4294967295)");
     }
+    if (appended == Appended::kAdded) triangleInterfaces_.push_back(mediumInterface);
   }
   if (dropped > 0) {
     // One warning for the whole scene (finish): Bitterli's staircase drops some in 30 shapes.

@@ -1,0 +1,502 @@
+// Participating media as both readers give them (host/scene/media.h, pbrt/pbrt_media.cpp,
+// json_media.cpp): pbrt-v4's types, parameters and defaults, presets, grids (counts, offsets,
+// order), transforms, interfaces parallel to the triangles, the camera's medium, interface
+// shapes kept or dropped, every error as one line, and media-free scenes left as they were.
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "common/check.h"
+#include "scene/load_scene.h"
+#include "scene/media.h"
+#include "scene/pbrt/pbrt_scene.h"
+#include "scene/scene.h"
+#include "test_util.h"
+
+namespace pt {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A camera that needs no mirroring (Scale -1 1 1, as Bitterli's files start), so that world
+// coordinates come through unchanged.
+constexpr char kUnmirrored[] =
+    "Scale -1 1 1\nLookAt 0 0 -10  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n";
+
+// A triangle at the origin, its normal +z: (0,0,0), (1,0,0), (0,1,0).
+constexpr char kTriangle[] =
+    "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0 ] \"integer indices\" [ 0 1 2 ]\n";
+
+Scene pbrtScene(const std::string& text, bool strict = false) {
+  return loadPbrtSceneText(text, "scene.pbrt", SceneLoadOptions{.strict = strict});
+}
+
+std::string pbrtError(const std::string& text, bool strict = false) {
+  try {
+    pbrtScene(text, strict);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// The world point p in medium m's space.
+glm::dvec3 toMedium(const Medium& m, glm::dvec3 p) {
+  const glm::dvec4 h(p, 1.0);
+  return {glm::dot(glm::dvec4(m.toMedium0), h), glm::dot(glm::dvec4(m.toMedium1), h),
+          glm::dot(glm::dvec4(m.toMedium2), h)};
+}
+
+void expectNear(glm::dvec3 a, glm::dvec3 b, const std::string& what) {
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 1e-5) << what << " [" << c << "]";
+}
+
+std::vector<float> grid(const Scene& s, uint offset, std::size_t count) {
+  EXPECT_LE(offset + count, s.mediumGrids.size());
+  if (offset + count > s.mediumGrids.size()) return {};
+  return {s.mediumGrids.begin() + offset, s.mediumGrids.begin() + offset + count};
+}
+
+void expectNoMedia(const Scene& s) {
+  EXPECT_TRUE(s.media.empty());
+  EXPECT_TRUE(s.mediumNames.empty());
+  EXPECT_TRUE(s.mediumGrids.empty());
+  EXPECT_TRUE(s.mediumInterfaces.empty());
+  EXPECT_EQ(s.cameraMedium, kNoMedium);
+}
+
+// ---- pbrt-v4: homogeneous -----------------------------------------------------------------
+
+TEST(MediaPbrt, HomogeneousTakesPbrtV4sDefaults) {
+  const Scene s = pbrtScene(std::string(kUnmirrored) +
+                            "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+                            "MediumInterface \"fog\" \"\"\n" +
+                            kTriangle);
+  ASSERT_EQ(s.media.size(), 1u);
+  EXPECT_EQ(s.mediumNames, std::vector<std::string>{"fog"});
+  const Medium& m = s.media[0];
+  EXPECT_EQ(m.type, kMediumHomogeneous);
+  EXPECT_EQ(m.sigmaA, vec3(1.0f));
+  EXPECT_EQ(m.sigmaS, vec3(1.0f));
+  EXPECT_EQ(m.g, 0.0f);
+  EXPECT_EQ(m.Le, vec3(0.0f));
+  EXPECT_EQ(m.emissive, 0u);
+  EXPECT_EQ(m.density, kNoGrid);
+  EXPECT_EQ(m.majorants, kNoGrid);
+  EXPECT_EQ(m.emission, kNoGrid);
+  EXPECT_TRUE(s.mediumGrids.empty());
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+}
+
+TEST(MediaPbrt, HomogeneousScalesCoefficientsAndEmission) {
+  const Scene s = pbrtScene(std::string(kUnmirrored) +
+                            "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+                            "  \"rgb sigma_a\" [1 2 3] \"rgb sigma_s\" [4 5 6] \"float scale\" 2\n"
+                            "  \"float g\" 0.5 \"rgb Le\" [1 2 3] \"float Lescale\" 3\n"
+                            "MediumInterface \"fog\"\n" +
+                            kTriangle);
+  ASSERT_EQ(s.media.size(), 1u);
+  const Medium& m = s.media[0];
+  EXPECT_EQ(m.sigmaA, vec3(2.0f, 4.0f, 6.0f));
+  EXPECT_EQ(m.sigmaS, vec3(8.0f, 10.0f, 12.0f));
+  EXPECT_EQ(m.g, 0.5f);
+  EXPECT_EQ(m.Le, vec3(3.0f, 6.0f, 9.0f));
+  EXPECT_EQ(m.emissive, 1u);
+  // One name: the medium on both sides.
+  ASSERT_EQ(s.mediumInterfaces.size(), 1u);
+  EXPECT_EQ(s.mediumInterfaces[0].inside, 0u);
+  EXPECT_EQ(s.mediumInterfaces[0].outside, 0u);
+}
+
+TEST(MediaPbrt, PresetsArePbrtV4sMeasuredMediaWithSigmaPrimeSAsSigmaS) {
+  const Scene s = pbrtScene(std::string(kUnmirrored) +
+                            "MakeNamedMedium \"k\" \"string type\" \"homogeneous\"\n"
+                            "  \"string preset\" \"Ketchup\" \"float scale\" 10\n"
+                            "MediumInterface \"k\" \"\"\n" +
+                            kTriangle);
+  ASSERT_EQ(s.media.size(), 1u);
+  // Jensen et al. 2001: Ketchup's sigma'_s (0.18, 0.07, 0.03), sigma_a (0.061, 0.97, 1.45).
+  expectNear(s.media[0].sigmaS, glm::dvec3(1.8, 0.7, 0.3), "sigma_s");
+  expectNear(s.media[0].sigmaA, glm::dvec3(0.61, 9.7, 14.5), "sigma_a");
+  ASSERT_NE(findMediumPreset("Regular Milk"), nullptr);
+  EXPECT_EQ(findMediumPreset("Regular Milk")->sigmaPrimeS, vec3(4.5513f, 5.8294f, 7.136f));
+  EXPECT_EQ(mediumPresetNames().size(), 47u);
+
+  // With a preset pbrt-v4 reads neither sigma_a nor sigma_s: they are reported unused.
+  const Scene both = pbrtScene(std::string(kUnmirrored) +
+                               "MakeNamedMedium \"k\" \"string type\" \"homogeneous\"\n"
+                               "  \"string preset\" \"Apple\" \"rgb sigma_a\" [9 9 9]\n"
+                               "MediumInterface \"k\" \"\"\n" +
+                               kTriangle);
+  EXPECT_EQ(both.media[0].sigmaA, vec3(0.0030f, 0.0034f, 0.046f));
+  ASSERT_EQ(both.warnings.size(), 1u);
+  EXPECT_NE(both.warnings[0].find("sigma_a"), std::string::npos) << both.warnings[0];
+
+  // An unknown preset: warned as pbrt-v4 does, sigma_a and sigma_s used.
+  const Scene unknown = pbrtScene(std::string(kUnmirrored) +
+                                  "MakeNamedMedium \"k\" \"string type\" \"homogeneous\"\n"
+                                  "  \"string preset\" \"Ketchp\" \"rgb sigma_a\" [2 2 2]\n"
+                                  "MediumInterface \"k\" \"\"\n" +
+                                  kTriangle);
+  EXPECT_EQ(unknown.media[0].sigmaA, vec3(2.0f));
+  ASSERT_EQ(unknown.warnings.size(), 1u);
+  EXPECT_EQ(unknown.warnings[0],
+            "scene.pbrt:6: MakeNamedMedium 'k': unknown preset 'Ketchp' (did you mean "
+            "'Ketchup'?) (pbrt-v4 warns too): sigma_a and sigma_s are used");
+}
+
+// ---- pbrt-v4: grids -----------------------------------------------------------------------
+
+TEST(MediaPbrt, UniformGridStoresDensityXFastestAndItsEmissionGrid) {
+  const Scene s = pbrtScene(
+      std::string(kUnmirrored) +
+      "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\"\n"
+      "  \"integer nx\" 3 \"integer ny\" 2 \"integer nz\" 1\n"
+      "  \"float density\" [0 1 2 3 4 5] \"point3 p0\" [-1 -2 -3] \"point3 p1\" [1 2 3]\n"
+      "  \"rgb sigma_a\" [0.5 1 2] \"float scale\" 4 \"rgb Le\" [1 0.5 0.25]\n"
+      "  \"float Lescale\" [6 7 8 9 10 11]\n"
+      "MediumInterface \"smoke\" \"\"\n" +
+      kTriangle);
+  ASSERT_EQ(s.media.size(), 1u);
+  const Medium& m = s.media[0];
+  EXPECT_EQ(m.type, kMediumUniformGrid);
+  EXPECT_EQ(m.size, uvec3(3, 2, 1));
+  EXPECT_EQ(m.boundsMin, vec3(-1, -2, -3));
+  EXPECT_EQ(m.boundsMax, vec3(1, 2, 3));
+  EXPECT_EQ(m.sigmaA, vec3(2.0f, 4.0f, 8.0f));  // times scale
+  EXPECT_EQ(m.sigmaS, vec3(4.0f));              // pbrt-v4's default 1, times scale
+  EXPECT_EQ(m.Le, vec3(1.0f, 0.5f, 0.25f));
+  EXPECT_EQ(m.emissive, 1u);
+  EXPECT_EQ(m.majorants, kNoGrid);
+  // The file's order is pbrt-v4's SampledGrid order, (z * ny + y) * nx + x: kept as it is.
+  EXPECT_EQ(grid(s, m.density, 6), (std::vector<float>{0, 1, 2, 3, 4, 5}));
+  ASSERT_NE(m.emission, kNoGrid);
+  EXPECT_EQ(grid(s, m.emission, 6), (std::vector<float>{6, 7, 8, 9, 10, 11}));
+  EXPECT_EQ(s.mediumGrids.size(), 12u);
+  EXPECT_EQ(densityFloats(m), 6u);
+  EXPECT_EQ(emissionFloats(m), 6u);
+
+  // Without Le it does not emit, and its Lescale grid is not kept; defaults p0 (0 0 0),
+  // p1 (1 1 1), nx = ny = nz = 1.
+  const Scene dark = pbrtScene(std::string(kUnmirrored) +
+                               "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\"\n"
+                               "  \"float density\" [2] \"float Lescale\" [3]\n"
+                               "MediumInterface \"smoke\" \"\"\n" +
+                               kTriangle);
+  const Medium& d = dark.media[0];
+  EXPECT_EQ(d.emissive, 0u);
+  EXPECT_EQ(d.emission, kNoGrid);
+  EXPECT_EQ(d.size, uvec3(1));
+  EXPECT_EQ(d.boundsMin, vec3(0.0f));
+  EXPECT_EQ(d.boundsMax, vec3(1.0f));
+  EXPECT_EQ(dark.mediumGrids, std::vector<float>{2.0f});
+}
+
+TEST(MediaPbrt, RgbGridHasItsScalesInItsGrids) {
+  const Scene s = pbrtScene(std::string(kUnmirrored) +
+                            "MakeNamedMedium \"c\" \"string type\" \"rgbgrid\"\n"
+                            "  \"integer nx\" 2 \"rgb sigma_a\" [1 2 3  4 5 6]\n"
+                            "  \"rgb sigma_s\" [0.5 0.5 0.5  1 1 1] \"float scale\" 2\n"
+                            "  \"rgb Le\" [2 4 6  8 10 12] \"float Lescale\" 0.5 \"float g\" -0.25\n"
+                            "MediumInterface \"\" \"c\"\n" +
+                            kTriangle);
+  ASSERT_EQ(s.media.size(), 1u);
+  const Medium& m = s.media[0];
+  EXPECT_EQ(m.type, kMediumRgbGrid);
+  EXPECT_EQ(m.size, uvec3(2, 1, 1));
+  EXPECT_EQ(m.g, -0.25f);
+  EXPECT_EQ(m.sigmaA, vec3(1.0f));
+  EXPECT_EQ(m.sigmaS, vec3(1.0f));
+  EXPECT_EQ(m.Le, vec3(1.0f));
+  EXPECT_EQ(m.emissive, 1u);
+  // sigma_a's RGB per voxel, then sigma_s's, times scale; then Le times Lescale.
+  EXPECT_EQ(grid(s, m.density, 12),
+            (std::vector<float>{2, 4, 6, 8, 10, 12, 1, 1, 1, 2, 2, 2}));
+  EXPECT_EQ(grid(s, m.emission, 6), (std::vector<float>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(s.mediumInterfaces[0].inside, kNoMedium);
+  EXPECT_EQ(s.mediumInterfaces[0].outside, 0u);
+
+  // A missing sigma_s is pbrt-v4's constant 1 (times scale), stored as a grid, warned.
+  const Scene one = pbrtScene(std::string(kUnmirrored) +
+                              "MakeNamedMedium \"c\" \"string type\" \"rgbgrid\"\n"
+                              "  \"rgb sigma_a\" [1 2 3] \"float scale\" 3\n"
+                              "MediumInterface \"\" \"c\"\n" +
+                              kTriangle);
+  EXPECT_EQ(one.mediumGrids, (std::vector<float>{3, 6, 9, 3, 3, 3}));
+  EXPECT_EQ(one.media[0].emission, kNoGrid);
+  EXPECT_EQ(one.media[0].emissive, 0u);
+  ASSERT_EQ(one.warnings.size(), 1u);
+  EXPECT_NE(one.warnings[0].find("grid of ones"), std::string::npos) << one.warnings[0];
+}
+
+TEST(MediaPbrt, TheCtmAtMakeNamedMediumPlacesAGrid) {
+  const std::string grid =
+      "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" \"float density\" [1]\n";
+  const std::string use = "MediumInterface \"g\" \"\"\n" + std::string(kTriangle);
+  // Medium to world: translate (1, 2, 3) after a scale by 2.
+  const Scene s = pbrtScene(std::string(kUnmirrored) + "AttributeBegin\nTranslate 1 2 3\n" +
+                            "Scale 2 2 2\n" + grid + "AttributeEnd\n" + use);
+  const Medium& m = s.media[0];
+  expectNear(toMedium(m, {1, 2, 3}), {0, 0, 0}, "origin");
+  expectNear(toMedium(m, {3, 2, 3}), {1, 0, 0}, "x");
+  expectNear(toMedium(m, {1, 2, 5}), {0, 0, 1}, "z");
+  EXPECT_EQ(m.toMedium0, vec4(0.5f, 0.0f, 0.0f, -0.5f));
+
+  // A camera that pbrt's left-handed space makes this renderer mirror in x: the medium is
+  // mirrored with the triangles.
+  const Scene mirrored = pbrtScene(
+      "LookAt 0 0 -10  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nTranslate 1 2 3\n" +
+      grid + use);
+  expectNear(toMedium(mirrored.media[0], {-1, 2, 3}), {0, 0, 0}, "mirrored origin");
+  expectNear(toMedium(mirrored.media[0], {-2, 2, 3}), {1, 0, 0}, "mirrored x");
+
+  // Before the Camera directive pbrt-v4 takes the CTM in its render space, the world moved
+  // to the camera's position (0, 0, -10).
+  const Scene before = pbrtScene(grid + "Scale -1 1 1\nLookAt 0 0 -10  0 0 0  0 1 0\n" +
+                                 "Camera \"perspective\"\nWorldBegin\n" + use);
+  expectNear(toMedium(before.media[0], {0, 0, -10}), {0, 0, 0}, "before the camera");
+
+  // Homogeneous media ignore it.
+  const Scene homogeneous =
+      pbrtScene(std::string(kUnmirrored) + "Scale 0 0 0\n" +
+                "MakeNamedMedium \"h\" \"string type\" \"homogeneous\"\nIdentity\n" +
+                "MediumInterface \"h\" \"\"\n" + kTriangle);
+  EXPECT_EQ(homogeneous.media[0].toMedium0, vec4(1, 0, 0, 0));
+}
+
+// ---- pbrt-v4: interfaces, the camera, interface shapes -----------------------------------
+
+TEST(MediaPbrt, EveryTriangleGetsTheInterfaceOfItsShapeThroughDropsAndInstances) {
+  const Scene s = pbrtScene(
+      std::string(kUnmirrored) +
+      "MakeNamedMedium \"a\" \"string type\" \"homogeneous\"\n"
+      "MakeNamedMedium \"b\" \"string type\" \"homogeneous\" \"float g\" 0.5\n"
+      "ObjectBegin \"o\"\n"
+      "  MediumInterface \"b\" \"a\"\n" +
+      kTriangle + "ObjectEnd\n" +
+      // 0: vacuum; 1, 2: a inside, vacuum outside (one zero-area triangle between them dropped)
+      kTriangle +
+      "AttributeBegin\n  MediumInterface \"a\" \"\"\n"
+      "  Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 2 0 0 0 0 1]\n"
+      "    \"integer indices\" [0 1 2  0 1 3  0 1 4]\n"
+      // interface material without a transition: dropped
+      "  AttributeBegin\n    Material \"interface\"\n    MediumInterface \"a\"\n" +
+      kTriangle +
+      "  AttributeEnd\nAttributeEnd\n"
+      // 3: vacuum again after AttributeEnd; 4, 5: the instance, its definition's interface,
+      // whatever is current at its use
+      + kTriangle + "MediumInterface \"a\" \"b\"\nObjectInstance \"o\"\nTranslate 0 0 1\n" +
+      "ObjectInstance \"o\"\n");
+  ASSERT_EQ(s.triangles.size(), 6u);
+  ASSERT_EQ(s.mediumInterfaces.size(), s.triangles.size());
+  ASSERT_EQ(s.mediumNames, (std::vector<std::string>{"a", "b"}));
+  const uint a = 0, b = 1, none = kNoMedium;
+  const std::vector<std::pair<uint, uint>> expected = {{none, none}, {a, none}, {a, none},
+                                                       {none, none}, {b, a},    {b, a}};
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(s.mediumInterfaces[i].inside, expected[i].first) << i;
+    EXPECT_EQ(s.mediumInterfaces[i].outside, expected[i].second) << i;
+    EXPECT_EQ(s.triangles[i].primitive, i);
+  }
+  EXPECT_EQ(s.triangles[4].v0.z, 0.0f);
+  EXPECT_EQ(s.triangles[5].v0.z, 1.0f);
+}
+
+TEST(MediaPbrt, TheCameraIsInTheOutsideMediumCurrentAtCamera) {
+  const Scene s = pbrtScene(
+      "MediumInterface \"fog\" \"water\"\nScale -1 1 1\nLookAt 0 0 -10  0 0 0  0 1 0\n"
+      "Camera \"perspective\"\nMediumInterface \"\"\n"
+      "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+      "MakeNamedMedium \"water\" \"string type\" \"homogeneous\" \"float scale\" 2\n"
+      "WorldBegin\n" +
+      std::string(kTriangle));
+  // Only water is used: fog, named inside, is not kept.
+  ASSERT_EQ(s.media.size(), 1u);
+  EXPECT_EQ(s.mediumNames[0], "water");
+  EXPECT_EQ(s.cameraMedium, 0u);
+  EXPECT_EQ(s.media[0].sigmaA, vec3(2.0f));
+  // The triangle after MediumInterface "": vacuum on both sides, kept parallel.
+  ASSERT_EQ(s.mediumInterfaces.size(), 1u);
+  EXPECT_EQ(s.mediumInterfaces[0].inside, kNoMedium);
+  EXPECT_EQ(s.mediumInterfaces[0].outside, kNoMedium);
+}
+
+TEST(MediaPbrt, InterfaceShapesAreKeptWhereTheyBoundAMedium) {
+  const std::string fog = "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n";
+  const Scene s = pbrtScene(std::string(kUnmirrored) + fog + kTriangle +
+                            "AttributeBegin\nMaterial \"interface\"\nMediumInterface \"fog\" \"\"\n" +
+                            kTriangle + "AttributeEnd\n" +
+                            // defined after its use, with an area light: the light is ignored
+                            "AttributeBegin\nNamedMaterial \"later\"\nMediumInterface \"\" \"fog\"\n" +
+                            "AreaLightSource \"diffuse\"\n" + kTriangle + "AttributeEnd\n" +
+                            "MakeNamedMaterial \"later\" \"string type\" \"interface\"\n");
+  ASSERT_EQ(s.triangles.size(), 3u);
+  ASSERT_EQ(s.materials.size(), 3u);
+  EXPECT_EQ(s.materials[s.triangles[0].material].type, kMaterialDiffuse);
+  for (int i : {1, 2}) {
+    const Material& m = s.materials[s.triangles[i].material];
+    EXPECT_EQ(m.type, kMaterialInterface) << i;
+    EXPECT_EQ(m.emission, vec3(0.0f)) << i;
+  }
+  EXPECT_EQ(s.mediumInterfaces[1].inside, 0u);
+  EXPECT_EQ(s.mediumInterfaces[2].outside, 0u);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("area light on shapes with the \"interface\" material is ignored"),
+            std::string::npos)
+      << s.warnings[0];
+
+  // Without a medium they change nothing and go silently; the scene has no media fields.
+  const Scene none = pbrtScene(std::string(kUnmirrored) + fog + kTriangle +
+                               "Material \"interface\"\n" + kTriangle + "MediumInterface \"fog\"\n" +
+                               kTriangle);
+  EXPECT_EQ(none.triangles.size(), 1u);
+  EXPECT_TRUE(none.warnings.empty());
+  expectNoMedia(none);
+}
+
+TEST(MediaPbrt, ScenesWithoutMediaHaveEmptyMediaFields) {
+  expectNoMedia(loadScene(test::kConfigs / "cornell-box.pbrt"));
+  // Media defined but used by no shape and not the camera: left out.
+  expectNoMedia(pbrtScene(std::string(kUnmirrored) +
+                          "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n" +
+                          "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" "
+                          "\"float density\" [1]\n" +
+                          kTriangle));
+}
+
+TEST(MediaPbrt, UnusedMediaAndTheirGridsAreLeftOut) {
+  const Scene s = pbrtScene(std::string(kUnmirrored) +
+                            "MakeNamedMedium \"big\" \"string type\" \"uniformgrid\" "
+                            "\"integer nx\" 4 \"float density\" [1 2 3 4]\n"
+                            "MakeNamedMedium \"small\" \"string type\" \"uniformgrid\" "
+                            "\"integer nx\" 2 \"float density\" [5 6] \"rgb Le\" [1 1 1] "
+                            "\"float Lescale\" [7 8]\n"
+                            "MediumInterface \"small\" \"\"\n" +
+                            kTriangle);
+  ASSERT_EQ(s.media.size(), 1u);
+  EXPECT_EQ(s.mediumNames[0], "small");
+  EXPECT_EQ(s.mediumGrids, (std::vector<float>{5, 6, 7, 8}));
+  EXPECT_EQ(s.media[0].density, 0u);
+  EXPECT_EQ(s.media[0].emission, 2u);
+}
+
+TEST(MediaPbrt, MediaNotSimulatedAreWarnedAndVacuum) {
+  const std::string text = std::string(kUnmirrored) +
+                           "MakeNamedMedium \"vdb\" \"string type\" \"nanovdb\" "
+                           "\"string filename\" \"smoke.nvdb\"\n"
+                           "MakeNamedMedium \"c\" \"string type\" \"cloud\" \"float density\" 2\n"
+                           "MediumInterface \"vdb\" \"c\"\n" +
+                           kTriangle;
+  const Scene s = pbrtScene(text);
+  expectNoMedia(s);
+  ASSERT_EQ(s.warnings.size(), 2u);
+  EXPECT_EQ(s.warnings[0],
+            "scene.pbrt:5: MakeNamedMedium 'vdb': \"nanovdb\" media are not simulated (no NanoVDB "
+            "reader): left out, vacuum where a MediumInterface names it");
+  EXPECT_EQ(s.warnings[1],
+            "scene.pbrt:6: MakeNamedMedium 'c': \"cloud\" media are not simulated: left out, "
+            "vacuum where a MediumInterface names it");
+  EXPECT_EQ(pbrtError(text, true),
+            "scene.pbrt:5:1: MakeNamedMedium 'vdb': \"nanovdb\" media are not simulated (no "
+            "NanoVDB reader): left out, vacuum where a MediumInterface names it (an error with "
+            "--strict)");
+  // A uniformgrid's temperature (blackbody emission): warned, the medium does not emit.
+  const Scene hot = pbrtScene(std::string(kUnmirrored) +
+                              "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" "
+                              "\"float density\" [1] \"float temperature\" [1500] "
+                              "\"float temperaturescale\" 2\n"
+                              "MediumInterface \"g\" \"\"\n" +
+                              kTriangle);
+  ASSERT_EQ(hot.media.size(), 1u);
+  EXPECT_EQ(hot.media[0].emissive, 0u);
+  ASSERT_EQ(hot.warnings.size(), 1u);
+  EXPECT_EQ(hot.warnings[0],
+            "scene.pbrt:5: MakeNamedMedium 'g': \"temperature\" (blackbody emission) is not "
+            "simulated: the medium does not emit");
+}
+
+TEST(MediaPbrt, EveryErrorIsOneLineAtItsPlace) {
+  const std::string w = kUnmirrored;
+  const std::string use = "MediumInterface \"m\" \"\"\n" + std::string(kTriangle);
+  const auto grid = [&](const std::string& params) {
+    return w + "MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" " + params + "\n" + use;
+  };
+  const auto rgb = [&](const std::string& params) {
+    return w + "MakeNamedMedium \"m\" \"string type\" \"rgbgrid\" " + params + "\n" + use;
+  };
+  const std::pair<std::string, std::string> cases[] = {
+      {w + "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+           "MediumInterface \"fgo\" \"\"\n" + kTriangle,
+       "scene.pbrt:6:17: MediumInterface: no medium named 'fgo' (did you mean 'fog'?)"},
+      {w + "MediumInterface \"\" \"nowhere\"\n" + kTriangle,
+       "scene.pbrt:5:20: MediumInterface: no medium named 'nowhere'"},
+      {w + "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n"
+           "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n" + use,
+       "scene.pbrt:6:1: named medium 'm' redefined (first at scene.pbrt:5)"},
+      {w + "MakeNamedMedium \"m\" \"float g\" 0\n" + use,
+       "scene.pbrt:5:1: MakeNamedMedium 'm' needs a \"string type\" parameter"},
+      {w + "MakeNamedMedium \"m\" \"string type\" \"homogenous\"\n" + use,
+       "scene.pbrt:5:21: MakeNamedMedium 'm': unknown medium type 'homogenous' (did you mean "
+       "'homogeneous'?)"},
+      {w + "MakeNamedMedium \"m\" \"string type\" \"heterogeneous\"\n" + use,
+       "scene.pbrt:5:21: MakeNamedMedium 'm': unknown medium type 'heterogeneous' (pbrt-v3's "
+       "name of pbrt-v4's \"uniformgrid\")"},
+      {w + "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float g\" 1.5\n" + use,
+       "scene.pbrt:5:49: 'g' of MakeNamedMedium 'm': expected a number in [-1, 1], got 1.5"},
+      {w + "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float scale\" -1\n" + use,
+       "scene.pbrt:5:49: 'scale' of MakeNamedMedium 'm': expected a non-negative number that "
+       "fits a 32-bit float, got -1"},
+      {w + "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 -1 1]\n" +
+           use,
+       "scene.pbrt:5:49: rgb 'sigma_a' of MakeNamedMedium 'm' has a negative component"},
+      {w + "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [1e38 1 1] "
+           "\"float scale\" 10\n" + use,
+       "scene.pbrt:5:74: 'scale' of MakeNamedMedium 'm': 'sigma_s' times 'scale' does not fit a "
+       "32-bit float"},
+      {grid(""), "scene.pbrt:5:1: 'density' of MakeNamedMedium 'm': is required: one value per "
+                 "voxel"},
+      {grid("\"integer nx\" 2 \"integer ny\" 2 \"float density\" [1 2 3]"),
+       "scene.pbrt:5:79: 'density' of MakeNamedMedium 'm': has 3 values; expected nx * ny * nz "
+       "= 4"},
+      {grid("\"integer nx\" 2 \"float density\" [1 -2]"),
+       "scene.pbrt:5:64: 'density' of MakeNamedMedium 'm', its value [1]: expected a "
+       "non-negative number that fits a 32-bit float, got -2"},
+      {grid("\"integer nz\" 0 \"float density\" [1]"),
+       "scene.pbrt:5:49: 'nz' of MakeNamedMedium 'm': expected a number of voxels of at least 1, "
+       "got 0"},
+      {grid("\"float density\" [1] \"point3 p1\" [1 0 1]"),
+       "scene.pbrt:5:69: 'p1' of MakeNamedMedium 'm': expected p0 < p1 on every axis, got p0 "
+       "(0, 0, 0) and p1 (1, 0, 1)"},
+      {grid("\"float density\" [1 2] \"integer nx\" 2 \"float Lescale\" [1]"),
+       "scene.pbrt:5:86: 'Lescale' of MakeNamedMedium 'm': has 1 value; expected nx * ny * nz "
+       "= 2"},
+      {grid("\"float density\" [1] \"rgb Le\" [1 1 1] \"float temperature\" [1000]"),
+       "scene.pbrt:5:86: MakeNamedMedium 'm': both \"Le\" and \"temperature\" given (pbrt-v4 "
+       "takes one or the other)"},
+      {grid("\"float density\" [1] \"float temperature\" [1000 2000]"),
+       "scene.pbrt:5:69: 'temperature' of MakeNamedMedium 'm' has 2 values for 1 density values"},
+      {rgb("\"float scale\" 2"),
+       "scene.pbrt:5:1: 'sigma_a' of MakeNamedMedium 'm': an rgbgrid needs \"sigma_a\" or "
+       "\"sigma_s\" (or both)"},
+      {rgb("\"rgb sigma_s\" [1 1 1] \"rgb Le\" [1 1 1]"),
+       "scene.pbrt:5:67: 'Le' of MakeNamedMedium 'm': an rgbgrid with \"Le\" needs \"sigma_a\" "
+       "too (pbrt-v4's rule)"},
+      {rgb("\"integer nx\" 2 \"rgb sigma_a\" [1 1 1]"),
+       "scene.pbrt:5:60: 'sigma_a' of MakeNamedMedium 'm': has 1 RGB value; expected nx * ny * "
+       "nz = 2"},
+      {w + "Scale 1 0 1\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" "
+           "[1]\nIdentity\n" + use,
+       "scene.pbrt:6:1: MakeNamedMedium 'm': the CTM is singular or too large (a grid medium "
+       "needs an invertible transform)"},
+  };
+  for (const auto& [text, message] : cases) EXPECT_EQ(pbrtError(text), message) << text;
+}
+
+}  // namespace
+}  // namespace pt
