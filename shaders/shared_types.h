@@ -219,8 +219,10 @@ struct Medium {
 PT_CONST uint kMediumTexels = 9u;
 
 // The media on the two sides of a triangle, by Triangle::primitive: `inside` on the side
-// opposite its geometric normal, `outside` on the normal's side (pbrt-v4's MediumInterface). A
-// triangle whose two are equal marks no change: a ray keeps the medium it was in.
+// opposite its normal, `outside` on the normal's side (pbrt-v4's MediumInterface). The normal
+// is the geometric one, turned to the side of the vertex normals where the triangle has them
+// (as pbrt-v4 turns it; the readers give the geometric normal's sides, prepareScene turns
+// them). A triangle whose two are equal marks no change: a ray keeps the medium it was in.
 struct MediumInterface {
   uint inside;   // 4 bytes: a Medium index, or kNoMedium
   uint outside;  // 4 bytes

@@ -394,6 +394,25 @@ TEST(Media, VolumeIntegratorOnTheCpu) {
   EXPECT_GT(sum, 0.0);
 }
 
+// A triangle's inside and outside follow its vertex normals where it has them (pbrt-v4 turns
+// the geometric normal towards them): the one whose normals face against its winding has its
+// two media swapped, the other keeps them.
+TEST(Media, InterfacesFollowTheVertexNormals) {
+  Scene scene;
+  scene.camera = camera(vec3(0, 0, -5), vec3(0, 0, 0), 20.0f, 4);
+  scene.materials = {Material{vec3(0.0f), kMaterialInterface, vec3(0.0f), 0}};
+  scene.media = {homogeneous(vec3(1.0f), vec3(0.0f))};
+  addShape(scene, quad(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0)), 0, MediumInterface{0, kVacuum});
+  const vec3 z(0, 0, 1);
+  scene.normals = {TriangleNormals{-z, 0, -z, 0, -z, 0}, TriangleNormals{z, 0, z, 0, z, 0}};
+  const SceneData data = prepare(scene);
+  ASSERT_EQ(data.mediumInterfaces.size(), 2u);
+  EXPECT_EQ(data.mediumInterfaces[0].inside, kVacuum);
+  EXPECT_EQ(data.mediumInterfaces[0].outside, 0u);
+  EXPECT_EQ(data.mediumInterfaces[1].inside, 0u);
+  EXPECT_EQ(data.mediumInterfaces[1].outside, kVacuum);
+}
+
 // ---- Samplers against their densities -------------------------------------------------------
 
 // The phase function's directions against its density, for wo along a fixed direction.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "common/check.h"
 
@@ -74,6 +75,17 @@ void prepareMedia(Scene& scene, vec3 shift, SceneData& data) {
   data.mediumInterfaces = std::move(scene.mediumInterfaces);
   if (data.mediumInterfaces.empty()) {
     data.mediumInterfaces.assign(data.bvh.triangles.size(), MediumInterface{kNoMedium, kNoMedium});
+  }
+  // pbrt-v4 turns a triangle's normal to the side of its vertex normals where it has them (as
+  // a dielectric's inside is told by them here too): the interface's sides follow.
+  if (!data.normals.empty()) {
+    for (const Triangle& t : data.bvh.triangles) {
+      const TriangleNormals& n = data.normals[t.primitive];
+      if (dot(cross(t.v1 - t.v0, t.v2 - t.v0), n.n0 + n.n1 + n.n2) < 0.0f) {
+        MediumInterface& mi = data.mediumInterfaces[t.primitive];
+        std::swap(mi.inside, mi.outside);
+      }
+    }
   }
   data.params.cameraMedium = scene.cameraMedium;
   data.params.mediaPresent = 1u;
