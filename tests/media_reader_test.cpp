@@ -498,5 +498,174 @@ TEST(MediaPbrt, EveryErrorIsOneLineAtItsPlace) {
   for (const auto& [text, message] : cases) EXPECT_EQ(pbrtError(text), message) << text;
 }
 
+// ---- JSON --------------------------------------------------------------------------------
+
+// A scene of one diffuse triangle (normal +z) with `media` as its "media", `shape` as more keys
+// of the shape, `camera` as keys of the camera and `more` as more top-level keys.
+std::string jsonText(const std::string& media, const std::string& shape = "",
+                     const std::string& camera = "", const std::string& more = "") {
+  return R"({"camera": {"position": [0, 0, 5], "target": [0, 0, 0])" + camera +
+         R"(}, "materials": [{"name": "white"}, {"name": "glass", "type": "interface"}],)" +
+         (media.empty() ? "" : R"("media": )" + media + ",") + more +
+         R"("shapes": [{"type": "triangles", "material": "white", "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [[0, 1, 2]])" +
+         shape + "}]}";
+}
+
+Scene jsonScene(const std::string& text) {
+  test::TempDir dir;
+  return loadScene(dir.write("s.json", text));
+}
+
+// The error without its "<file>: " prefix.
+std::string jsonError(const std::string& text) {
+  test::TempDir dir;
+  const fs::path path = dir.write("s.json", text);
+  try {
+    loadScene(path);
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    const std::string prefix = path.string() + ": ";
+    return m.rfind(prefix, 0) == 0 ? m.substr(prefix.size()) : m;
+  }
+  return "no error";
+}
+
+TEST(MediaJson, HomogeneousWithDefaultsAndPbrtV4sNames) {
+  const Scene s = jsonScene(jsonText(R"([{"name": "fog", "type": "homogeneous"},
+      {"name": "tea", "type": "homogeneous", "sigma_a": [1, 2, 3], "sigma_s": [4, 5, 6],
+       "scale": 2, "g": -0.5, "Le": [1, 0, 0], "Lescale": 4}])",
+                                     R"(, "interior": "tea", "exterior": "fog")"));
+  ASSERT_EQ(s.media.size(), 2u);
+  EXPECT_EQ(s.mediumNames, (std::vector<std::string>{"fog", "tea"}));
+  EXPECT_EQ(s.media[0].sigmaA, vec3(1.0f));
+  EXPECT_EQ(s.media[0].sigmaS, vec3(1.0f));
+  EXPECT_EQ(s.media[0].g, 0.0f);
+  EXPECT_EQ(s.media[0].emissive, 0u);
+  const Medium& tea = s.media[1];
+  EXPECT_EQ(tea.sigmaA, vec3(2, 4, 6));
+  EXPECT_EQ(tea.sigmaS, vec3(8, 10, 12));
+  EXPECT_EQ(tea.g, -0.5f);
+  EXPECT_EQ(tea.Le, vec3(4, 0, 0));
+  EXPECT_EQ(tea.emissive, 1u);
+  ASSERT_EQ(s.mediumInterfaces.size(), 1u);
+  EXPECT_EQ(s.mediumInterfaces[0].inside, 1u);
+  EXPECT_EQ(s.mediumInterfaces[0].outside, 0u);
+  EXPECT_EQ(s.cameraMedium, kNoMedium);
+}
+
+TEST(MediaJson, PresetsAreThePbrtTable) {
+  const Scene s = jsonScene(jsonText(
+      R"([{"name": "milk", "type": "homogeneous", "preset": "Wholemilk", "scale": 100}])", "",
+      R"(, "medium": "milk")"));
+  ASSERT_EQ(s.media.size(), 1u);
+  expectNear(s.media[0].sigmaS, glm::dvec3(255, 321, 377), "sigma_s");
+  expectNear(s.media[0].sigmaA, glm::dvec3(0.11, 0.24, 1.4), "sigma_a");
+  EXPECT_EQ(s.cameraMedium, 0u);
+  // Only the camera uses it: every triangle has vacuum on both sides, kept parallel.
+  ASSERT_EQ(s.mediumInterfaces.size(), 1u);
+  EXPECT_EQ(s.mediumInterfaces[0].inside, kNoMedium);
+}
+
+TEST(MediaJson, GridsTheirOrderOffsetsAndTransform) {
+  const Scene s = jsonScene(jsonText(
+      R"([{"name": "unused", "type": "uniformgrid", "nx": 2, "density": [9, 9]},
+          {"name": "smoke", "type": "uniformgrid", "nx": 2, "ny": 1, "nz": 2,
+           "density": [0, 1, 2, 3], "p0": [-1, -1, -1], "p1": [1, 1, 1], "sigma_s": [2, 2, 2],
+           "Le": [1, 1, 1], "Lescale": [4, 5, 6, 7],
+           "transform": {"scale": 2, "translate": [10, 0, 0]}},
+          {"name": "cloud", "type": "rgbgrid", "nx": 2, "sigma_a": [[1, 2, 3], [4, 5, 6]],
+           "scale": 0.5, "Le": [[2, 2, 2], [0, 0, 0]], "Lescale": 3}])",
+      R"(, "interior": "smoke", "exterior": "cloud")"));
+  // "unused" is left out with its grid; the others' grids follow in their order.
+  ASSERT_EQ(s.mediumNames, (std::vector<std::string>{"smoke", "cloud"}));
+  const Medium& smoke = s.media[0];
+  EXPECT_EQ(smoke.type, kMediumUniformGrid);
+  EXPECT_EQ(smoke.size, uvec3(2, 1, 2));
+  EXPECT_EQ(smoke.sigmaA, vec3(1.0f));
+  EXPECT_EQ(smoke.sigmaS, vec3(2.0f));
+  EXPECT_EQ(smoke.density, 0u);
+  EXPECT_EQ(smoke.emission, 4u);
+  const Medium& cloud = s.media[1];
+  EXPECT_EQ(cloud.type, kMediumRgbGrid);
+  EXPECT_EQ(cloud.density, 8u);
+  EXPECT_EQ(cloud.emission, 20u);
+  EXPECT_EQ(s.mediumGrids,
+            (std::vector<float>{0, 1, 2, 3, 4, 5, 6, 7,                                 // smoke
+                                0.5f, 1, 1.5f, 2, 2.5f, 3, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f,  // cloud
+                                6, 6, 6, 0, 0, 0}));
+  // World (10, 0, 0) is the medium's origin, world (12, 0, 0) its (1, 0, 0).
+  expectNear(toMedium(smoke, {10, 0, 0}), {0, 0, 0}, "origin");
+  expectNear(toMedium(smoke, {12, 0, 0}), {1, 0, 0}, "x");
+  EXPECT_EQ(cloud.toMedium0, vec4(1, 0, 0, 0));
+}
+
+TEST(MediaJson, InterfaceShapesAreKeptOnlyWhereTheyBoundAMedium) {
+  const std::string media = R"([{"name": "fog", "type": "homogeneous"}])";
+  const std::string glass =
+      R"(}, {"type": "quad", "material": "glass", "vertices": [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])";
+  const Scene kept = jsonScene(jsonText(media, glass + R"(, "exterior": "fog")"));
+  ASSERT_EQ(kept.triangles.size(), 3u);
+  EXPECT_EQ(kept.materials[kept.triangles[1].material].type, kMaterialInterface);
+  EXPECT_EQ(kept.mediumInterfaces[1].outside, 0u);
+  EXPECT_EQ(kept.mediumInterfaces[0].outside, kNoMedium);
+  const Scene dropped = jsonScene(jsonText(media, glass + R"(, "exterior": "fog", "interior": "fog")"));
+  EXPECT_EQ(dropped.triangles.size(), 1u);
+  expectNoMedia(dropped);
+}
+
+TEST(MediaJson, ScenesWithoutMediaHaveEmptyMediaFields) {
+  expectNoMedia(loadScene(test::kConfigs / "cornell-box.json"));
+  expectNoMedia(jsonScene(jsonText(R"([{"name": "fog", "type": "homogeneous"}])")));
+}
+
+TEST(MediaJson, EveryErrorNamesItsField) {
+  const std::string fog = R"({"name": "fog", "type": "homogeneous")";
+  std::string interfaceOnly = jsonText("");
+  interfaceOnly.replace(interfaceOnly.find(R"("material": "white")"), 19, R"("material": "glass")");
+  const std::pair<std::string, std::string> cases[] = {
+      {jsonText(R"([)" + fog + "}]", R"(, "interior": "fgo")"),
+       "shapes[0].interior: unknown medium 'fgo' (did you mean 'fog'?)"},
+      {jsonText(R"([)" + fog + "}]", R"(, "exterior": "")"),
+       "shapes[0].exterior: expected a medium's name (leave the key out for vacuum)"},
+      {jsonText("[]", "", R"(, "medium": "air")"), "camera.medium: unknown medium 'air'"},
+      {jsonText(R"([)" + fog + "}, " + fog + "}]"),
+       "media[1].name: duplicate medium name 'fog' (also used by media[0])"},
+      {jsonText(R"([{"name": "m", "type": "nanovdb"}])"),
+       "media[0].type: unknown medium type 'nanovdb' (expected \"homogeneous\", \"uniformgrid\" "
+       "or \"rgbgrid\")"},
+      {jsonText(R"([{"name": "m", "type": "homogeneous", "density": [1]}])"),
+       "media[0].density: unknown key (expected 'name', 'type', 'sigma_a', 'sigma_s', 'scale', "
+       "'g', 'Le', 'Lescale' or 'preset')"},
+      {jsonText(R"([)" + fog + R"(, "g": 1.5}])"),
+       "media[0].g: expected a number in [-1, 1], got 1.5"},
+      {jsonText(R"([)" + fog + R"(, "sigma_s": [1, -2, 1]}])"),
+       "media[0].sigma_s[1]: expected a non-negative number that fits a 32-bit float, got -2"},
+      {jsonText(R"([)" + fog + R"(, "preset": "Ketchp"}])"),
+       "media[0].preset: unknown preset 'Ketchp' (did you mean 'Ketchup'?)"},
+      {jsonText(R"([)" + fog + R"(, "preset": "Apple", "sigma_a": [1, 1, 1]}])"),
+       "media[0].preset: give a preset or sigma_a and sigma_s, not both"},
+      {jsonText(R"([{"name": "m", "type": "uniformgrid", "nx": 2, "density": [1]}])"),
+       "media[0].density: has 1 value; expected nx * ny * nz = 2"},
+      {jsonText(R"([{"name": "m", "type": "uniformgrid"}])"),
+       "media[0]: 'density': is required: one value per voxel"},
+      {jsonText(R"([{"name": "m", "type": "uniformgrid", "density": [1, -1], "nx": 2}])"),
+       "media[0].density[1]: expected a non-negative number that fits a 32-bit float, got -1"},
+      {jsonText(R"([{"name": "m", "type": "uniformgrid", "density": [1], "p0": [0, 2, 0]}])"),
+       "media[0]: 'p1': expected p0 < p1 on every axis, got p0 (0, 2, 0) and p1 (1, 1, 1)"},
+      {jsonText(R"([{"name": "m", "type": "rgbgrid", "nx": 2, "sigma_s": [[1, 1, 1], [1, -1, 1]]}])"),
+       "media[0].sigma_s[1][1]: expected a non-negative number that fits a 32-bit float, got -1"},
+      {jsonText(R"([{"name": "m", "type": "rgbgrid", "sigma_a": [[1, 1]]}])"),
+       "media[0].sigma_a[0]: expected an array of 3 numbers, got an array of 2 elements"},
+      {jsonText(R"([{"name": "m", "type": "rgbgrid", "nx": 0, "sigma_a": [[1, 1, 1]]}])"),
+       "media[0].nx: expected an integer in [1, 2147483647], got the number 0"},
+      {jsonText(R"([{"name": "m", "type": "uniformgrid", "density": [1], "transform": {"scale": 1e-39}}])"),
+       "media[0].transform: its inverse does not fit 32-bit floats (a scale too close to 0)"},
+      {interfaceOnly,
+       "shapes: no triangles left: all 1 have zero area or belong to \"interface\" shapes that "
+       "bound no medium"},
+  };
+  for (const auto& [text, message] : cases) EXPECT_EQ(jsonError(text), message) << text;
+}
+
 }  // namespace
 }  // namespace pt

@@ -641,8 +641,8 @@ TEST(SceneMaterials, BadParametersOfTheNewTypes) {
                   "'emission', 'twoSided', 'alpha' or 'displacement')");
   EXPECT_CONTAINS(withMaterial(R"({"name": "white", "type": "metal"})"),
                   "materials[0].type: unknown material type 'metal' (expected 'diffuse', "
-                  "'mirror', 'conductor', 'dielectric', 'thindielectric', 'diffusetransmission' "
-                  "or 'coateddiffuse')");
+                  "'mirror', 'conductor', 'dielectric', 'thindielectric', 'diffusetransmission', "
+                  "'coateddiffuse' or 'interface')");
 
   // Conductor: reflectance or eta and k, not both (pbrt-v4's rule).
   EXPECT_EQ(withMaterial(R"({"name": "w", "type": "conductor", "reflectance": [1, 1, 1],

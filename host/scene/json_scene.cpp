@@ -21,7 +21,10 @@
 #include "common/named_values.h"
 #include "scene/camera_filter.h"
 #include "scene/json_reader.h"
+#include "scene/media.h"
+#include "scene/json_media.h"
 #include "scene/json_textures.h"
+#include "scene/json_transform.h"
 #include "scene/mtl_materials.h"
 #include "scene/obj_mesh.h"
 #include "scene/ply_mesh.h"
@@ -33,7 +36,11 @@ namespace pt {
 namespace {
 
 using scene_detail::JsonNode;
+using scene_detail::JsonMedia;
 using scene_detail::JsonTextures;
+using scene_detail::readRotation;
+using scene_detail::readTransform;
+using scene_detail::Transform;
 using scene_detail::quotedPath;
 using scene_detail::singleQuoted;
 using Tri = std::array<glm::dvec3, 3>;
@@ -128,8 +135,9 @@ PixelFilterDesc readFilter(const JsonNode& node) {
 }
 
 CameraDesc readCamera(const JsonNode& node) {
+  // "medium" (the medium the camera is in) is read with the media (loadJsonScene).
   node.checkKeys({"position", "target", "up", "vfov", "width", "height", "filter", "lensRadius",
-                  "focalDistance", "screenWindow", "cropWindow", "pixelBounds"});
+                  "focalDistance", "screenWindow", "cropWindow", "pixelBounds", "medium"});
   CameraDesc desc;
   glm::dvec3 position(desc.position), target(desc.target), up(desc.up);
   if (auto n = node.find("position")) position = n->vec3();
@@ -237,7 +245,7 @@ IntegratorSettings readIntegrator(const JsonNode& node) {
 
 // ---- materials --------------------------------------------------------------------------
 
-constexpr NameTable<uint, 7> kMaterialTypes{{
+constexpr NameTable<uint, 8> kMaterialTypes{{
     {"diffuse", kMaterialDiffuse, "Lambertian"},
     {"mirror", kMaterialMirror, "ideal specular reflection"},
     {"conductor", kMaterialConductor, "metal"},
@@ -245,12 +253,14 @@ constexpr NameTable<uint, 7> kMaterialTypes{{
     {"thindielectric", kMaterialThinDielectric, "a thin pane"},
     {"diffusetransmission", kMaterialDiffuseTransmission, "Lambertian, both sides"},
     {"coateddiffuse", kMaterialCoatedDiffuse, "varnish over a Lambertian base"},
+    {"interface", kMaterialInterface, "no surface: only bounds media"},
 }};
 
 // The keys a material of `type` takes: name, type and emission for all, then pbrt-v4's names
 // of the type's parameters (docs/scene-format.md).
 std::vector<std::string_view> materialKeys(uint type) {
   std::vector<std::string_view> keys = {"name", "type"};
+  if (type == kMaterialInterface) return keys;  // nothing to see, nothing to emit
   const std::initializer_list<std::string_view> roughness = {"roughness", "uroughness",
                                                              "vroughness", "remaproughness"};
   switch (type) {
@@ -422,6 +432,8 @@ void readMaterialParameters(const JsonNode& m, Material& material) {
         material.nSamples = static_cast<uint>(n->integer(1, kMaxCoatedWalk));
       }
       break;
+    case kMaterialInterface:
+      break;
     default:
       PT_CHECK(false, "material type without a reader");
   }
@@ -531,58 +543,6 @@ void readMaterials(const JsonNode& node, Scene& scene, JsonTextures& textures) {
     scene.materialNames.push_back(name);
     setMaterialTextures(scene, scene.materials.size() - 1, materialTextures);
   }
-}
-
-// ---- transforms -------------------------------------------------------------------------
-
-// p -> rotate(scale * p) + translate, evaluated in double so that vertices are rounded to
-// float once.
-struct Transform {
-  glm::dvec3 scale{1.0};
-  glm::dvec3 axis{0.0, 1.0, 0.0};  // unit
-  double cosAngle = 1.0;
-  double sinAngle = 0.0;
-  glm::dvec3 translate{0.0};
-
-  glm::dvec3 apply(glm::dvec3 p) const {
-    p *= scale;
-    // Rodrigues' rotation formula (right-handed about axis).
-    p = p * cosAngle + glm::cross(axis, p) * sinAngle +
-        axis * (glm::dot(axis, p) * (1.0 - cosAngle));
-    return p + translate;
-  }
-};
-
-// A "rotate" object ({"axis": [x, y, z], "degrees": d}) into t: right-handed about the axis.
-void readRotation(const JsonNode& n, Transform& t) {
-  n.checkKeys({"axis", "degrees"});
-  const JsonNode axisNode = n.require("axis");
-  const glm::dvec3 axis = axisNode.vec3();
-  if (glm::length(axis) == 0.0) axisNode.fail("rotation axis must not be the zero vector");
-  t.axis = glm::normalize(axis);
-  std::tie(t.cosAngle, t.sinAngle) = cosSinDegrees(n.require("degrees").number());
-}
-
-Transform readTransform(const JsonNode& node) {
-  node.checkKeys({"scale", "rotate", "translate"});
-  Transform t;
-  if (auto n = node.find("scale")) {
-    if (n->json().is_array()) {
-      t.scale = n->vec3();
-      for (std::size_t c = 0; c < 3; ++c) {
-        if (t.scale[c] == 0.0) (*n)[c].fail("scale factors must be non-zero");
-      }
-    } else {
-      if (!n->json().is_number()) {
-        n->fail("expected a number or an array of 3 numbers, got " + n->describe());
-      }
-      t.scale = glm::dvec3(n->floatNumber());
-      if (t.scale.x == 0.0) n->fail("scale factor must be non-zero");
-    }
-  }
-  if (auto n = node.find("rotate")) readRotation(*n, t);
-  if (auto n = node.find("translate")) t.translate = n->vec3();
-  return t;
 }
 
 // ---- shapes -----------------------------------------------------------------------------
@@ -774,7 +734,8 @@ glm::dvec3 worldNormal(glm::dvec3 n, const std::optional<Transform>& transform) 
 // once any shape has some, every triangle has an entry there (its geometric normal where its
 // mesh has none).
 void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
-                   const std::optional<Transform>& transform, uint material, Scene& scene) {
+                   const std::optional<Transform>& transform, uint material,
+                   MediumInterface mediumInterface, Scene& scene) {
   const std::vector<Tri>& triangles = shapeTriangles.triangles;
   std::size_t dropped = 0;
   // Room for the shape, growing geometrically: reserving the exact size for every shape
@@ -806,6 +767,7 @@ void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
     if (appended == Appended::kTooMany) {
       shape.fail("too many triangles in the scene (at most 4294967295)");
     }
+    if (appended == Appended::kAdded) scene.mediumInterfaces.push_back(mediumInterface);
   }
   if (dropped > 0) {
     scene.warnings.push_back(shape.file() + ": " + shape.path() + ": dropped " +
@@ -815,7 +777,8 @@ void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
   }
 }
 
-void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Scene& scene) {
+void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, const JsonMedia& media,
+                Scene& scene) {
   if (node.size() == 0) node.fail("expected at least one shape");
   std::unordered_map<std::string, uint> materialIndex;
   // Views into a copy of the JSON's material names: shapes with "materials": "mtl" append to
@@ -828,6 +791,7 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
   }
 
   std::size_t total = 0;
+  std::size_t interfaceDropped = 0;
   MtlLibrary mtlLibrary;
   for (std::size_t i = 0; i < node.size(); ++i) {
     const JsonNode shape = node[i];
@@ -842,16 +806,16 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
     const Kind kind = readChoice(shape.require("type"), kKinds, "shape type");
     switch (kind) {
       case Kind::kQuad:
-        shape.checkKeys({"type", "name", "material", "vertices", "transform"});
+        shape.checkKeys({"type", "name", "material", "vertices", "transform", "interior", "exterior"});
         break;
       case Kind::kTriangles:
-        shape.checkKeys({"type", "name", "material", "vertices", "indices", "transform"});
+        shape.checkKeys({"type", "name", "material", "vertices", "indices", "transform", "interior", "exterior"});
         break;
       case Kind::kObj:
-        shape.checkKeys({"type", "name", "material", "materials", "file", "transform"});
+        shape.checkKeys({"type", "name", "material", "materials", "file", "transform", "interior", "exterior"});
         break;
       case Kind::kPly:
-        shape.checkKeys({"type", "name", "material", "file", "transform"});
+        shape.checkKeys({"type", "name", "material", "file", "transform", "interior", "exterior"});
         break;
     }
     if (auto n = shape.find("name")) n->string();  // documentation only, but must be a string
@@ -879,6 +843,10 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
 
     std::optional<Transform> transform;
     if (auto n = shape.find("transform")) transform = readTransform(*n);
+    // The media on the two sides: "interior" opposite the triangles' normals (pbrt-v4's inside),
+    // "exterior" on their side.
+    const MediumInterface mediumInterface{media.find(shape, "interior"),
+                                          media.find(shape, "exterior")};
 
     ShapeTriangles triangles;
     switch (kind) {
@@ -925,12 +893,21 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, Sc
       }
     }
     total += triangles.triangles.size();
+    // An "interface" shape that bounds no medium (the same on both sides) changes nothing.
+    if (!useMtl && scene.materials[*material].type == kMaterialInterface &&
+        mediumInterface.inside == mediumInterface.outside) {
+      interfaceDropped += triangles.triangles.size();
+      continue;
+    }
     // Texture coordinates only where some material has a texture (materials come first).
     if (scene.materialTextures.empty()) triangles.uvs.clear();
-    emitTriangles(shape, triangles, transform, material.value_or(0u), scene);
+    emitTriangles(shape, triangles, transform, material.value_or(0u), mediumInterface, scene);
   }
   if (scene.triangles.empty()) {
-    node.fail("no triangles left: all " + std::to_string(total) + " have zero area");
+    node.fail("no triangles left: all " + std::to_string(total) +
+              (interfaceDropped == 0 ? " have zero area"
+                                     : " have zero area or belong to \"interface\" shapes that "
+                                       "bound no medium"));
   }
 }
 
@@ -1082,8 +1059,8 @@ Scene loadJsonScene(const std::filesystem::path& path) {
   }
   const nlohmann::json document = scene_detail::parseJson(text, file);
   const JsonNode root(document, "", file);
-  root.checkKeys(
-      {"description", "camera", "integrator", "textures", "materials", "shapes", "lights"});
+  root.checkKeys({"description", "camera", "integrator", "textures", "media", "materials",
+                  "shapes", "lights"});
 
   Scene scene;
   if (auto n = root.find("description")) n->string();
@@ -1091,10 +1068,14 @@ Scene loadJsonScene(const std::filesystem::path& path) {
   if (auto n = root.find("integrator")) scene.integrator = readIntegrator(*n);
   scene_detail::JsonTextures textures(scene, path.parent_path());
   if (auto n = root.find("textures")) textures.read(*n);
+  JsonMedia media(scene);
+  if (auto n = root.find("media")) media.read(*n);
+  if (auto n = root.find("camera")) scene.cameraMedium = media.find(*n, "medium");
   readMaterials(root.require("materials"), scene, textures);
-  readShapes(root.require("shapes"), path, scene);
+  readShapes(root.require("shapes"), path, media, scene);
   if (auto n = root.find("lights")) readLights(*n, path, scene);
   padMaterialTextures(scene);
+  keepUsedMedia(scene);  // none used: every media field empty
   return scene;
 }
 
