@@ -16,6 +16,7 @@
 #include "image/image.h"
 #include "image/texture_image.h"
 #include "scene/load_scene.h"
+#include "scene/media.h"
 #include "scene/mtl_materials.h"
 #include "scene/obj_mesh.h"
 #include "scene/ply_mesh.h"
@@ -99,12 +100,51 @@ void checkNormals(const Mesh& mesh) {
   }
 }
 
+// What the readers promise of an accepted scene's media (the renderer relies on them): no
+// media fields without media, one interface per triangle with valid indices, grids inside the
+// grid buffer, the majorants left to prepareScene, g in [-1, 1], finite non-negative values.
+void checkMedia(const Scene& scene) {
+  const std::size_t n = scene.media.size();
+  PT_CHECK(scene.mediumNames.size() == n, "media: names not parallel");
+  if (n == 0) {
+    PT_CHECK(scene.mediumInterfaces.empty() && scene.mediumGrids.empty() &&
+                 scene.cameraMedium == kNoMedium,
+             "media: media fields without media");
+    return;
+  }
+  PT_CHECK(scene.mediumInterfaces.size() == scene.triangles.size(),
+           "media: interfaces not parallel to the triangles");
+  const auto valid = [&](uint m) { return m == kNoMedium || m < n; };
+  PT_CHECK(valid(scene.cameraMedium), "media: bad camera medium");
+  for (const MediumInterface& mi : scene.mediumInterfaces) {
+    PT_CHECK(valid(mi.inside) && valid(mi.outside), "media: bad interface index");
+  }
+  for (const Medium& m : scene.media) {
+    PT_CHECK(m.type < kMediumTypeCount && m.g >= -1.0f && m.g <= 1.0f, "media: bad type or g");
+    PT_CHECK(m.majorants == kNoGrid, "media: majorants set by a reader");
+    for (const vec3& c : {m.sigmaA, m.sigmaS, m.Le}) {
+      PT_CHECK(std::isfinite(c.x + c.y + c.z) && c.x >= 0 && c.y >= 0 && c.z >= 0,
+               "media: bad coefficient");
+    }
+    const auto inside = [&](uint offset, std::size_t count) {
+      return offset == kNoGrid ? count == 0
+                               : std::size_t(offset) + count <= scene.mediumGrids.size();
+    };
+    PT_CHECK(inside(m.density, densityFloats(m)) && inside(m.emission, emissionFloats(m)),
+             "media: grid outside the grid buffer");
+    PT_CHECK(m.type == kMediumHomogeneous || m.density != kNoGrid, "media: grid without density");
+  }
+  for (float v : scene.mediumGrids) {
+    PT_CHECK(std::isfinite(v) && v >= 0.0f, "media: bad grid value");
+  }
+}
+
 }  // namespace
 
 Outcome fuzzScene(const std::uint8_t* data, std::size_t size) {
   const fs::path path = workDir() / "scene.json";
   writeFile(path, data, size);
-  return guarded([&] { loadScene(path); });
+  return guarded([&] { checkMedia(loadScene(path)); });
 }
 
 Outcome fuzzObj(const std::uint8_t* data, std::size_t size) {
@@ -159,6 +199,7 @@ Outcome fuzzPbrt(const std::uint8_t* data, std::size_t size) {
                    m.emission.y >= 0 && m.emission.z >= 0,
                "pbrt: bad emission accepted");
     }
+    checkMedia(scene);
     PT_CHECK(scene.camera.width >= 1 && scene.camera.height >= 1 &&
                  scene.camera.vfovDegrees > 0.0f && scene.camera.vfovDegrees < 180.0f,
              "pbrt: bad camera accepted");

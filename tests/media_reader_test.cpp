@@ -6,6 +6,8 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,7 @@
 #include <glm/vec4.hpp>
 
 #include "common/check.h"
+#include "fuzz/fuzz_entry.h"
 #include "scene/load_scene.h"
 #include "scene/media.h"
 #include "scene/pbrt/pbrt_scene.h"
@@ -665,6 +668,30 @@ TEST(MediaJson, EveryErrorNamesItsField) {
        "bound no medium"},
   };
   for (const auto& [text, message] : cases) EXPECT_EQ(jsonError(text), message) << text;
+}
+
+// ---- fuzzing -------------------------------------------------------------------------------
+
+// The media seeds of the fuzz corpora are accepted, so that the fuzzers start inside the media
+// code rather than at an early error (the replay test only asks for no crash).
+TEST(MediaFuzzSeeds, AreAcceptedByTheFuzzEntryPoints) {
+  const fs::path corpus = fs::path(PT_SOURCE_DIR) / "fuzz" / "corpus";
+  const auto bytes = [&](const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  const std::string pbrt = bytes(corpus / "pbrt" / "media.pbrt");
+  const std::string json = bytes(corpus / "scene" / "media.json");
+  ASSERT_FALSE(pbrt.empty());
+  ASSERT_FALSE(json.empty());
+  EXPECT_EQ(fuzz::fuzzPbrt(reinterpret_cast<const std::uint8_t*>(pbrt.data()), pbrt.size()),
+            fuzz::Outcome::kAccepted);
+  EXPECT_EQ(fuzz::fuzzScene(reinterpret_cast<const std::uint8_t*>(json.data()), json.size()),
+            fuzz::Outcome::kAccepted);
+  // And they do have media.
+  const Scene s = loadPbrtSceneText(pbrt, "media.pbrt");
+  EXPECT_EQ(s.mediumNames, (std::vector<std::string>{"air", "fog", "smoke", "cloud"}));
+  EXPECT_EQ(s.cameraMedium, 0u);
 }
 
 }  // namespace
