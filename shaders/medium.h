@@ -89,8 +89,8 @@ PT_INLINE vec3 gridLookupRgb(PT_SCENE_PARAM uint first, uvec3 size, vec3 u) {
 // ---- The coefficients at a point ------------------------------------------------------------
 
 // Medium m's coefficients at world point p. A grid is zero outside its bounds. uniformgrid:
-// sigma_a and sigma_s times the density, Le times its grid (or constant without one); rgbgrid:
-// the RGB grids times sigma_a and sigma_s (its scale), its Le grid times Le (its Lescale).
+// sigma_a and sigma_s times the density, Le times its grid; rgbgrid: the RGB grids times
+// sigma_a and sigma_s, its Le grid times Le (the readers fold the scales into its grids).
 PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, vec3 p) {
   if (m.type == kMediumHomogeneous) return MediumProperties(m.sigmaA, m.sigmaS, m.Le);
   vec3 u = (toMediumSpace(m, p) - m.boundsMin) / (m.boundsMax - m.boundsMin);
@@ -100,7 +100,10 @@ PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, ve
     mp.sigmaA = m.sigmaA * d;
     mp.sigmaS = m.sigmaS * d;
     if (m.emissive != 0u) {
-      mp.Le = m.emission == kNoGrid ? m.Le
+      // Without a grid of its own, Le's scale is pbrt-v4's grid of one voxel of 1: the
+      // interpolation falls to a half at the faces.
+      vec3 f = vec3(1.0f) - abs(u - 0.5f);
+      mp.Le = m.emission == kNoGrid ? m.Le * (f.x * f.y * f.z)
                                     : m.Le * gridLookup(PT_SCENE_ARG m.emission, m.size, 1u, 0u, u);
     }
   } else {

@@ -197,8 +197,11 @@ PT_CONST uint kNoGrid = 0xFFFFFFFFu;      // a grid medium's missing grid (no Le
 // 16^3), each the largest density of the voxels it overlaps.
 PT_CONST uint kMajorantGridRes = 16u;
 
+// Grids hold a value per voxel (RGB: three) in pbrt-v4's SampledGrid order, x fastest: voxel
+// (x, y, z) is number (z * size.y + y) * size.x + x. An rgbgrid's scales are folded into its
+// grids by the readers (its sigmaA, sigmaS and Le are then ones).
 struct Medium {
-  vec3 sigmaA;       // 12 bytes: absorption (homogeneous), or its scale of the density grid
+  vec3 sigmaA;       // 12 bytes: absorption (homogeneous), or what the density grid multiplies
   uint type;         //  4 bytes: kMedium*
   vec3 sigmaS;       // 12 bytes: scattering, likewise
   float g;           //  4 bytes: Henyey-Greenstein asymmetry, in [-1, 1]
