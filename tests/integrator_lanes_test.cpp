@@ -80,6 +80,9 @@ std::vector<Case> cases(const test::TempDir& dir) {
     list.push_back({everything, s});
   }
   list.push_back({"textured-sky.json", small});
+  // Participating media (the volume integrator, which the lanes run path by path).
+  list.push_back({"fog-beam.json", small});
+  list.push_back({"tinted-glass.json", small});
   // An environment image, octahedral (the pbrt file's) and lat-long, with each strategy.
   const std::string environment = environmentImageScene(dir);
   for (uint strategy : {kStrategyMis, kStrategyNee, kStrategyBsdf}) {
@@ -119,6 +122,10 @@ TEST(CpuLanes, EqualsTheReferenceBitForBit) {
     const SceneData data = prepareScene(std::move(scene), c.settings);
     if (c.config.find("lanes-environment") != std::string::npos) {
       ASSERT_TRUE(data.effects.environmentImage) << data.effects.toString();
+    }
+    if (c.config.find("fog-beam") != std::string::npos ||
+        c.config.find("tinted-glass") != std::string::npos) {
+      ASSERT_TRUE(data.effects.media) << data.effects.toString();
     }
     if (c.config.find("shading-normals") != std::string::npos) {
       ASSERT_TRUE(data.effects.shadingNormals) << data.effects.toString();
