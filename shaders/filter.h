@@ -325,6 +325,17 @@ PT_INLINE CameraSample generateCameraRay(PT_IN(Camera) cam, uvec2 filmPixel, vec
   return s;
 }
 
+// The camera ray of a path sample: sample sampleIndex of film pixel filmPixel, its numbers
+// from dimension kDimPixel (the filter) and, for a thin lens only, kDimLens (a pinhole draws
+// nothing for it, so that its paths are those of the renderer before lenses).
+PT_INLINE CameraSample cameraSampleOf(PT_IN(Camera) cam, bool sobol, uvec2 filmPixel,
+                                      uint sampleIndex, uint seed) {
+  vec2 uLens =
+      cam.lensRadius > 0.0f ? random2(sobol, filmPixel, sampleIndex, kDimLens, seed) : vec2(0.0f);
+  return generateCameraRay(cam, filmPixel, random2(sobol, filmPixel, sampleIndex, kDimPixel, seed),
+                           uLens);
+}
+
 #ifdef __cplusplus
 }  // namespace pt
 #endif

@@ -374,12 +374,7 @@ Path startPath(uvec2 pixel, uint sampleIndex) {
   Path path;
   path.sampleIndex = sampleIndex;
   path.depth = 0u;
-  // The lens's numbers only for a thin lens: a pinhole draws what it drew before lenses.
-  vec2 uLens = params.camera.lensRadius > 0.0
-                   ? random2(PT_SOBOL, pixel, sampleIndex, kDimLens, params.seed)
-                   : vec2(0.0);
-  CameraSample camera = generateCameraRay(
-      params.camera, pixel, random2(PT_SOBOL, pixel, sampleIndex, kDimPixel, params.seed), uLens);
+  CameraSample camera = cameraSampleOf(params.camera, PT_SOBOL, pixel, sampleIndex, params.seed);
   path.origin = camera.origin;
   path.direction = camera.direction;
   path.weight = camera.weight;

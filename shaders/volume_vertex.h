@@ -133,6 +133,52 @@ PT_INLINE uint crossInterface(PT_SCENE_PARAM uint index, PT_IN(Triangle) tri, ve
   return mediumAfter(PT_SCENE_ARG tri.primitive, shading.normal, d, medium);
 }
 
+// ---- Tentative collisions -------------------------------------------------------------------
+
+// The tentative collisions of a ray with a medium: distances sampled at the hero channel's
+// majorant, segment by segment of the majorant walk (pbrt-v4's SampleT_maj, as an iterator
+// rather than a callback). Between collisions, T gathers the majorant's transmittance in
+// every channel.
+struct CollisionWalk {
+  MajorantWalk walk;
+  MajorantSegment seg;  // the segment under way
+  bool inSegment;       // seg is under way
+  float tMin;           // where the next distance is measured from
+  vec3 T;               // the majorant's transmittance since the last collision (or the start)
+};
+
+PT_INLINE CollisionWalk startCollisionWalk(PT_SCENE_PARAM uint medium, vec3 o, vec3 d, float tMax) {
+  return CollisionWalk(startMajorantWalk(PT_SCENE_ARG medium, o, d, tMax),
+                       MajorantSegment(0.0f, 0.0f, vec3(0.0f)), false, 0.0f, vec3(1.0f));
+}
+
+// The next tentative collision, at t along the ray (c.seg.sigmaMaj the majorant there, c.T
+// the transmittance since the last); false once the ray's range is crossed, c.T then holding
+// the transmittance of its rest. A segment where the hero's majorant is zero is crossed whole.
+PT_INLINE bool nextCollision(PT_SCENE_PARAM PT_INOUT(CollisionWalk) c, uint h,
+                             PT_INOUT(RandomStream) rng, PT_OUT(float) t) {
+  for (;;) {
+    if (!c.inSegment) {
+      if (!nextMajorantSegment(PT_SCENE_ARG c.walk, c.seg)) return false;
+      c.tMin = c.seg.tMin;
+      if (c.seg.sigmaMaj[h] == 0.0f) {
+        c.T *= exp(-min(c.seg.tMax - c.seg.tMin, kMaxFloat) * c.seg.sigmaMaj);
+        continue;
+      }
+      c.inSegment = true;
+    }
+    PT_MEDIUM_LOOP_TICK();
+    t = c.tMin + sampleExponential(nextRandom(rng), c.seg.sigmaMaj[h]);
+    if (t < c.seg.tMax) {
+      c.T *= exp(-(t - c.tMin) * c.seg.sigmaMaj);
+      c.tMin = t;
+      return true;
+    }
+    c.T *= exp(-min(c.seg.tMax - c.tMin, kMaxFloat) * c.seg.sigmaMaj);
+    c.inSegment = false;
+  }
+}
+
 // ---- Delta tracking of a flight ------------------------------------------------------------
 
 PT_CONST uint kFlightPassed = 0u;     // the ray reached tMax (the surface, or nothing)
@@ -151,65 +197,49 @@ PT_INLINE uint trackFlight(PT_SCENE_PARAM PT_INOUT(VolumePath) v, vec3 o, vec3 d
   Medium m = loadMedium(PT_SCENE_ARG v.medium);
   g = m.g;
   p = o;
-  MajorantWalk walk = startMajorantWalk(PT_SCENE_ARG v.medium, o, d, tMax);
-  vec3 T = vec3(1.0f);  // the majorant's transmittance since the last collision
+  CollisionWalk c = startCollisionWalk(PT_SCENE_ARG v.medium, o, d, tMax);
   float uMode = nextRandom(v.rng);
-  float u = nextRandom(v.rng);
-  MajorantSegment seg;
-  while (nextMajorantSegment(PT_SCENE_ARG walk, seg)) {
-    vec3 sigmaMaj = seg.sigmaMaj;
-    if (sigmaMaj[h] == 0.0f) {
-      T *= exp(-min(seg.tMax - seg.tMin, kMaxFloat) * sigmaMaj);
-      continue;
+  float t;
+  while (nextCollision(PT_SCENE_ARG c, h, v.rng, t)) {
+    vec3 sigmaMaj = c.seg.sigmaMaj;
+    vec3 T = c.T;
+    p = o + t * d;
+    MediumProperties mp = mediumPropertiesAt(PT_SCENE_ARG m, p);
+    // The medium's emission, weighed by the densities of reaching this point.
+    if (m.emissive != 0u && v.depth < PT_PARAMS.maxDepth && maxComponent(mp.Le) > 0.0f) {
+      float pdf = sigmaMaj[h] * T[h];
+      vec3 rE = v.rU * sigmaMaj * T / pdf;
+      if (maxComponent(rE) > 0.0f) {
+        v.path.L += (v.path.beta * T / pdf) * mp.sigmaA * mp.Le / average(rE);
+      }
     }
-    float tMin = seg.tMin;
-    for (;;) {
-      PT_MEDIUM_LOOP_TICK();
-      float t = tMin + sampleExponential(u, sigmaMaj[h]);
-      u = nextRandom(v.rng);
-      if (!(t < seg.tMax)) {
-        T *= exp(-min(seg.tMax - tMin, kMaxFloat) * sigmaMaj);
-        break;
-      }
-      T *= exp(-(t - tMin) * sigmaMaj);
-      p = o + t * d;
-      MediumProperties mp = mediumPropertiesAt(PT_SCENE_ARG m, p);
-      // The medium's emission, weighed by the densities of reaching this point.
-      if (m.emissive != 0u && v.depth < PT_PARAMS.maxDepth && maxComponent(mp.Le) > 0.0f) {
-        float pdf = sigmaMaj[h] * T[h];
-        vec3 rE = v.rU * sigmaMaj * T / pdf;
-        if (maxComponent(rE) > 0.0f) {
-          v.path.L += (v.path.beta * T / pdf) * mp.sigmaA * mp.Le / average(rE);
-        }
-      }
-      // Which event: absorption, scattering or a null collision, by the hero's coefficients.
-      float pAbsorb = mp.sigmaA[h] / sigmaMaj[h];
-      float pScatter = mp.sigmaS[h] / sigmaMaj[h];
-      float pNull = max(0.0f, 1.0f - pAbsorb - pScatter);
-      float up = uMode * (pAbsorb + pScatter + pNull);
-      uMode = nextRandom(v.rng);
-      if (up < pAbsorb) return kFlightEnded;
-      if (up < pAbsorb + pScatter) {
-        float pdf = T[h] * mp.sigmaS[h];
-        v.path.beta *= T * mp.sigmaS / pdf;
-        v.rU *= T * mp.sigmaS / pdf;
-        return maxComponent(v.path.beta) > 0.0f && maxComponent(v.rU) > 0.0f ? kFlightScattered
-                                                                           : kFlightEnded;
-      }
-      vec3 sigmaN = max(sigmaMaj - mp.sigmaA - mp.sigmaS, vec3(0.0f));
-      float pdf = T[h] * sigmaN[h];
-      if (pdf == 0.0f) return kFlightEnded;
-      v.path.beta *= T * sigmaN / pdf;
-      v.rU *= T * sigmaN / pdf;
-      v.rL *= T * sigmaMaj / pdf;
-      if (!(maxComponent(v.path.beta) > 0.0f) || !(maxComponent(v.rU) > 0.0f)) {
-        return kFlightEnded;
-      }
-      T = vec3(1.0f);
-      tMin = t;
+    // Which event: absorption, scattering or a null collision, by the hero's coefficients.
+    float pAbsorb = mp.sigmaA[h] / sigmaMaj[h];
+    float pScatter = mp.sigmaS[h] / sigmaMaj[h];
+    float pNull = max(0.0f, 1.0f - pAbsorb - pScatter);
+    float up = uMode * (pAbsorb + pScatter + pNull);
+    uMode = nextRandom(v.rng);
+    if (up < pAbsorb) return kFlightEnded;
+    if (up < pAbsorb + pScatter) {
+      float pdf = T[h] * mp.sigmaS[h];
+      v.path.beta *= T * mp.sigmaS / pdf;
+      v.rU *= T * mp.sigmaS / pdf;
+      return maxComponent(v.path.beta) > 0.0f && maxComponent(v.rU) > 0.0f ? kFlightScattered
+                                                                         : kFlightEnded;
     }
+    vec3 sigmaN = max(sigmaMaj - mp.sigmaA - mp.sigmaS, vec3(0.0f));
+    float pdf = T[h] * sigmaN[h];
+    if (pdf == 0.0f) return kFlightEnded;
+    v.path.beta *= T * sigmaN / pdf;
+    v.rU *= T * sigmaN / pdf;
+    v.rL *= T * sigmaMaj / pdf;
+    if (!(maxComponent(v.path.beta) > 0.0f) || !(maxComponent(v.rU) > 0.0f)) {
+      return kFlightEnded;
+    }
+    c.T = vec3(1.0f);
   }
   // No collision left: the majorant's transmittance over the probability of passing.
+  vec3 T = c.T;
   if (!(T[h] > 0.0f)) return kFlightEnded;
   v.path.beta *= T / T[h];
   v.rU *= T / T[h];
@@ -240,46 +270,30 @@ PT_INLINE ShadowTransmittance startShadowTransmittance(PT_SCENE_PARAM VertexKey 
 PT_INLINE bool trackShadowSegment(PT_SCENE_PARAM PT_INOUT(ShadowTransmittance) tr, uint medium,
                                   uint h, vec3 o, vec3 d, float tMax) {
   Medium m = loadMedium(PT_SCENE_ARG medium);
-  MajorantWalk walk = startMajorantWalk(PT_SCENE_ARG medium, o, d, tMax);
-  vec3 T = vec3(1.0f);
-  float u = nextRandom(tr.rng);
-  MajorantSegment seg;
-  while (nextMajorantSegment(PT_SCENE_ARG walk, seg)) {
-    vec3 sigmaMaj = seg.sigmaMaj;
-    if (sigmaMaj[h] == 0.0f) {
-      T *= exp(-min(seg.tMax - seg.tMin, kMaxFloat) * sigmaMaj);
-      continue;
-    }
-    float tMin = seg.tMin;
-    for (;;) {
-      PT_MEDIUM_LOOP_TICK();
-      float t = tMin + sampleExponential(u, sigmaMaj[h]);
-      u = nextRandom(tr.rng);
-      if (!(t < seg.tMax)) {
-        T *= exp(-min(seg.tMax - tMin, kMaxFloat) * sigmaMaj);
-        break;
+  CollisionWalk c = startCollisionWalk(PT_SCENE_ARG medium, o, d, tMax);
+  float t;
+  while (nextCollision(PT_SCENE_ARG c, h, tr.rng, t)) {
+    vec3 sigmaMaj = c.seg.sigmaMaj;
+    vec3 T = c.T;
+    MediumProperties mp = mediumPropertiesAt(PT_SCENE_ARG m, o + t * d);
+    vec3 sigmaN = max(sigmaMaj - mp.sigmaA - mp.sigmaS, vec3(0.0f));
+    float pdf = T[h] * sigmaMaj[h];
+    tr.T *= T * sigmaN / pdf;
+    tr.rL *= T * sigmaMaj / pdf;
+    tr.rU *= T * sigmaN / pdf;
+    // Roulette where little is left to carry.
+    vec3 estimate = tr.T / average(tr.rL + tr.rU);
+    if (maxComponent(estimate) < 0.05f) {
+      if (nextRandom(tr.rng) < 0.75f) {
+        tr.T = vec3(0.0f);
+      } else {
+        tr.T /= 0.25f;
       }
-      T *= exp(-(t - tMin) * sigmaMaj);
-      MediumProperties mp = mediumPropertiesAt(PT_SCENE_ARG m, o + t * d);
-      vec3 sigmaN = max(sigmaMaj - mp.sigmaA - mp.sigmaS, vec3(0.0f));
-      float pdf = T[h] * sigmaMaj[h];
-      tr.T *= T * sigmaN / pdf;
-      tr.rL *= T * sigmaMaj / pdf;
-      tr.rU *= T * sigmaN / pdf;
-      // Roulette where little is left to carry.
-      vec3 estimate = tr.T / average(tr.rL + tr.rU);
-      if (maxComponent(estimate) < 0.05f) {
-        if (nextRandom(tr.rng) < 0.75f) {
-          tr.T = vec3(0.0f);
-        } else {
-          tr.T /= 0.25f;
-        }
-      }
-      if (!(maxComponent(tr.T) > 0.0f)) return false;
-      T = vec3(1.0f);
-      tMin = t;
     }
+    if (!(maxComponent(tr.T) > 0.0f)) return false;
+    c.T = vec3(1.0f);
   }
+  vec3 T = c.T;
   if (!(T[h] > 0.0f)) {
     tr.T = vec3(0.0f);
     return false;

@@ -117,13 +117,8 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
   const Intersection test =
       params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
 
-  // The camera ray through a point of the pixel's filter (and of the lens: a pinhole draws no
-  // numbers for it, so that its paths are those of the renderer before lenses).
-  const vec2 uLens = params.camera.lensRadius > 0.0f
-                         ? random2(sobol, pixel, sampleIndex, kDimLens, seed)
-                         : vec2(0.0f);
-  const CameraSample camera = generateCameraRay(
-      params.camera, pixel, random2(sobol, pixel, sampleIndex, kDimPixel, seed), uLens);
+  // The camera ray through a point of the pixel's filter (and of the lens).
+  const CameraSample camera = cameraSampleOf(params.camera, sobol, pixel, sampleIndex, seed);
   Ray ray{camera.origin, camera.direction};
   PathState path = startPathState();  // L, beta, etaScale, bsdfPdf, specularBounce
 

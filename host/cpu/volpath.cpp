@@ -56,12 +56,8 @@ vec3 sampleRadianceVolume(const SceneData& scene, uvec2 imagePixel, uint32_t sam
   const Intersection test =
       params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
 
-  // The camera ray, as the path integrator's.
-  const vec2 uLens = params.camera.lensRadius > 0.0f
-                         ? random2(sobol, pixel, sampleIndex, kDimLens, seed)
-                         : vec2(0.0f);
-  const CameraSample camera = generateCameraRay(
-      params.camera, pixel, random2(sobol, pixel, sampleIndex, kDimPixel, seed), uLens);
+  // The camera ray through a point of the pixel's filter (and of the lens).
+  const CameraSample camera = cameraSampleOf(params.camera, sobol, pixel, sampleIndex, seed);
   Ray ray{camera.origin, camera.direction};
   // L, beta, the densities over the channels, the hero channel, the camera's medium.
   VolumePath v = startVolumePath(ps, pixel, sampleIndex, ray.origin);
