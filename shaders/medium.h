@@ -51,8 +51,7 @@ PT_INLINE vec3 toMediumDirection(PT_IN(Medium) m, vec3 d) {
 
 // Component `c` (of `components` per voxel) of voxel v of the grid that starts at float
 // `first`, or 0 outside the grid.
-PT_INLINE float gridVoxel(PT_SCENE_PARAM uint first, uvec3 size, uint components, uint c,
-                          ivec3 v) {
+PT_INLINE float gridVoxel(PT_SCENE_PARAM uint first, uvec3 size, uint components, uint c, ivec3 v) {
   if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(size)))) return 0.0f;
   uint index = (uint(v.z) * size.y + uint(v.y)) * size.x + uint(v.x);
   return mediumGridFloat(PT_SCENE_ARG first + index * components + c);
@@ -64,20 +63,19 @@ PT_INLINE float lerpValue(float t, float a, float b) {
 }
 
 // The grid's value at point u of the unit cube (the bounds' offset coordinates), trilinearly.
-PT_INLINE float gridLookup(PT_SCENE_PARAM uint first, uvec3 size, uint components, uint c,
-                           vec3 u) {
+PT_INLINE float gridLookup(PT_SCENE_PARAM uint first, uvec3 size, uint components, uint c, vec3 u) {
   vec3 s = u * vec3(size) - 0.5f;
   vec3 f = floor(s);
   ivec3 i = ivec3(f);
   vec3 d = s - f;
   float c00 = lerpValue(d.x, gridVoxel(PT_SCENE_ARG first, size, components, c, i),
-                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 0, 0)));
+                        gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 0, 0)));
   float c10 = lerpValue(d.x, gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 1, 0)),
-                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 1, 0)));
+                        gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 1, 0)));
   float c01 = lerpValue(d.x, gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 0, 1)),
-                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 0, 1)));
+                        gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 0, 1)));
   float c11 = lerpValue(d.x, gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(0, 1, 1)),
-                  gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 1, 1)));
+                        gridVoxel(PT_SCENE_ARG first, size, components, c, i + ivec3(1, 1, 1)));
   return lerpValue(d.z, lerpValue(d.y, c00, c10), lerpValue(d.y, c01, c11));
 }
 PT_INLINE vec3 gridLookupRgb(PT_SCENE_PARAM uint first, uvec3 size, vec3 u) {
@@ -132,8 +130,7 @@ struct MajorantSegment {
 };
 
 struct MajorantWalk {
-  uint medium;
-  uint type;       // the medium's kMedium*
+  uint type;  // the medium's kMedium*
   bool done;
   float tMin;      // where the next segment starts
   float tMax;      // where the walk ends
@@ -145,10 +142,9 @@ struct MajorantWalk {
   uint majorants;  // grid: the first float of its majorant grid
 };
 
-// The walk of ray (o, d) over t in [0, tMax) through medium `index`.
-PT_INLINE MajorantWalk startMajorantWalk(PT_SCENE_PARAM uint index, vec3 o, vec3 d, float tMax) {
-  Medium m = loadMedium(PT_SCENE_ARG index);
-  MajorantWalk w = MajorantWalk(index, m.type, false, 0.0f, tMax, m.sigmaA + m.sigmaS, ivec3(0),
+// The walk of ray (o, d) over t in [0, tMax) through medium m.
+PT_INLINE MajorantWalk startMajorantWalk(PT_IN(Medium) m, vec3 o, vec3 d, float tMax) {
+  MajorantWalk w = MajorantWalk(m.type, false, 0.0f, tMax, m.sigmaA + m.sigmaS, ivec3(0),
                                 vec3(0.0f), vec3(0.0f), ivec3(0), m.majorants);
   if (m.type == kMediumHomogeneous) return w;
   if (m.type == kMediumRgbGrid) w.sigmaMaj = vec3(1.0f);
@@ -217,8 +213,8 @@ PT_INLINE bool nextMajorantSegment(PT_SCENE_PARAM PT_INOUT(MajorantWalk) w,
   int a = w.nextT.x < w.nextT.y ? (w.nextT.x < w.nextT.z ? 0 : 2) : (w.nextT.y < w.nextT.z ? 1 : 2);
   float tExit = min(w.nextT[a], w.tMax);
   uint r = kMajorantGridRes;
-  float cellMajorant = mediumGridFloat(
-      PT_SCENE_ARG w.majorants + (uint(w.cell.z) * r + uint(w.cell.y)) * r + uint(w.cell.x));
+  float cellMajorant = mediumGridFloat(PT_SCENE_ARG w.majorants +
+                                       (uint(w.cell.z) * r + uint(w.cell.y)) * r + uint(w.cell.x));
   seg = MajorantSegment(w.tMin, tExit, w.sigmaMaj * cellMajorant);
   w.tMin = tExit;
   w.cell[a] += w.step[a];

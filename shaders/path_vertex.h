@@ -86,7 +86,7 @@ struct PathScene {
   const vec4* environmentTexels;
   // Participating media (medium.h, volume_vertex.h); null in a scene without any.
   const Medium* media;
-  const float* mediumGrids;                  // grid floats, majorant grids included
+  const float* mediumGrids;                 // grid floats, majorant grids included
   const MediumInterface* mediumInterfaces;  // by Triangle::primitive
 };
 #define PT_SCENE_PARAM const PathScene &scene,
@@ -286,8 +286,8 @@ PT_INLINE float emitterPdfFound(PT_SCENE_PARAM PT_IN(Triangle) tri, PT_IN(Surfac
 #ifndef PT_NO_BSDF_MATERIALS
   // A sphere light's triangle: light sampling draws its cone (seen from the ray's origin).
   if (PT_HAS_SPHERE_LIGHTS && (emitter.triangle & kEmitterLight) != 0u) {
-    lightPdf = emitter.pmf * sphereLightPdf(loadLight(PT_SCENE_ARG emitter.triangle & ~kEmitterLight),
-                                            from);
+    lightPdf = emitter.pmf *
+               sphereLightPdf(loadLight(PT_SCENE_ARG emitter.triangle & ~kEmitterLight), from);
   }
 #endif
   return lightPdf;
@@ -313,8 +313,8 @@ PT_INLINE void addEmissionFound(PT_SCENE_PARAM PT_INOUT(PathState) path, PT_IN(T
   } else if (bsdfEmissionOn(PT_SCENE_ONLY)) {
     float weight = 1.0f;
     if (misOn(PT_SCENE_ONLY)) {
-      weight = powerHeuristic(path.bsdfPdf,
-                              emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, t, rayOrigin));
+      weight =
+          powerHeuristic(path.bsdfPdf, emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, t, rayOrigin));
     }
     path.L += path.beta * weight * Le;
   }

@@ -357,13 +357,13 @@ struct Path {
   vec3 origin;  // the ray to trace next
   vec3 direction;
 #ifdef PT_VOLPATH
-  VolumePath vol;   // PathState and what media add (volume_vertex.h)
-  uint crossings;   // interface surfaces crossed since the last scattering event
+  VolumePath vol;  // PathState and what media add (volume_vertex.h)
+  uint crossings;  // interface surfaces crossed since the last scattering event
 #else
   PathState state;  // L, beta, etaScale, bsdfPdf, specularBounce (path_vertex.h)
 #endif
-  float weight;     // the camera sample's weight (filter.h): multiplies L at the end
-  bool hitReady;    // the ray's closest hit is hitFound and hit already (see Retrace)
+  float weight;   // the camera sample's weight (filter.h): multiplies L at the end
+  bool hitReady;  // the ray's closest hit is hitFound and hit already (see Retrace)
   bool hitFound;
   HitData hit;
 };

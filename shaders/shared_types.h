@@ -187,12 +187,12 @@ PT_CONST uint kLightTexels = 4u;
 // pbrt-v4's media (its MakeNamedMedium classes, their parameters and definitions;
 // shaders/medium.h evaluates them). Coefficients are per unit of world distance, linear RGB
 // (pbrt-v4 is spectral: its RGB values become spectra, ours stay RGB), scales applied.
-PT_CONST uint kNoMedium = 0xFFFFFFFFu;    // vacuum
-PT_CONST uint kMediumHomogeneous = 0u;    // constant sigma_a, sigma_s, Le
-PT_CONST uint kMediumUniformGrid = 1u;    // sigma_a, sigma_s times a density grid; Le times a grid
-PT_CONST uint kMediumRgbGrid = 2u;        // RGB grids of sigma_a, sigma_s and Le
+PT_CONST uint kNoMedium = 0xFFFFFFFFu;  // vacuum
+PT_CONST uint kMediumHomogeneous = 0u;  // constant sigma_a, sigma_s, Le
+PT_CONST uint kMediumUniformGrid = 1u;  // sigma_a, sigma_s times a density grid; Le times a grid
+PT_CONST uint kMediumRgbGrid = 2u;      // RGB grids of sigma_a, sigma_s and Le
 PT_CONST uint kMediumTypeCount = 3u;
-PT_CONST uint kNoGrid = 0xFFFFFFFFu;      // a grid medium's missing grid (no Le grid)
+PT_CONST uint kNoGrid = 0xFFFFFFFFu;  // a grid medium's missing grid (no Le grid)
 // The majorant grid of a grid medium: this many cells on each axis over its bounds (pbrt-v4's
 // 16^3), each the largest density of the voxels it overlaps.
 PT_CONST uint kMajorantGridRes = 16u;
@@ -201,24 +201,24 @@ PT_CONST uint kMajorantGridRes = 16u;
 // (x, y, z) is number (z * size.y + y) * size.x + x. An rgbgrid's scales are folded into its
 // grids by the readers (its sigmaA, sigmaS and Le are then ones).
 struct Medium {
-  vec3 sigmaA;       // 12 bytes: absorption (homogeneous), or what the density grid multiplies
-  uint type;         //  4 bytes: kMedium*
-  vec3 sigmaS;       // 12 bytes: scattering, likewise
-  float g;           //  4 bytes: Henyey-Greenstein asymmetry, in [-1, 1]
-  vec3 Le;           // 12 bytes: emitted radiance (homogeneous, uniformgrid: times its grid)
-  uint emissive;     //  4 bytes: 1 when some of it emits
-  vec3 boundsMin;    // 12 bytes: grids: p0, in the medium's space
-  uint density;      //  4 bytes: grids: the first float of its density grid (uniformgrid: one
-                     //           float per voxel; rgbgrid: sigma_a's RGB then sigma_s's RGB)
-  vec3 boundsMax;    // 12 bytes: grids: p1
-  uint majorants;    //  4 bytes: grids: the first float of its majorant grid (kMajorantGridRes^3)
-  uvec3 size;        // 12 bytes: grids: voxels along x, y, z
-  uint emission;     //  4 bytes: grids: the first float of its Le grid (uniformgrid: a scale per
-                     //           voxel; rgbgrid: RGB per voxel), or kNoGrid
-  vec4 toMedium0;    // 16 bytes: the world-to-medium transform's rows (affine: p' = M p + t,
-  vec4 toMedium1;    // 16 bytes: row i is (M[i][0], M[i][1], M[i][2], t[i])); grids only
-  vec4 toMedium2;    // 16 bytes
-};                   // 144 bytes
+  vec3 sigmaA;     // 12 bytes: absorption (homogeneous), or what the density grid multiplies
+  uint type;       //  4 bytes: kMedium*
+  vec3 sigmaS;     // 12 bytes: scattering, likewise
+  float g;         //  4 bytes: Henyey-Greenstein asymmetry, in [-1, 1]
+  vec3 Le;         // 12 bytes: emitted radiance (homogeneous, uniformgrid: times its grid)
+  uint emissive;   //  4 bytes: 1 when some of it emits
+  vec3 boundsMin;  // 12 bytes: grids: p0, in the medium's space
+  uint density;    //  4 bytes: grids: the first float of its density grid (uniformgrid: one
+                   //           float per voxel; rgbgrid: sigma_a's RGB then sigma_s's RGB)
+  vec3 boundsMax;  // 12 bytes: grids: p1
+  uint majorants;  //  4 bytes: grids: the first float of its majorant grid (kMajorantGridRes^3)
+  uvec3 size;      // 12 bytes: grids: voxels along x, y, z
+  uint emission;   //  4 bytes: grids: the first float of its Le grid (uniformgrid: a scale per
+                   //           voxel; rgbgrid: RGB per voxel), or kNoGrid
+  vec4 toMedium0;  // 16 bytes: the world-to-medium transform's rows (affine: p' = M p + t,
+  vec4 toMedium1;  // 16 bytes: row i is (M[i][0], M[i][1], M[i][2], t[i])); grids only
+  vec4 toMedium2;  // 16 bytes
+};                 // 144 bytes
 PT_CONST uint kMediumTexels = 9u;
 
 // The media on the two sides of a triangle, by Triangle::primitive: `inside` on the side

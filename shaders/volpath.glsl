@@ -8,8 +8,8 @@
 bool traceClosest(vec3 origin, vec3 direction, float tMax, out HitData hit) {
   gRays++;
   bool inexact;
-  bool found = traceRayWith(/*exact=*/false, origin, direction, tMax, /*anyHit=*/false, hit,
-                            inexact);
+  bool found =
+      traceRayWith(/*exact=*/false, origin, direction, tMax, /*anyHit=*/false, hit, inexact);
   if (inexact) {
     found = traceRayWith(/*exact=*/true, origin, direction, tMax, /*anyHit=*/false, hit, inexact);
   }
@@ -18,8 +18,7 @@ bool traceClosest(vec3 origin, vec3 direction, float tMax, out HitData hit) {
 
 // Traces the shadow ray of light sample ls, which starts in `medium`, through the interfaces
 // and media on its way: false when a surface blocks it; tr gathers the media's transmittance.
-bool traceShadowThroughMedia(LightSample ls, uint medium, uint hero,
-                             inout ShadowTransmittance tr) {
+bool traceShadowThroughMedia(LightSample ls, uint medium, uint hero, inout ShadowTransmittance tr) {
   vec3 from = ls.from;
   for (uint crossing = 0u; crossing <= kMaxInterfaceCrossings; ++crossing) {
     gLoopIterations++;

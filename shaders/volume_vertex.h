@@ -59,8 +59,10 @@ PT_INLINE float logarithm(float x) {
   }
   float s = (m - 1.0f) / (m + 1.0f);
   float s2 = s * s;
-  float series = 1.0f + s2 * (1.0f / 3.0f + s2 * (1.0f / 5.0f + s2 * (1.0f / 7.0f +
-                 s2 * (1.0f / 9.0f + s2 * (1.0f / 11.0f)))));
+  float series =
+      1.0f +
+      s2 * (1.0f / 3.0f +
+            s2 * (1.0f / 5.0f + s2 * (1.0f / 7.0f + s2 * (1.0f / 9.0f + s2 * (1.0f / 11.0f)))));
   return float(e) * 0.693147180559945f + 2.0f * s * series;
 }
 
@@ -74,16 +76,16 @@ PT_INLINE float sampleExponential(float u, float a) {
 // What a path carries through media, beyond path_vertex.h's PathState (whose bsdfPdf and
 // MIS it replaces with rU and rL).
 struct VolumePath {
-  PathState path;     // L, beta, etaScale, specularBounce (bsdfPdf: the last sample's density)
-  vec3 rU;            // pbrt-v4's r_u: the path's density with each channel as the hero, over
-                      // the density it was sampled with
-  vec3 rL;            // r_l: the density of light sampling reaching the path's next vertex,
-                      // over the same (times the light's density once one is found)
-  uint hero;          // the channel distances are sampled by (0, 1, 2)
-  uint medium;        // the medium the ray is in, or kNoMedium
-  uint depth;         // scattering events so far (surfaces and media)
-  vec3 prevP;         // the last scattering vertex (the camera's position at first)
-  RandomStream rng;   // the flight's collisions, keyed by the next event's dimension
+  PathState path;    // L, beta, etaScale, specularBounce (bsdfPdf: a surface sample's density)
+  vec3 rU;           // pbrt-v4's r_u: the path's density with each channel as the hero, over
+                     // the density it was sampled with
+  vec3 rL;           // r_l: the density of light sampling reaching the path's next vertex,
+                     // over the same (times the light's density once one is found)
+  uint hero;         // the channel distances are sampled by (0, 1, 2)
+  uint medium;       // the medium the ray is in, or kNoMedium
+  uint depth;        // scattering events so far (surfaces and media)
+  vec3 prevP;        // the last scattering vertex (the camera's position at first)
+  RandomStream rng;  // the flight's collisions, keyed by the next event's dimension
 };
 
 // The stream of the flight after `depth` scattering events.
@@ -147,9 +149,9 @@ struct CollisionWalk {
   vec3 T;               // the majorant's transmittance since the last collision (or the start)
 };
 
-PT_INLINE CollisionWalk startCollisionWalk(PT_SCENE_PARAM uint medium, vec3 o, vec3 d, float tMax) {
-  return CollisionWalk(startMajorantWalk(PT_SCENE_ARG medium, o, d, tMax),
-                       MajorantSegment(0.0f, 0.0f, vec3(0.0f)), false, 0.0f, vec3(1.0f));
+PT_INLINE CollisionWalk startCollisionWalk(PT_IN(Medium) m, vec3 o, vec3 d, float tMax) {
+  return CollisionWalk(startMajorantWalk(m, o, d, tMax), MajorantSegment(0.0f, 0.0f, vec3(0.0f)),
+                       false, 0.0f, vec3(1.0f));
 }
 
 // The next tentative collision, at t along the ray (c.seg.sigmaMaj the majorant there, c.T
@@ -197,7 +199,7 @@ PT_INLINE uint trackFlight(PT_SCENE_PARAM PT_INOUT(VolumePath) v, vec3 o, vec3 d
   Medium m = loadMedium(PT_SCENE_ARG v.medium);
   g = m.g;
   p = o;
-  CollisionWalk c = startCollisionWalk(PT_SCENE_ARG v.medium, o, d, tMax);
+  CollisionWalk c = startCollisionWalk(m, o, d, tMax);
   float uMode = nextRandom(v.rng);
   float t;
   while (nextCollision(PT_SCENE_ARG c, h, v.rng, t)) {
@@ -225,7 +227,7 @@ PT_INLINE uint trackFlight(PT_SCENE_PARAM PT_INOUT(VolumePath) v, vec3 o, vec3 d
       v.path.beta *= T * mp.sigmaS / pdf;
       v.rU *= T * mp.sigmaS / pdf;
       return maxComponent(v.path.beta) > 0.0f && maxComponent(v.rU) > 0.0f ? kFlightScattered
-                                                                         : kFlightEnded;
+                                                                           : kFlightEnded;
     }
     vec3 sigmaN = max(sigmaMaj - mp.sigmaA - mp.sigmaS, vec3(0.0f));
     float pdf = T[h] * sigmaN[h];
@@ -259,9 +261,9 @@ struct ShadowTransmittance {
 };
 
 PT_INLINE ShadowTransmittance startShadowTransmittance(PT_SCENE_PARAM VertexKey key) {
-  return ShadowTransmittance(vec3(1.0f), vec3(1.0f), vec3(1.0f),
-                             makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed,
-                                              kStreamShadowFlight));
+  return ShadowTransmittance(
+      vec3(1.0f), vec3(1.0f), vec3(1.0f),
+      makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed, kStreamShadowFlight));
 }
 
 // Ratio tracking over the shadow ray's segment o + t d (d unit), t in [0, tMax), in `medium`
@@ -270,7 +272,7 @@ PT_INLINE ShadowTransmittance startShadowTransmittance(PT_SCENE_PARAM VertexKey 
 PT_INLINE bool trackShadowSegment(PT_SCENE_PARAM PT_INOUT(ShadowTransmittance) tr, uint medium,
                                   uint h, vec3 o, vec3 d, float tMax) {
   Medium m = loadMedium(PT_SCENE_ARG medium);
-  CollisionWalk c = startCollisionWalk(PT_SCENE_ARG medium, o, d, tMax);
+  CollisionWalk c = startCollisionWalk(m, o, d, tMax);
   float t;
   while (nextCollision(PT_SCENE_ARG c, h, tr.rng, t)) {
     vec3 sigmaMaj = c.seg.sigmaMaj;
@@ -328,9 +330,8 @@ PT_INLINE SurfacePoint mediumPoint(vec3 p, vec3 wo, float g) {
 // scatters with value f (times its cosine) and samples the light's direction with density
 // scatterPdf; weighed against that sampling by the balance heuristic over all three heroes
 // (not for delta lights, nor with light sampling alone).
-PT_INLINE vec3 volumeLightContribution(PT_SCENE_PARAM PT_IN(VolumePath) v, vec3 f,
-                                       float scatterPdf, PT_IN(LightSample) ls,
-                                       PT_IN(ShadowTransmittance) tr) {
+PT_INLINE vec3 volumeLightContribution(PT_SCENE_PARAM PT_IN(VolumePath) v, vec3 f, float scatterPdf,
+                                       PT_IN(LightSample) ls, PT_IN(ShadowTransmittance) tr) {
   vec3 rL = v.rU * tr.rL * ls.lightPdf;
   vec3 rU = v.rU * tr.rU * scatterPdf;
   vec3 c = v.path.beta * f * tr.T * ls.Li;
@@ -376,13 +377,11 @@ PT_INLINE void addVolumeEnvironmentFound(PT_SCENE_PARAM PT_INOUT(VolumePath) v, 
 
 // The phase function's sample at a point of a medium: the next direction (from wo, the
 // direction back along the ray), its density as the next vertex's rL. False: none.
-PT_INLINE bool scatterInMedium(PT_INOUT(VolumePath) v, vec3 wo, float g, vec2 u,
-                               PT_OUT(vec3) wi) {
+PT_INLINE bool scatterInMedium(PT_INOUT(VolumePath) v, vec3 wo, float g, vec2 u, PT_OUT(vec3) wi) {
   float pdf;
   wi = sampleHenyeyGreenstein(wo, g, u, pdf);
   if (!(pdf > 0.0f)) return false;
   // The phase function's value over its density is one: beta is unchanged.
-  v.path.bsdfPdf = pdf;
   v.rL = v.rU / pdf;
   v.path.specularBounce = false;
   return true;

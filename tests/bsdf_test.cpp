@@ -132,8 +132,8 @@ Material coatedDiffuse(const CoatParams& p) {
 
 std::string describe(const Material& m) {
   std::ostringstream s;
-  static const char* const kNames[] = {"diffuse",      "mirror",         "conductor",
-                                       "dielectric",   "thindielectric", "diffusetransmission",
+  static const char* const kNames[] = {"diffuse",       "mirror",         "conductor",
+                                       "dielectric",    "thindielectric", "diffusetransmission",
                                        "coateddiffuse", "interface"};
   s << (m.type < kMaterialTypeCount ? kNames[m.type] : "?") << " alpha " << m.alphaX << "/"
     << m.alphaY << " eta " << m.eta.x;

@@ -157,15 +157,15 @@ TEST(MediaPbrt, PresetsArePbrtV4sMeasuredMediaWithSigmaPrimeSAsSigmaS) {
 // ---- pbrt-v4: grids -----------------------------------------------------------------------
 
 TEST(MediaPbrt, UniformGridStoresDensityXFastestAndItsEmissionGrid) {
-  const Scene s = pbrtScene(
-      std::string(kUnmirrored) +
-      "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\"\n"
-      "  \"integer nx\" 3 \"integer ny\" 2 \"integer nz\" 1\n"
-      "  \"float density\" [0 1 2 3 4 5] \"point3 p0\" [-1 -2 -3] \"point3 p1\" [1 2 3]\n"
-      "  \"rgb sigma_a\" [0.5 1 2] \"float scale\" 4 \"rgb Le\" [1 0.5 0.25]\n"
-      "  \"float Lescale\" [6 7 8 9 10 11]\n"
-      "MediumInterface \"smoke\" \"\"\n" +
-      kTriangle);
+  const Scene s =
+      pbrtScene(std::string(kUnmirrored) +
+                "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\"\n"
+                "  \"integer nx\" 3 \"integer ny\" 2 \"integer nz\" 1\n"
+                "  \"float density\" [0 1 2 3 4 5] \"point3 p0\" [-1 -2 -3] \"point3 p1\" [1 2 3]\n"
+                "  \"rgb sigma_a\" [0.5 1 2] \"float scale\" 4 \"rgb Le\" [1 0.5 0.25]\n"
+                "  \"float Lescale\" [6 7 8 9 10 11]\n"
+                "MediumInterface \"smoke\" \"\"\n" +
+                kTriangle);
   ASSERT_EQ(s.media.size(), 1u);
   const Medium& m = s.media[0];
   EXPECT_EQ(m.type, kMediumUniformGrid);
@@ -202,13 +202,14 @@ TEST(MediaPbrt, UniformGridStoresDensityXFastestAndItsEmissionGrid) {
 }
 
 TEST(MediaPbrt, RgbGridHasItsScalesInItsGrids) {
-  const Scene s = pbrtScene(std::string(kUnmirrored) +
-                            "MakeNamedMedium \"c\" \"string type\" \"rgbgrid\"\n"
-                            "  \"integer nx\" 2 \"rgb sigma_a\" [1 2 3  4 5 6]\n"
-                            "  \"rgb sigma_s\" [0.5 0.5 0.5  1 1 1] \"float scale\" 2\n"
-                            "  \"rgb Le\" [2 4 6  8 10 12] \"float Lescale\" 0.5 \"float g\" -0.25\n"
-                            "MediumInterface \"\" \"c\"\n" +
-                            kTriangle);
+  const Scene s =
+      pbrtScene(std::string(kUnmirrored) +
+                "MakeNamedMedium \"c\" \"string type\" \"rgbgrid\"\n"
+                "  \"integer nx\" 2 \"rgb sigma_a\" [1 2 3  4 5 6]\n"
+                "  \"rgb sigma_s\" [0.5 0.5 0.5  1 1 1] \"float scale\" 2\n"
+                "  \"rgb Le\" [2 4 6  8 10 12] \"float Lescale\" 0.5 \"float g\" -0.25\n"
+                "MediumInterface \"\" \"c\"\n" +
+                kTriangle);
   ASSERT_EQ(s.media.size(), 1u);
   const Medium& m = s.media[0];
   EXPECT_EQ(m.type, kMediumRgbGrid);
@@ -219,8 +220,7 @@ TEST(MediaPbrt, RgbGridHasItsScalesInItsGrids) {
   EXPECT_EQ(m.Le, vec3(1.0f));
   EXPECT_EQ(m.emissive, 1u);
   // sigma_a's RGB per voxel, then sigma_s's, times scale; then Le times Lescale.
-  EXPECT_EQ(grid(s, m.density, 12),
-            (std::vector<float>{2, 4, 6, 8, 10, 12, 1, 1, 1, 2, 2, 2}));
+  EXPECT_EQ(grid(s, m.density, 12), (std::vector<float>{2, 4, 6, 8, 10, 12, 1, 1, 1, 2, 2, 2}));
   EXPECT_EQ(grid(s, m.emission, 6), (std::vector<float>{1, 2, 3, 4, 5, 6}));
   EXPECT_EQ(s.mediumInterfaces[0].inside, kNoMedium);
   EXPECT_EQ(s.mediumInterfaces[0].outside, 0u);
@@ -254,8 +254,8 @@ TEST(MediaPbrt, TheCtmAtMakeNamedMediumPlacesAGrid) {
   // A camera that pbrt's left-handed space makes this renderer mirror in x: the medium is
   // mirrored with the triangles.
   const Scene mirrored = pbrtScene(
-      "LookAt 0 0 -10  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nTranslate 1 2 3\n" +
-      grid + use);
+      "LookAt 0 0 -10  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nTranslate 1 2 3\n" + grid +
+      use);
   expectNear(toMedium(mirrored.media[0], {-1, 2, 3}), {0, 0, 0}, "mirrored origin");
   expectNear(toMedium(mirrored.media[0], {-2, 2, 3}), {1, 0, 0}, "mirrored x");
 
@@ -332,13 +332,14 @@ TEST(MediaPbrt, TheCameraIsInTheOutsideMediumCurrentAtCamera) {
 
 TEST(MediaPbrt, InterfaceShapesAreKeptWhereTheyBoundAMedium) {
   const std::string fog = "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n";
-  const Scene s = pbrtScene(std::string(kUnmirrored) + fog + kTriangle +
-                            "AttributeBegin\nMaterial \"interface\"\nMediumInterface \"fog\" \"\"\n" +
-                            kTriangle + "AttributeEnd\n" +
-                            // defined after its use, with an area light: the light is ignored
-                            "AttributeBegin\nNamedMaterial \"later\"\nMediumInterface \"\" \"fog\"\n" +
-                            "AreaLightSource \"diffuse\"\n" + kTriangle + "AttributeEnd\n" +
-                            "MakeNamedMaterial \"later\" \"string type\" \"interface\"\n");
+  const Scene s =
+      pbrtScene(std::string(kUnmirrored) + fog + kTriangle +
+                "AttributeBegin\nMaterial \"interface\"\nMediumInterface \"fog\" \"\"\n" +
+                kTriangle + "AttributeEnd\n" +
+                // defined after its use, with an area light: the light is ignored
+                "AttributeBegin\nNamedMaterial \"later\"\nMediumInterface \"\" \"fog\"\n" +
+                "AreaLightSource \"diffuse\"\n" + kTriangle + "AttributeEnd\n" +
+                "MakeNamedMaterial \"later\" \"string type\" \"interface\"\n");
   ASSERT_EQ(s.triangles.size(), 3u);
   ASSERT_EQ(s.materials.size(), 3u);
   EXPECT_EQ(s.materials[s.triangles[0].material].type, kMaterialDiffuse);
@@ -355,9 +356,9 @@ TEST(MediaPbrt, InterfaceShapesAreKeptWhereTheyBoundAMedium) {
       << s.warnings[0];
 
   // Without a medium they change nothing and go silently; the scene has no media fields.
-  const Scene none = pbrtScene(std::string(kUnmirrored) + fog + kTriangle +
-                               "Material \"interface\"\n" + kTriangle + "MediumInterface \"fog\"\n" +
-                               kTriangle);
+  const Scene none =
+      pbrtScene(std::string(kUnmirrored) + fog + kTriangle + "Material \"interface\"\n" +
+                kTriangle + "MediumInterface \"fog\"\n" + kTriangle);
   EXPECT_EQ(none.triangles.size(), 1u);
   EXPECT_TRUE(none.warnings.empty());
   expectNoMedia(none);
@@ -434,13 +435,17 @@ TEST(MediaPbrt, EveryErrorIsOneLineAtItsPlace) {
     return w + "MakeNamedMedium \"m\" \"string type\" \"rgbgrid\" " + params + "\n" + use;
   };
   const std::pair<std::string, std::string> cases[] = {
-      {w + "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
-           "MediumInterface \"fgo\" \"\"\n" + kTriangle,
+      {w +
+           "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+           "MediumInterface \"fgo\" \"\"\n" +
+           kTriangle,
        "scene.pbrt:6:17: MediumInterface: no medium named 'fgo' (did you mean 'fog'?)"},
       {w + "MediumInterface \"\" \"nowhere\"\n" + kTriangle,
        "scene.pbrt:5:20: MediumInterface: no medium named 'nowhere'"},
-      {w + "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n"
-           "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n" + use,
+      {w +
+           "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n"
+           "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n" +
+           use,
        "scene.pbrt:6:1: named medium 'm' redefined (first at scene.pbrt:5)"},
       {w + "MakeNamedMedium \"m\" \"float g\" 0\n" + use,
        "scene.pbrt:5:1: MakeNamedMedium 'm' needs a \"string type\" parameter"},
@@ -455,15 +460,17 @@ TEST(MediaPbrt, EveryErrorIsOneLineAtItsPlace) {
       {w + "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float scale\" -1\n" + use,
        "scene.pbrt:5:49: 'scale' of MakeNamedMedium 'm': expected a non-negative number that "
        "fits a 32-bit float, got -1"},
-      {w + "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 -1 1]\n" +
-           use,
+      {w + "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 -1 1]\n" + use,
        "scene.pbrt:5:49: rgb 'sigma_a' of MakeNamedMedium 'm' has a negative component"},
-      {w + "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [1e38 1 1] "
-           "\"float scale\" 10\n" + use,
+      {w +
+           "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [1e38 1 1] "
+           "\"float scale\" 10\n" +
+           use,
        "scene.pbrt:5:74: 'scale' of MakeNamedMedium 'm': 'sigma_s' times 'scale' does not fit a "
        "32-bit float"},
-      {grid(""), "scene.pbrt:5:1: 'density' of MakeNamedMedium 'm': is required: one value per "
-                 "voxel"},
+      {grid(""),
+       "scene.pbrt:5:1: 'density' of MakeNamedMedium 'm': is required: one value per "
+       "voxel"},
       {grid("\"integer nx\" 2 \"integer ny\" 2 \"float density\" [1 2 3]"),
        "scene.pbrt:5:79: 'density' of MakeNamedMedium 'm': has 3 values; expected nx * ny * nz "
        "= 4"},
@@ -493,8 +500,10 @@ TEST(MediaPbrt, EveryErrorIsOneLineAtItsPlace) {
       {rgb("\"integer nx\" 2 \"rgb sigma_a\" [1 1 1]"),
        "scene.pbrt:5:60: 'sigma_a' of MakeNamedMedium 'm': has 1 RGB value; expected nx * ny * "
        "nz = 2"},
-      {w + "Scale 1 0 1\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" "
-           "[1]\nIdentity\n" + use,
+      {w +
+           "Scale 1 0 1\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" "
+           "[1]\nIdentity\n" +
+           use,
        "scene.pbrt:6:1: MakeNamedMedium 'm': the CTM is singular or too large (a grid medium "
        "needs an invertible transform)"},
   };
@@ -557,9 +566,9 @@ TEST(MediaJson, HomogeneousWithDefaultsAndPbrtV4sNames) {
 }
 
 TEST(MediaJson, PresetsAreThePbrtTable) {
-  const Scene s = jsonScene(jsonText(
-      R"([{"name": "milk", "type": "homogeneous", "preset": "Wholemilk", "scale": 100}])", "",
-      R"(, "medium": "milk")"));
+  const Scene s = jsonScene(
+      jsonText(R"([{"name": "milk", "type": "homogeneous", "preset": "Wholemilk", "scale": 100}])",
+               "", R"(, "medium": "milk")"));
   ASSERT_EQ(s.media.size(), 1u);
   expectNear(s.media[0].sigmaS, glm::dvec3(255, 321, 377), "sigma_s");
   expectNear(s.media[0].sigmaA, glm::dvec3(0.11, 0.24, 1.4), "sigma_a");
@@ -592,10 +601,10 @@ TEST(MediaJson, GridsTheirOrderOffsetsAndTransform) {
   EXPECT_EQ(cloud.type, kMediumRgbGrid);
   EXPECT_EQ(cloud.density, 8u);
   EXPECT_EQ(cloud.emission, 20u);
-  EXPECT_EQ(s.mediumGrids,
-            (std::vector<float>{0, 1, 2, 3, 4, 5, 6, 7,                                 // smoke
-                                0.5f, 1, 1.5f, 2, 2.5f, 3, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f,  // cloud
-                                6, 6, 6, 0, 0, 0}));
+  EXPECT_EQ(s.mediumGrids, (std::vector<float>{0,    1,    2,    3,    4,    5, 6,    7,  // smoke
+                                               0.5f, 1,    1.5f, 2,    2.5f, 3, 0.5f, 0.5f,
+                                               0.5f, 0.5f, 0.5f, 0.5f,  // cloud
+                                               6,    6,    6,    0,    0,    0}));
   // World (10, 0, 0) is the medium's origin, world (12, 0, 0) its (1, 0, 0).
   expectNear(toMedium(smoke, {10, 0, 0}), {0, 0, 0}, "origin");
   expectNear(toMedium(smoke, {12, 0, 0}), {1, 0, 0}, "x");
@@ -611,7 +620,8 @@ TEST(MediaJson, InterfaceShapesAreKeptOnlyWhereTheyBoundAMedium) {
   EXPECT_EQ(kept.materials[kept.triangles[1].material].type, kMaterialInterface);
   EXPECT_EQ(kept.mediumInterfaces[1].outside, 0u);
   EXPECT_EQ(kept.mediumInterfaces[0].outside, kNoMedium);
-  const Scene dropped = jsonScene(jsonText(media, glass + R"(, "exterior": "fog", "interior": "fog")"));
+  const Scene dropped =
+      jsonScene(jsonText(media, glass + R"(, "exterior": "fog", "interior": "fog")"));
   EXPECT_EQ(dropped.triangles.size(), 1u);
   expectNoMedia(dropped);
 }
@@ -655,13 +665,15 @@ TEST(MediaJson, EveryErrorNamesItsField) {
        "media[0].density[1]: expected a non-negative number that fits a 32-bit float, got -1"},
       {jsonText(R"([{"name": "m", "type": "uniformgrid", "density": [1], "p0": [0, 2, 0]}])"),
        "media[0]: 'p1': expected p0 < p1 on every axis, got p0 (0, 2, 0) and p1 (1, 1, 1)"},
-      {jsonText(R"([{"name": "m", "type": "rgbgrid", "nx": 2, "sigma_s": [[1, 1, 1], [1, -1, 1]]}])"),
+      {jsonText(
+           R"([{"name": "m", "type": "rgbgrid", "nx": 2, "sigma_s": [[1, 1, 1], [1, -1, 1]]}])"),
        "media[0].sigma_s[1][1]: expected a non-negative number that fits a 32-bit float, got -1"},
       {jsonText(R"([{"name": "m", "type": "rgbgrid", "sigma_a": [[1, 1]]}])"),
        "media[0].sigma_a[0]: expected an array of 3 numbers, got an array of 2 elements"},
       {jsonText(R"([{"name": "m", "type": "rgbgrid", "nx": 0, "sigma_a": [[1, 1, 1]]}])"),
        "media[0].nx: expected an integer in [1, 2147483647], got the number 0"},
-      {jsonText(R"([{"name": "m", "type": "uniformgrid", "density": [1], "transform": {"scale": 1e-39}}])"),
+      {jsonText(
+           R"([{"name": "m", "type": "uniformgrid", "density": [1], "transform": {"scale": 1e-39}}])"),
        "media[0].transform: its inverse does not fit 32-bit floats (a scale too close to 0)"},
       {interfaceOnly,
        "shapes: no triangles left: all 1 have zero area or belong to \"interface\" shapes that "

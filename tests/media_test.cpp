@@ -71,8 +71,8 @@ std::vector<Triangle> box(vec3 lo, vec3 hi) {
   const vec3 c = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
   const vec3 x(h.x, 0, 0), y(0, h.y, 0), z(0, 0, h.z);
   std::vector<Triangle> tris;
-  for (const auto& q : {quad(c + x, y, z), quad(c - x, z, y), quad(c + y, z, x),
-                        quad(c - y, x, z), quad(c + z, x, y), quad(c - z, y, x)}) {
+  for (const auto& q : {quad(c + x, y, z), quad(c - x, z, y), quad(c + y, z, x), quad(c - y, x, z),
+                        quad(c + z, x, y), quad(c - z, y, x)}) {
     tris.insert(tris.end(), q.begin(), q.end());
   }
   return tris;
@@ -139,8 +139,8 @@ TEST(MediaBothBackends, BeerLambertThroughAnAbsorbingSlab) {
       const double meanT = (e.x + e.y + e.z) / 3.0;
       for (int c = 0; c < 3; ++c) {
         const double sd = e[c] * std::sqrt(1.0 / meanT - 1.0) / std::sqrt(double(kSpp));
-        EXPECT_NEAR(image->pixels[i][c], e[c], 5.0 * sd + 1e-4) << "pixel " << i << " channel "
-                                                                << c;
+        EXPECT_NEAR(image->pixels[i][c], e[c], 5.0 * sd + 1e-4)
+            << "pixel " << i << " channel " << c;
       }
       mean += glm::dvec3(image->pixels[i]);
       expectedMean += glm::dvec3(e);
@@ -326,8 +326,7 @@ TEST(MediaBothBackends, ZeroAndHugeCoefficientsStayFinite) {
     Scene scene = base;
     scene.lights = {environment(1.0f)};
     scene.media = {homogeneous(vec3(0.0f), vec3(1e6f), 0.5f)};
-    addShape(scene, box(vec3(-0.3f, -3, -0.5f), vec3(3, 3, 0.5f)), 0,
-             MediumInterface{0, kVacuum});
+    addShape(scene, box(vec3(-0.3f, -3, -0.5f), vec3(3, 3, 0.5f)), 0, MediumInterface{0, kVacuum});
     scene.camera = camera(vec3(-0.3f, 0, -5), vec3(-0.3f, 0, 0), 10.0f, 8);
     const Comparison cmp = renderBoth(prepare(scene, 64), 4);
     EXPECT_EQ(cmp.gpu.invalidSamples, 0u);
@@ -354,8 +353,8 @@ Scene nestedMediaScene(int size) {
   scene.materials = {Material{vec3(0.0f), kMaterialInterface, vec3(0.0f), 0},
                      Material{vec3(0.6f), kMaterialDiffuse, vec3(0.0f), 0},
                      Material{vec3(0.0f), kMaterialDiffuse, vec3(12.0f, 10.0f, 8.0f), 0}, glass};
-  scene.media = {homogeneous(vec3(0.01f), vec3(0.08f), 0.3f),            // 0: fog
-                 homogeneous(vec3(0.1f, 0.6f, 2.0f), vec3(0.0f)),        // 1: tea
+  scene.media = {homogeneous(vec3(0.01f), vec3(0.08f), 0.3f),               // 0: fog
+                 homogeneous(vec3(0.1f, 0.6f, 2.0f), vec3(0.0f)),           // 1: tea
                  homogeneous(vec3(0.05f), vec3(1.5f, 0.8f, 0.3f), -0.4f)};  // 2: smoke
   std::vector<float> density(4 * 4 * 4, 0.0f);
   for (int i = 0; i < 64; i += 3) density[size_t(i)] = 2.0f;  // empty cells between
@@ -370,7 +369,8 @@ Scene nestedMediaScene(int size) {
            MediumInterface{kVacuum, kVacuum});
   addShape(scene, sphere(vec3(-1.2f, 0.8f, 0), 0.8f), 3, MediumInterface{tea, fog});
   addShape(scene, sphere(vec3(0.3f, 0.6f, -1.5f), 0.6f), 0, MediumInterface{smoke, fog});
-  addShape(scene, box(vec3(1.2f, 0.05f, -1), vec3(2.8f, 1.6f, 0.6f)), 0, MediumInterface{grid, fog});
+  addShape(scene, box(vec3(1.2f, 0.05f, -1), vec3(2.8f, 1.6f, 0.6f)), 0,
+           MediumInterface{grid, fog});
   return scene;
 }
 
@@ -402,7 +402,8 @@ TEST(Media, InterfacesFollowTheVertexNormals) {
   scene.camera = camera(vec3(0, 0, -5), vec3(0, 0, 0), 20.0f, 4);
   scene.materials = {Material{vec3(0.0f), kMaterialInterface, vec3(0.0f), 0}};
   scene.media = {homogeneous(vec3(1.0f), vec3(0.0f))};
-  addShape(scene, quad(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0)), 0, MediumInterface{0, kVacuum});
+  addShape(scene, quad(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0)), 0,
+           MediumInterface{0, kVacuum});
   const vec3 z(0, 0, 1);
   scene.normals = {TriangleNormals{-z, 0, -z, 0, -z, 0}, TriangleNormals{z, 0, z, 0, z, 0}};
   const SceneData data = prepare(scene);
@@ -480,8 +481,8 @@ test::Chi2Result flightChi2(const FlightSetup& setup, float tMax, double (*optic
     float g;
     const uint flight = trackFlight(ps, v, vec3(0.0f), vec3(1, 0, 0), tMax, p, g);
     EXPECT_NE(flight, kFlightEnded);  // nothing absorbs
-    const int cell = flight == kFlightScattered ? std::min(kCells - 1, int(p.x / tMax * kCells))
-                                                : kCells;
+    const int cell =
+        flight == kFlightScattered ? std::min(kCells - 1, int(p.x / tMax * kCells)) : kCells;
     observed[size_t(cell)] += 1.0;
   }
   for (int c = 0; c < kCells; ++c) {

@@ -97,14 +97,13 @@ KeyValues imageSettings(const SceneData& data, const RenderSettings& settings,
   // Media only where the scene has them (the settings of scenes without stay as they were).
   if (!data.media.empty()) {
     const std::vector<uint32_t> cameraMedium{p.cameraMedium};
-    s.emplace_back(
-        "media",
-        hexHash(hashBytes(
-            data.media.data(), data.media.size() * sizeof(Medium),
-            hashBytes(data.mediumGrids.data(), data.mediumGrids.size() * sizeof(float),
-                      hashBytes(data.mediumInterfaces.data(),
-                                data.mediumInterfaces.size() * sizeof(MediumInterface),
-                                hashBytes(cameraMedium.data(), sizeof(uint32_t)))))));
+    s.emplace_back("media",
+                   hexHash(hashBytes(
+                       data.media.data(), data.media.size() * sizeof(Medium),
+                       hashBytes(data.mediumGrids.data(), data.mediumGrids.size() * sizeof(float),
+                                 hashBytes(data.mediumInterfaces.data(),
+                                           data.mediumInterfaces.size() * sizeof(MediumInterface),
+                                           hashBytes(cameraMedium.data(), sizeof(uint32_t)))))));
   }
   s.insert(s.end(), backendExtra.begin(), backendExtra.end());
   return s;

@@ -39,7 +39,8 @@ bool traceShadowThroughMedia(const SceneData& scene, const PathScene& ps, const 
       }
     }
     if (tri == nullptr) return true;
-    medium = crossInterface(ps, hit->triangle, *tri, hit->barycentrics, ray.direction, medium, from);
+    medium =
+        crossInterface(ps, hit->triangle, *tri, hit->barycentrics, ray.direction, medium, from);
   }
   return false;
 }
@@ -112,15 +113,15 @@ vec3 sampleRadianceVolume(const SceneData& scene, uvec2 imagePixel, uint32_t sam
     // A surface that only bounds media: the ray goes on beyond it, in the medium there.
     if (scene.materials[tri.material].type == kMaterialInterface) {
       if (++crossings > kMaxInterfaceCrossings) break;
-      v.medium =
-          crossInterface(ps, hit->triangle, tri, hit->barycentrics, ray.direction, v.medium,
-                         ray.origin);
+      v.medium = crossInterface(ps, hit->triangle, tri, hit->barycentrics, ray.direction, v.medium,
+                                ray.origin);
       continue;
     }
-    const SurfacePoint s = surfacePointAt(ps, hit->triangle, tri, hit->barycentrics, -ray.direction);
+    const SurfacePoint s =
+        surfacePointAt(ps, hit->triangle, tri, hit->barycentrics, -ray.direction);
     if (debugPrint) {
-      std::fprintf(stderr, "cpu depth %u: hit triangle %u (primitive %u) t=%g medium %d\n",
-                   v.depth, hit->triangle, tri.primitive, hit->t, int(v.medium));
+      std::fprintf(stderr, "cpu depth %u: hit triangle %u (primitive %u) t=%g medium %d\n", v.depth,
+                   hit->triangle, tri.primitive, hit->t, int(v.medium));
     }
 
     // Emitted light found by this ray, weighed against light sampling.

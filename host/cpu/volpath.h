@@ -10,7 +10,7 @@ namespace pt {
 
 // Radiance along one path sample of image pixel (x, y), as sampleRadiance (integrator.h),
 // which calls it for a scene with media.
-vec3 sampleRadianceVolume(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex,
-                          uint64_t& rays, bool debugPrint = false);
+vec3 sampleRadianceVolume(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
+                          bool debugPrint = false);
 
 }  // namespace pt

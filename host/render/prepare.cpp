@@ -419,9 +419,8 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   fx.watertight = !settings.fastIntersection;
   fx.sobol = p.samplerType == kSamplerSobol;
   fx.mis = fx.lightSampling && fx.bsdfEmission && p.strategy == kStrategyMis;
-  fx.russianRoulette =
-      p.russianRoulette != 0 && scatters &&
-      (fx.diffuse || fx.mirror || fx.hasBsdfMaterials() || fx.media);
+  fx.russianRoulette = p.russianRoulette != 0 && scatters &&
+                       (fx.diffuse || fx.mirror || fx.hasBsdfMaterials() || fx.media);
   return data;
 }
 

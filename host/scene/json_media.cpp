@@ -21,8 +21,8 @@ constexpr std::int64_t kMaxVoxels = std::numeric_limits<int>::max();
 
 // The keys a medium of `type` takes.
 std::vector<std::string_view> mediumKeys(uint type) {
-  std::vector<std::string_view> keys = {"name", "type", "sigma_a", "sigma_s", "scale",
-                                        "g",    "Le",   "Lescale"};
+  std::vector<std::string_view> keys = {"name",  "type", "sigma_a", "sigma_s",
+                                        "scale", "g",    "Le",      "Lescale"};
   if (type == kMediumHomogeneous) {
     keys.push_back("preset");
   } else {

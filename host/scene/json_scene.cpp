@@ -20,11 +20,11 @@
 #include "common/check.h"
 #include "common/named_values.h"
 #include "scene/camera_filter.h"
-#include "scene/json_reader.h"
-#include "scene/media.h"
 #include "scene/json_media.h"
+#include "scene/json_reader.h"
 #include "scene/json_textures.h"
 #include "scene/json_transform.h"
+#include "scene/media.h"
 #include "scene/mtl_materials.h"
 #include "scene/obj_mesh.h"
 #include "scene/ply_mesh.h"
@@ -35,14 +35,14 @@ namespace pt {
 
 namespace {
 
-using scene_detail::JsonNode;
 using scene_detail::JsonMedia;
+using scene_detail::JsonNode;
 using scene_detail::JsonTextures;
+using scene_detail::quotedPath;
 using scene_detail::readRotation;
 using scene_detail::readTransform;
-using scene_detail::Transform;
-using scene_detail::quotedPath;
 using scene_detail::singleQuoted;
+using scene_detail::Transform;
 using Tri = std::array<glm::dvec3, 3>;
 
 constexpr std::int64_t kMaxResolution = 16384;  // keeps width * height well inside int
@@ -777,8 +777,8 @@ void emitTriangles(const JsonNode& shape, const ShapeTriangles& shapeTriangles,
   }
 }
 
-void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, const JsonMedia& media,
-                Scene& scene) {
+void readShapes(const JsonNode& node, const std::filesystem::path& scenePath,
+                const JsonMedia& media, Scene& scene) {
   if (node.size() == 0) node.fail("expected at least one shape");
   std::unordered_map<std::string, uint> materialIndex;
   // Views into a copy of the JSON's material names: shapes with "materials": "mtl" append to
@@ -806,13 +806,16 @@ void readShapes(const JsonNode& node, const std::filesystem::path& scenePath, co
     const Kind kind = readChoice(shape.require("type"), kKinds, "shape type");
     switch (kind) {
       case Kind::kQuad:
-        shape.checkKeys({"type", "name", "material", "vertices", "transform", "interior", "exterior"});
+        shape.checkKeys(
+            {"type", "name", "material", "vertices", "transform", "interior", "exterior"});
         break;
       case Kind::kTriangles:
-        shape.checkKeys({"type", "name", "material", "vertices", "indices", "transform", "interior", "exterior"});
+        shape.checkKeys({"type", "name", "material", "vertices", "indices", "transform", "interior",
+                         "exterior"});
         break;
       case Kind::kObj:
-        shape.checkKeys({"type", "name", "material", "materials", "file", "transform", "interior", "exterior"});
+        shape.checkKeys(
+            {"type", "name", "material", "materials", "file", "transform", "interior", "exterior"});
         break;
       case Kind::kPly:
         shape.checkKeys({"type", "name", "material", "file", "transform", "interior", "exterior"});
@@ -1059,8 +1062,8 @@ Scene loadJsonScene(const std::filesystem::path& path) {
   }
   const nlohmann::json document = scene_detail::parseJson(text, file);
   const JsonNode root(document, "", file);
-  root.checkKeys({"description", "camera", "integrator", "textures", "media", "materials",
-                  "shapes", "lights"});
+  root.checkKeys({"description", "camera", "integrator", "textures", "media", "materials", "shapes",
+                  "lights"});
 
   Scene scene;
   if (auto n = root.find("description")) n->string();

@@ -13,8 +13,7 @@ namespace pt::scene_detail {
 glm::dvec3 Transform::apply(glm::dvec3 p) const {
   p *= scale;
   // Rodrigues' rotation formula (right-handed about axis).
-  p = p * cosAngle + glm::cross(axis, p) * sinAngle +
-      axis * (glm::dot(axis, p) * (1.0 - cosAngle));
+  p = p * cosAngle + glm::cross(axis, p) * sinAngle + axis * (glm::dot(axis, p) * (1.0 - cosAngle));
   return p + translate;
 }
 

@@ -63,22 +63,32 @@ const MediumPreset kPresets[] = {
     {"White Grapefruit Juice", {0.22826f, 0.23998f, 0.32748f}, {0.0138f, 0.018831f, 0.056781f}},
     {"Shampoo", {0.0007176f, 0.0008303f, 0.0009016f}, {0.014107f, 0.045693f, 0.061717f}},
     {"Strawberry Shampoo", {0.00015671f, 0.00015947f, 1.518e-05f}, {0.01449f, 0.05796f, 0.075823f}},
-    {"Head & Shoulders Shampoo", {0.023805f, 0.028804f, 0.034306f}, {0.084621f, 0.15688f, 0.20365f}},
+    {"Head & Shoulders Shampoo",
+     {0.023805f, 0.028804f, 0.034306f},
+     {0.084621f, 0.15688f, 0.20365f}},
     {"Lemon Tea Powder", {0.040224f, 0.045264f, 0.051081f}, {2.4288f, 4.5757f, 7.2127f}},
     {"Orange Powder", {0.00015617f, 0.00017482f, 0.0001762f}, {0.001449f, 0.003441f, 0.007863f}},
-    {"Pink Lemonade Powder", {0.00012103f, 0.00013073f, 0.00012528f}, {0.001165f, 0.002366f, 0.003195f}},
+    {"Pink Lemonade Powder",
+     {0.00012103f, 0.00013073f, 0.00012528f},
+     {0.001165f, 0.002366f, 0.003195f}},
     {"Cappuccino Powder", {1.8436f, 2.5851f, 2.1662f}, {35.844f, 49.547f, 61.084f}},
     {"Salt Powder", {0.027333f, 0.032451f, 0.031979f}, {0.28415f, 0.3257f, 0.34148f}},
     {"Sugar Powder", {0.00022272f, 0.00025513f, 0.000271f}, {0.012638f, 0.031051f, 0.050124f}},
     {"Suisse Mocha Powder", {2.7979f, 3.5452f, 4.3365f}, {17.502f, 27.004f, 35.433f}},
-    {"Pacific Ocean Surface Water", {0.0001764f, 0.00032095f, 0.00019617f}, {0.031845f, 0.031324f, 0.030147f}},
+    {"Pacific Ocean Surface Water",
+     {0.0001764f, 0.00032095f, 0.00019617f},
+     {0.031845f, 0.031324f, 0.030147f}},
 };
 
 constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
 
-bool fitsFloat(double v) { return std::fabs(v) <= kFloatMax; }
+bool fitsFloat(double v) {
+  return std::fabs(v) <= kFloatMax;
+}
 
-std::string number(double v) { return scene_detail::formatNumber(v); }
+std::string number(double v) {
+  return scene_detail::formatNumber(v);
+}
 
 std::string point(const glm::dvec3& p) {
   return "(" + number(p.x) + ", " + number(p.y) + ", " + number(p.z) + ")";
@@ -94,10 +104,10 @@ std::optional<MediumProblem> checkNonNegative(const char* param, const double* v
                                               std::size_t count) {
   for (std::size_t i = 0; i < count; ++i) {
     if (!(values[i] >= 0.0) || !fitsFloat(values[i])) {
-      return problem(param,
-                     "expected a non-negative number that fits a 32-bit float, got " +
-                         number(values[i]),
-                     count > 1 ? std::optional<std::size_t>(i) : std::nullopt);
+      return problem(
+          param,
+          "expected a non-negative number that fits a 32-bit float, got " + number(values[i]),
+          count > 1 ? std::optional<std::size_t>(i) : std::nullopt);
     }
   }
   return std::nullopt;
@@ -134,10 +144,9 @@ std::optional<MediumProblem> checkGrid(const char* param, const std::vector<floa
   }
   for (std::size_t i = 0; i < grid.size(); ++i) {
     if (!(grid[i] >= 0.0f) || !std::isfinite(grid[i])) {
-      return problem(param,
-                     "expected a non-negative number that fits a 32-bit float, got " +
-                         number(grid[i]),
-                     i);
+      return problem(
+          param, "expected a non-negative number that fits a 32-bit float, got " + number(grid[i]),
+          i);
     }
   }
   return std::nullopt;
@@ -148,7 +157,6 @@ float gridMax(const std::vector<float>& grid) {
   for (float v : grid) m = std::max(m, v);
   return m;
 }
-
 
 // Appends floats to the scene's grid buffer, returning the offset of the first.
 uint appendGrid(Scene& scene, const std::vector<float>& values) {
@@ -210,8 +218,8 @@ std::optional<MediumProblem> checkMedium(const MediumParams& m) {
   // Exact below 2^53, and beyond that no grid has as many values.
   const double voxels = double(m.nx) * double(m.ny) * double(m.nz);
   if (!(m.p0.x < m.p1.x && m.p0.y < m.p1.y && m.p0.z < m.p1.z)) {
-    return problem("p1", "expected p0 < p1 on every axis, got p0 " + point(m.p0) + " and p1 " +
-                             point(m.p1));
+    return problem(
+        "p1", "expected p0 < p1 on every axis, got p0 " + point(m.p0) + " and p1 " + point(m.p1));
   }
   for (const auto& [name, p] : {std::pair{"p0", m.p0}, std::pair{"p1", m.p1}}) {
     for (int a = 0; a < 3; ++a) {
@@ -296,8 +304,8 @@ void setMediumTransform(Medium& m, const glm::dmat4& mediumFromWorld) {
   vec4* rows[3] = {&m.toMedium0, &m.toMedium1, &m.toMedium2};
   for (int i = 0; i < 3; ++i) {
     // glm indexes [column][row].
-    *rows[i] = vec4(glm::dvec4(mediumFromWorld[0][i], mediumFromWorld[1][i],
-                               mediumFromWorld[2][i], mediumFromWorld[3][i]));
+    *rows[i] = vec4(glm::dvec4(mediumFromWorld[0][i], mediumFromWorld[1][i], mediumFromWorld[2][i],
+                               mediumFromWorld[3][i]));
   }
 }
 
@@ -315,9 +323,9 @@ std::size_t emissionFloats(const Medium& m) {
 }
 
 void keepUsedMedia(Scene& scene) {
-  PT_CHECK(scene.mediumInterfaces.empty() ||
-               scene.mediumInterfaces.size() == scene.triangles.size(),
-           "medium interfaces not parallel to the triangles");
+  PT_CHECK(
+      scene.mediumInterfaces.empty() || scene.mediumInterfaces.size() == scene.triangles.size(),
+      "medium interfaces not parallel to the triangles");
   std::vector<bool> used(scene.media.size(), false);
   const auto mark = [&](uint m) {
     if (m != kNoMedium) used.at(m) = true;

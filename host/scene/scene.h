@@ -109,7 +109,7 @@ struct Scene {
   std::vector<std::string> mediumNames;
   std::vector<float> mediumGrids;
   std::vector<MediumInterface> mediumInterfaces;
-  uint cameraMedium = kNoMedium;  // the medium the camera is in
+  uint cameraMedium = kNoMedium;      // the medium the camera is in
   std::vector<std::string> warnings;  // e.g. dropped zero-area triangles, one line each
 };
 

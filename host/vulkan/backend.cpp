@@ -196,11 +196,11 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
                     camera.lensRadius > 0.0f;
   // Scenes with media take the volume integrator's variant (also under --debug-pixel, whose
   // printing it leaves out).
-  const std::span<const uint32_t> spirv =
-      fx.media                     ? std::span<const uint32_t>(kPathtraceVolumeSpv)
-      : options.context.debugPrintf ? std::span<const uint32_t>(kPathtraceDebugSpv)
-      : full                        ? std::span<const uint32_t>(kPathtraceSpv)
-                                    : std::span<const uint32_t>(kPathtraceBaseSpv);
+  const std::span<const uint32_t> spirv = fx.media ? std::span<const uint32_t>(kPathtraceVolumeSpv)
+                                          : options.context.debugPrintf
+                                              ? std::span<const uint32_t>(kPathtraceDebugSpv)
+                                          : full ? std::span<const uint32_t>(kPathtraceSpv)
+                                                 : std::span<const uint32_t>(kPathtraceBaseSpv);
   return makeComputeProgram(ctx, spirv, bound, sizeof(PassConstants), &specInfo);
 }
 
@@ -500,10 +500,9 @@ KeyValues vulkanImageSettings(const VulkanRenderOptions& options) {
   const std::span<const uint32_t> volume(kPathtraceVolumeSpv);
   return {{"samples_per_fold", std::to_string(vulkanBatchSize(options))},
           {"specialize", options.specialize ? "on" : "off"},
-          {"shader", hexHash(hashBytes(
-                         spirv.data(), spirv.size_bytes(),
-                         hashBytes(base.data(), base.size_bytes(),
-                                   hashBytes(volume.data(), volume.size_bytes()))))}};
+          {"shader", hexHash(hashBytes(spirv.data(), spirv.size_bytes(),
+                                       hashBytes(base.data(), base.size_bytes(),
+                                                 hashBytes(volume.data(), volume.size_bytes()))))}};
 }
 
 uint32_t vulkanBatchSize(const VulkanRenderOptions& options) {

@@ -67,8 +67,8 @@ void Builder::makeNamedMedium(Statement& s) {
     fail(t->location, context + ": unknown medium type " + singleQuoted(type) +
                           (type == "heterogeneous"
                                ? " (pbrt-v3's name of pbrt-v4's \"uniformgrid\")"
-                               : scene_detail::didYouMean(type, {std::begin(kMediumTypes),
-                                                                 std::end(kMediumTypes)})));
+                               : scene_detail::didYouMean(
+                                     type, {std::begin(kMediumTypes), std::end(kMediumTypes)})));
   }
   const bool simulated = type == "homogeneous" || type == "uniformgrid" || type == "rgbgrid";
   if (simulated) {
@@ -141,21 +141,23 @@ void Builder::makeNamedMedium(Statement& s) {
         if (const Param* temperature = p.find("temperature", {ParamType::kFloat})) {
           if (p.find("Le")) {
             fail(temperature->location,
-                 context + ": both \"Le\" and \"temperature\" given (pbrt-v4 takes one or the "
-                           "other)");
+                 context +
+                     ": both \"Le\" and \"temperature\" given (pbrt-v4 takes one or the "
+                     "other)");
           }
           if (temperature->numbers.size() != m.density.size()) {
-            fail(temperature->location,
-                 "'temperature' of " + context + " has " +
-                     std::to_string(temperature->numbers.size()) + " values for " +
-                     std::to_string(m.density.size()) + " density values");
+            fail(temperature->location, "'temperature' of " + context + " has " +
+                                            std::to_string(temperature->numbers.size()) +
+                                            " values for " + std::to_string(m.density.size()) +
+                                            " density values");
           }
           for (const char* key : {"temperatureoffset", "temperaturecutoff", "temperaturescale"}) {
             p.number(key);
           }
           warnOnce("medium temperature", temperature->location,
-                   context + ": \"temperature\" (blackbody emission) is not simulated: the "
-                             "medium does not emit");
+                   context +
+                       ": \"temperature\" (blackbody emission) is not simulated: the "
+                       "medium does not emit");
         }
       } else {
         m.sigmaAGrid = floats(p, "sigma_a", ParamType::kRgb);
@@ -164,9 +166,10 @@ void Builder::makeNamedMedium(Statement& s) {
         if (auto v = p.number("Lescale")) m.LeScale = *v;
         if (m.sigmaAGrid.empty() != m.sigmaSGrid.empty()) {
           warnOnce("rgbgrid constant", s.location,
-                   context + ": the missing one of \"sigma_a\" and \"sigma_s\" is a grid of ones "
-                             "(pbrt-v4's is 1 everywhere, also in the half voxel at the bounds' "
-                             "faces where a grid's interpolation falls off)");
+                   context +
+                       ": the missing one of \"sigma_a\" and \"sigma_s\" is a grid of ones "
+                       "(pbrt-v4's is 1 everywhere, also in the half voxel at the bounds' "
+                       "faces where a grid's interpolation falls off)");
         }
       }
     }
@@ -218,8 +221,8 @@ std::vector<MediumInterface> Builder::resolveMedia() {
   for (std::size_t i = 0; i < mediumInterfaces_.size(); ++i) {
     const MediumNames& n = mediumInterfaces_[i];
     if (!n.used) continue;
-    resolved[i] = MediumInterface{find(n.inside, n.insideLocation),
-                                  find(n.outside, n.outsideLocation)};
+    resolved[i] =
+        MediumInterface{find(n.inside, n.insideLocation), find(n.outside, n.outsideLocation)};
   }
   // The media's transforms into this scene's world, mirrored in x where the camera asked for
   // it (setupCamera): world to medium is the inverse of world-from-medium, after the mirror.
