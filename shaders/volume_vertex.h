@@ -44,31 +44,9 @@ PT_INLINE float average(vec3 v) {
   return (v.x + v.y + v.z) / 3.0f;
 }
 
-// The natural logarithm of x > 0 (finite, normal), to within about an ulp, by the same
-// operations on both sides: delta tracking compares the distances it samples with the ends of
-// segments, and the shader's log() (lavapipe's is a cruder approximation) would move those
-// decisions apart from the CPU's. x = m 2^e with m in [sqrt(1/2), sqrt(2)), and log m =
-// 2 atanh(s) with s = (m - 1) / (m + 1), |s| < 0.172: its series to s^11.
-PT_INLINE float logarithm(float x) {
-  int bits = floatBitsToInt(x);
-  int e = ((bits >> 23) & 255) - 127;
-  float m = intBitsToFloat((bits & 0x007FFFFF) | 0x3F800000);
-  if (m > 1.41421356f) {
-    m *= 0.5f;
-    e += 1;
-  }
-  float s = (m - 1.0f) / (m + 1.0f);
-  float s2 = s * s;
-  float series =
-      1.0f +
-      s2 * (1.0f / 3.0f +
-            s2 * (1.0f / 5.0f + s2 * (1.0f / 7.0f + s2 * (1.0f / 9.0f + s2 * (1.0f / 11.0f)))));
-  return float(e) * 0.693147180559945f + 2.0f * s * series;
-}
-
 // An exponentially distributed distance of rate a (the density a exp(-a t)).
 PT_INLINE float sampleExponential(float u, float a) {
-  return -logarithm(1.0f - u) / a;
+  return -log(1.0f - u) / a;
 }
 
 // ---- The path ----------------------------------------------------------------------------
