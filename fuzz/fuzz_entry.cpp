@@ -122,20 +122,33 @@ void checkMedia(const Scene& scene) {
   for (const Medium& m : scene.media) {
     PT_CHECK(m.type < kMediumTypeCount && m.g >= -1.0f && m.g <= 1.0f, "media: bad type or g");
     PT_CHECK(m.majorants == kNoGrid, "media: majorants set by a reader");
-    for (const vec3& c : {m.sigmaA, m.sigmaS, m.Le}) {
+    // nanovdb and cloud media keep parameters in Le (shared_types.h), some of any sign.
+    const bool LeIsRadiance = m.type != kMediumNanoVdb && m.type != kMediumCloud;
+    for (const vec3& c : {m.sigmaA, m.sigmaS, LeIsRadiance ? m.Le : vec3(0.0f)}) {
       PT_CHECK(std::isfinite(c.x + c.y + c.z) && c.x >= 0 && c.y >= 0 && c.z >= 0,
                "media: bad coefficient");
     }
+    PT_CHECK(std::isfinite(m.Le.x + m.Le.y + m.Le.z), "media: bad Le");
     const auto inside = [&](uint offset, std::size_t count) {
       return offset == kNoGrid ? count == 0
                                : std::size_t(offset) + count <= scene.mediumGrids.size();
     };
-    PT_CHECK(inside(m.density, densityFloats(m)) && inside(m.emission, emissionFloats(m)),
+    PT_CHECK(inside(m.density, densityFloats(m, scene.mediumGrids)) &&
+                 inside(m.emission, emissionFloats(m, scene.mediumGrids)),
              "media: grid outside the grid buffer");
     PT_CHECK(m.type == kMediumHomogeneous || m.density != kNoGrid, "media: grid without density");
-  }
-  for (float v : scene.mediumGrids) {
-    PT_CHECK(std::isfinite(v) && v >= 0.0f, "media: bad grid value");
+    // Dense grids: values non-negative and finite (sparse grids hold integers as bits).
+    if (m.type == kMediumUniformGrid || m.type == kMediumRgbGrid) {
+      for (uint offset : {m.density, m.emission}) {
+        if (offset == kNoGrid) continue;
+        const std::size_t count = offset == m.density ? densityFloats(m, scene.mediumGrids)
+                                                      : emissionFloats(m, scene.mediumGrids);
+        for (std::size_t i = 0; i < count; ++i) {
+          const float v = scene.mediumGrids[offset + i];
+          PT_CHECK(std::isfinite(v) && v >= 0.0f, "media: bad grid value");
+        }
+      }
+    }
   }
 }
 

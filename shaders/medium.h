@@ -6,7 +6,8 @@
 // material's medium uses it too). What a path does in a medium is volume_vertex.h's.
 //
 // What the functions read: in C++ the PathScene's media and grid floats (path_vertex.h); in
-// GLSL the includer defines loadMedium(i) and mediumGridFloat(i) before including this.
+// GLSL the includer defines loadMedium(i), mediumGridFloat(i) and mediumGridWord(i) (the same
+// float's bits) before including this.
 // PT_MEDIUM_LOOP_TICK() is called once per step of the grid's majorant walk (the shader counts
 // its loops for lavapipe's cap).
 #ifndef PT_MEDIUM_H
@@ -26,6 +27,16 @@ inline const Medium& loadMedium(const PathScene& scene, uint i) {
 inline float mediumGridFloat(const PathScene& scene, uint i) {
   return scene.mediumGrids[i];
 }
+inline uint mediumGridWord(const PathScene& scene, uint i) {
+  return floatBitsToUint(scene.mediumGrids[i]);
+}
+}  // namespace pt
+#endif
+
+#include "noise.h"
+
+#ifdef __cplusplus
+namespace pt {
 #endif
 
 // A medium's coefficients at a point (pbrt-v4's MediumProperties; the phase function is
@@ -84,6 +95,71 @@ PT_INLINE vec3 gridLookupRgb(PT_SCENE_PARAM uint first, uvec3 size, vec3 u) {
               gridLookup(PT_SCENE_ARG first, size, 3u, 2u, u));
 }
 
+// ---- Sparse voxel grids (shared_types.h's layout) ---------------------------------------------
+
+// The value of voxel v (index coordinates) of the sparse grid that starts at float g.
+PT_INLINE float voxelGridValue(PT_SCENE_PARAM uint g, ivec3 v) {
+  ivec3 origin =
+      ivec3(int(mediumGridWord(PT_SCENE_ARG g + 12u)), int(mediumGridWord(PT_SCENE_ARG g + 13u)),
+            int(mediumGridWord(PT_SCENE_ARG g + 14u)));
+  uvec3 bricks = uvec3(mediumGridWord(PT_SCENE_ARG g + 15u), mediumGridWord(PT_SCENE_ARG g + 16u),
+                       mediumGridWord(PT_SCENE_ARG g + 17u));
+  ivec3 local = v - origin;
+  ivec3 b = local >> 3;  // rounds down: negative coordinates fall outside
+  if (any(lessThan(local, ivec3(0))) || any(greaterThanEqual(b, ivec3(bricks)))) {
+    return mediumGridFloat(PT_SCENE_ARG g + 18u);
+  }
+  uint entry = mediumGridWord(PT_SCENE_ARG g + kVoxelGridHeader +
+                              (uint(b.z) * bricks.y + uint(b.y)) * bricks.x + uint(b.x));
+  if ((entry & kConstantBrick) != 0u) {
+    return mediumGridFloat(PT_SCENE_ARG g + mediumGridWord(PT_SCENE_ARG g + 19u) +
+                           (entry & ~kConstantBrick));
+  }
+  ivec3 in8 = local & 7;
+  return mediumGridFloat(PT_SCENE_ARG g + mediumGridWord(PT_SCENE_ARG g + 20u) +
+                         entry * kBrickVoxels + uint((in8.z * 8 + in8.y) * 8 + in8.x));
+}
+
+// The grid's value at point p of the medium's space: trilinear between the voxels around its
+// index coordinates (NanoVDB's SampleFromVoxels of order 1, as pbrt-v4 samples it).
+PT_INLINE float voxelGridLookup(PT_SCENE_PARAM uint g, vec3 p) {
+  vec4 r0 = vec4(mediumGridFloat(PT_SCENE_ARG g), mediumGridFloat(PT_SCENE_ARG g + 1u),
+                 mediumGridFloat(PT_SCENE_ARG g + 2u), mediumGridFloat(PT_SCENE_ARG g + 3u));
+  vec4 r1 = vec4(mediumGridFloat(PT_SCENE_ARG g + 4u), mediumGridFloat(PT_SCENE_ARG g + 5u),
+                 mediumGridFloat(PT_SCENE_ARG g + 6u), mediumGridFloat(PT_SCENE_ARG g + 7u));
+  vec4 r2 = vec4(mediumGridFloat(PT_SCENE_ARG g + 8u), mediumGridFloat(PT_SCENE_ARG g + 9u),
+                 mediumGridFloat(PT_SCENE_ARG g + 10u), mediumGridFloat(PT_SCENE_ARG g + 11u));
+  vec3 s = vec3(dot(vec3(r0), p) + r0.w, dot(vec3(r1), p) + r1.w, dot(vec3(r2), p) + r2.w);
+  vec3 f = floor(s);
+  ivec3 i = ivec3(f);
+  vec3 d = s - f;
+  float c00 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG g, i),
+                        voxelGridValue(PT_SCENE_ARG g, i + ivec3(1, 0, 0)));
+  float c10 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG g, i + ivec3(0, 1, 0)),
+                        voxelGridValue(PT_SCENE_ARG g, i + ivec3(1, 1, 0)));
+  float c01 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG g, i + ivec3(0, 0, 1)),
+                        voxelGridValue(PT_SCENE_ARG g, i + ivec3(1, 0, 1)));
+  float c11 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG g, i + ivec3(0, 1, 1)),
+                        voxelGridValue(PT_SCENE_ARG g, i + ivec3(1, 1, 1)));
+  return lerpValue(d.z, lerpValue(d.y, c00, c10), lerpValue(d.y, c01, c11));
+}
+
+// pbrt-v4's normalized blackbody spectrum at `kelvin` as RGB, from the table at float `table`
+// (shared_types.h): zero at 100 K and below, as pbrt-v4 emits nothing there.
+PT_INLINE vec3 blackbodyLookup(PT_SCENE_PARAM uint table, float kelvin) {
+  float top = mediumGridFloat(PT_SCENE_ARG table);
+  if (!(kelvin > 100.0f)) return vec3(0.0f);
+  float x = min((kelvin - 100.0f) / (top - 100.0f), 1.0f) * float(kBlackbodyEntries - 1u);
+  uint i = min(uint(x), kBlackbodyEntries - 2u);
+  float t = x - float(i);
+  uint at = table + 1u + 3u * i;
+  vec3 a = vec3(mediumGridFloat(PT_SCENE_ARG at), mediumGridFloat(PT_SCENE_ARG at + 1u),
+                mediumGridFloat(PT_SCENE_ARG at + 2u));
+  vec3 b = vec3(mediumGridFloat(PT_SCENE_ARG at + 3u), mediumGridFloat(PT_SCENE_ARG at + 4u),
+                mediumGridFloat(PT_SCENE_ARG at + 5u));
+  return a + t * (b - a);
+}
+
 // ---- The coefficients at a point ------------------------------------------------------------
 
 // Medium m's coefficients at world point p. A grid is zero outside its bounds. uniformgrid:
@@ -91,9 +167,27 @@ PT_INLINE vec3 gridLookupRgb(PT_SCENE_PARAM uint first, uvec3 size, vec3 u) {
 // sigma_a and sigma_s, its Le grid times Le (the readers fold the scales into its grids).
 PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, vec3 p) {
   if (m.type == kMediumHomogeneous) return MediumProperties(m.sigmaA, m.sigmaS, m.Le);
-  vec3 u = (toMediumSpace(m, p) - m.boundsMin) / (m.boundsMax - m.boundsMin);
+  vec3 pm = toMediumSpace(m, p);
+  vec3 u = (pm - m.boundsMin) / (m.boundsMax - m.boundsMin);
   MediumProperties mp = MediumProperties(vec3(0.0f), vec3(0.0f), vec3(0.0f));
-  if (m.type == kMediumUniformGrid) {
+  if (m.type == kMediumNanoVdb) {
+    // pbrt-v4's NanoVDBMedium: the density grid scales sigma_a and sigma_s; where it has a
+    // temperature grid, Lescale times the blackbody at (T - temperatureoffset) *
+    // temperaturescale.
+    float d = voxelGridLookup(PT_SCENE_ARG m.density, pm);
+    mp.sigmaA = m.sigmaA * d;
+    mp.sigmaS = m.sigmaS * d;
+    if (m.emissive != 0u) {
+      float t = voxelGridLookup(PT_SCENE_ARG m.emission + kBlackbodyTableFloats, pm);
+      mp.Le = m.Le.x * blackbodyLookup(PT_SCENE_ARG m.emission, (t - m.Le.y) * m.Le.z);
+    }
+  } else if (m.type == kMediumCloud) {
+    // pbrt-v4's CloudMedium; Le holds its density, wispiness and frequency, `density` where
+    // its noise's permutation is.
+    float d = cloudDensity(PT_SCENE_ARG m.density, pm, m.Le.x, m.Le.y, m.Le.z);
+    mp.sigmaA = m.sigmaA * d;
+    mp.sigmaS = m.sigmaS * d;
+  } else if (m.type == kMediumUniformGrid) {
     float d = gridLookup(PT_SCENE_ARG m.density, m.size, 1u, 0u, u);
     mp.sigmaA = m.sigmaA * d;
     mp.sigmaS = m.sigmaS * d;
@@ -140,14 +234,17 @@ struct MajorantWalk {
   vec3 deltaT;     // grid: t from one crossing to the next along each axis
   ivec3 step;      // grid: +1 or -1 per axis
   uint majorants;  // grid: the first float of its majorant grid
+  ivec3 res;       // grid: its cells along x, y, z
 };
 
 // The walk of ray (o, d) over t in [0, tMax) through medium m.
 PT_INLINE MajorantWalk startMajorantWalk(PT_IN(Medium) m, vec3 o, vec3 d, float tMax) {
   MajorantWalk w = MajorantWalk(m.type, false, 0.0f, tMax, m.sigmaA + m.sigmaS, ivec3(0),
-                                vec3(0.0f), vec3(0.0f), ivec3(0), m.majorants);
+                                vec3(0.0f), vec3(0.0f), ivec3(0), m.majorants, ivec3(0));
   if (m.type == kMediumHomogeneous) return w;
   if (m.type == kMediumRgbGrid) w.sigmaMaj = vec3(1.0f);
+  w.res = m.type == kMediumUniformGrid || m.type == kMediumRgbGrid ? ivec3(int(kMajorantGridRes))
+                                                                   : ivec3(m.size);
   // The ray in the grid's unit cube.
   vec3 extent = m.boundsMax - m.boundsMin;
   vec3 o01 = (toMediumSpace(m, o) - m.boundsMin) / extent;
@@ -177,10 +274,9 @@ PT_INLINE MajorantWalk startMajorantWalk(PT_IN(Medium) m, vec3 o, vec3 d, float 
   w.tMin = t0;
   w.tMax = t1;
   // The cell it enters and where it leaves that cell along each axis.
-  float res = float(kMajorantGridRes);
-  vec3 g = (o01 + t0 * d01) * res;
   for (int a = 0; a < 3; ++a) {
-    w.cell[a] = clamp(int(floor(g[a])), 0, int(kMajorantGridRes) - 1);
+    float res = float(w.res[a]);
+    w.cell[a] = clamp(int(floor((o01[a] + t0 * d01[a]) * res)), 0, w.res[a] - 1);
     if (d01[a] == 0.0f) {
       w.nextT[a] = 1e30f;
       w.deltaT[a] = 1e30f;
@@ -212,14 +308,14 @@ PT_INLINE bool nextMajorantSegment(PT_SCENE_PARAM PT_INOUT(MajorantWalk) w,
   // The axis whose crossing comes first leaves the cell.
   int a = w.nextT.x < w.nextT.y ? (w.nextT.x < w.nextT.z ? 0 : 2) : (w.nextT.y < w.nextT.z ? 1 : 2);
   float tExit = min(w.nextT[a], w.tMax);
-  uint r = kMajorantGridRes;
-  float cellMajorant = mediumGridFloat(PT_SCENE_ARG w.majorants +
-                                       (uint(w.cell.z) * r + uint(w.cell.y)) * r + uint(w.cell.x));
+  uvec3 r = uvec3(w.res);
+  float cellMajorant = mediumGridFloat(
+      PT_SCENE_ARG w.majorants + (uint(w.cell.z) * r.y + uint(w.cell.y)) * r.x + uint(w.cell.x));
   seg = MajorantSegment(w.tMin, tExit, w.sigmaMaj * cellMajorant);
   w.tMin = tExit;
   w.cell[a] += w.step[a];
   w.nextT[a] += w.deltaT[a];
-  if (tExit >= w.tMax || w.cell[a] < 0 || w.cell[a] >= int(r)) w.done = true;
+  if (tExit >= w.tMax || w.cell[a] < 0 || w.cell[a] >= w.res[a]) w.done = true;
   return true;
 }
 

@@ -279,6 +279,9 @@ Medium loadMedium(uint i) {
 float mediumGridFloat(uint i) {
   return uintBitsToFloat(texelFetch(mediumGridTexels, int(i >> 2u))[i & 3u]);
 }
+uint mediumGridWord(uint i) {
+  return texelFetch(mediumGridTexels, int(i >> 2u))[i & 3u];
+}
 MediumInterface loadMediumInterface(uint primitive) {
   uvec4 a = texelFetch(interfaceTexels, int(primitive >> 1u));
   return (primitive & 1u) != 0u ? MediumInterface(a.z, a.w) : MediumInterface(a.x, a.y);

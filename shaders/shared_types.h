@@ -191,35 +191,73 @@ PT_CONST uint kNoMedium = 0xFFFFFFFFu;  // vacuum
 PT_CONST uint kMediumHomogeneous = 0u;  // constant sigma_a, sigma_s, Le
 PT_CONST uint kMediumUniformGrid = 1u;  // sigma_a, sigma_s times a density grid; Le times a grid
 PT_CONST uint kMediumRgbGrid = 2u;      // RGB grids of sigma_a, sigma_s and Le
-PT_CONST uint kMediumTypeCount = 3u;
+PT_CONST uint kMediumNanoVdb = 3u;  // sigma_a, sigma_s times a sparse density grid; blackbody Le
+PT_CONST uint kMediumCloud = 4u;    // sigma_a, sigma_s times pbrt-v4's procedural cloud density
+PT_CONST uint kMediumTypeCount = 5u;
 PT_CONST uint kNoGrid = 0xFFFFFFFFu;  // a grid medium's missing grid (no Le grid)
 // The majorant grid of a grid medium: this many cells on each axis over its bounds (pbrt-v4's
 // 16^3), each the largest density of the voxels it overlaps.
 PT_CONST uint kMajorantGridRes = 16u;
+// A nanovdb medium's majorant grid: this many cells on each axis over its bounds (pbrt-v4's).
+PT_CONST uint kNanoVdbMajorantRes = 64u;
 
 // Grids hold a value per voxel (RGB: three) in pbrt-v4's SampledGrid order, x fastest: voxel
 // (x, y, z) is number (z * size.y + y) * size.x + x. An rgbgrid's scales are folded into its
-// grids by the readers (its sigmaA, sigmaS and Le are then ones).
+// grids by the readers (its sigmaA, sigmaS and Le are then ones). A nanovdb medium's grids are
+// sparse voxel grids (below), its emission a blackbody table followed by its temperature grid;
+// a cloud's density is a function of the point (shaders/noise.h), its "density grid" the
+// permutation its noise reads. "Grids" below means every medium but the homogeneous one.
 struct Medium {
-  vec3 sigmaA;     // 12 bytes: absorption (homogeneous), or what the density grid multiplies
+  vec3 sigmaA;     // 12 bytes: absorption (homogeneous), or what the density multiplies
   uint type;       //  4 bytes: kMedium*
   vec3 sigmaS;     // 12 bytes: scattering, likewise
   float g;         //  4 bytes: Henyey-Greenstein asymmetry, in [-1, 1]
-  vec3 Le;         // 12 bytes: emitted radiance (homogeneous, uniformgrid: times its grid)
+  vec3 Le;         // 12 bytes: emitted radiance (homogeneous, uniformgrid: times its grid);
+                   //           nanovdb: (Lescale, temperatureoffset, temperaturescale);
+                   //           cloud: (density, wispiness, frequency)
   uint emissive;   //  4 bytes: 1 when some of it emits
-  vec3 boundsMin;  // 12 bytes: grids: p0, in the medium's space
+  vec3 boundsMin;  // 12 bytes: grids: p0, in the medium's space (nanovdb: its grids' bounds)
   uint density;    //  4 bytes: grids: the first float of its density grid (uniformgrid: one
-                   //           float per voxel; rgbgrid: sigma_a's RGB then sigma_s's RGB)
+                   //           float per voxel; rgbgrid: sigma_a's RGB then sigma_s's RGB;
+                   //           nanovdb: a sparse voxel grid; cloud: its noise's permutation)
   vec3 boundsMax;  // 12 bytes: grids: p1
-  uint majorants;  //  4 bytes: grids: the first float of its majorant grid (kMajorantGridRes^3)
-  uvec3 size;      // 12 bytes: grids: voxels along x, y, z
+  uint majorants;  //  4 bytes: grids: the first float of its majorant grid (size below)
+  uvec3 size;      // 12 bytes: uniformgrid, rgbgrid: voxels along x, y, z (their majorant grid
+                   //           is kMajorantGridRes^3); nanovdb, cloud: the majorant grid's cells
   uint emission;   //  4 bytes: grids: the first float of its Le grid (uniformgrid: a scale per
-                   //           voxel; rgbgrid: RGB per voxel), or kNoGrid
+                   //           voxel; rgbgrid: RGB per voxel; nanovdb: its blackbody table), or
+                   //           kNoGrid
   vec4 toMedium0;  // 16 bytes: the world-to-medium transform's rows (affine: p' = M p + t,
   vec4 toMedium1;  // 16 bytes: row i is (M[i][0], M[i][1], M[i][2], t[i])); grids only
   vec4 toMedium2;  // 16 bytes
 };                 // 144 bytes
 PT_CONST uint kMediumTexels = 9u;
+
+// A sparse voxel grid (a nanovdb medium's density or temperature: NanoVDB's float tree, its
+// leaves kept as they are and its tiles as constants), floats in the media's grid buffer from
+// its first: kVoxelGridHeader floats of header, then a brick map, its constants and its bricks.
+// Values sit at integer index coordinates; a point of the medium's space maps to index space by
+// the grid's own affine transform. The index space is cut into bricks of 8^3 voxels (NanoVDB's
+// leaves, aligned at multiples of 8); the brick map has an entry per brick over the grid's
+// bounding box, x fastest: a brick number (its 512 values, x fastest, at bricks + 512 number),
+// or kConstantBrick plus the number of the constant every voxel of that brick has. Integers are
+// stored as their bits. Header, by float:
+//   0-11  index-from-medium rows (as Medium::toMedium0-2)
+//   12-14 the index of the first voxel of brick (0, 0, 0) (int, multiples of 8)
+//   15-17 bricks along x, y, z (uint)
+//   18    the value beyond the bounding box (NanoVDB's background)
+//   19    where the constants start, from the grid's first float (uint)
+//   20    where the bricks start, likewise (uint)
+//   21    the floats of the whole grid (uint)
+PT_CONST uint kVoxelGridHeader = 24u;
+PT_CONST uint kBrickVoxels = 512u;
+PT_CONST uint kConstantBrick = 0x80000000u;
+// A nanovdb medium's blackbody table (its emission): float 0 the highest temperature T1 it
+// covers, then kBlackbodyEntries RGB triples of pbrt-v4's normalized blackbody spectrum at
+// temperatures evenly spaced from 100 K to T1, interpolated linearly; its temperature grid
+// follows the table.
+PT_CONST uint kBlackbodyEntries = 2048u;
+PT_CONST uint kBlackbodyTableFloats = 1u + 3u * kBlackbodyEntries;
 
 // The media on the two sides of a triangle, by Triangle::primitive: `inside` on the side
 // opposite its normal, `outside` on the normal's side (pbrt-v4's MediumInterface). The normal

@@ -182,8 +182,8 @@ TEST(MediaPbrt, UniformGridStoresDensityXFastestAndItsEmissionGrid) {
   ASSERT_NE(m.emission, kNoGrid);
   EXPECT_EQ(grid(s, m.emission, 6), (std::vector<float>{6, 7, 8, 9, 10, 11}));
   EXPECT_EQ(s.mediumGrids.size(), 12u);
-  EXPECT_EQ(densityFloats(m), 6u);
-  EXPECT_EQ(emissionFloats(m), 6u);
+  EXPECT_EQ(densityFloats(m, s.mediumGrids), 6u);
+  EXPECT_EQ(emissionFloats(m, s.mediumGrids), 6u);
 
   // Without Le it does not emit, and its Lescale grid is not kept; defaults p0 (0 0 0),
   // p1 (1 1 1), nx = ny = nz = 1.
@@ -390,26 +390,26 @@ TEST(MediaPbrt, UnusedMediaAndTheirGridsAreLeftOut) {
   EXPECT_EQ(s.media[0].emission, 2u);
 }
 
-TEST(MediaPbrt, MediaNotSimulatedAreWarnedAndVacuum) {
-  const std::string text = std::string(kUnmirrored) +
-                           "MakeNamedMedium \"vdb\" \"string type\" \"nanovdb\" "
-                           "\"string filename\" \"smoke.nvdb\"\n"
-                           "MakeNamedMedium \"c\" \"string type\" \"cloud\" \"float density\" 2\n"
-                           "MediumInterface \"vdb\" \"c\"\n" +
-                           kTriangle;
-  const Scene s = pbrtScene(text);
-  expectNoMedia(s);
-  ASSERT_EQ(s.warnings.size(), 2u);
-  EXPECT_EQ(s.warnings[0],
-            "scene.pbrt:5: MakeNamedMedium 'vdb': \"nanovdb\" media are not simulated (no NanoVDB "
-            "reader): left out, vacuum where a MediumInterface names it");
-  EXPECT_EQ(s.warnings[1],
-            "scene.pbrt:6: MakeNamedMedium 'c': \"cloud\" media are not simulated: left out, "
-            "vacuum where a MediumInterface names it");
-  EXPECT_EQ(pbrtError(text, true),
-            "scene.pbrt:5:1: MakeNamedMedium 'vdb': \"nanovdb\" media are not simulated (no "
-            "NanoVDB reader): left out, vacuum where a MediumInterface names it (an error with "
-            "--strict)");
+TEST(MediaPbrt, CloudsAreReadAndUniformGridTemperaturesWarned) {
+  // A cloud: pbrt-v4's parameters and defaults (wispiness 1, frequency 5, p0 0 0 0, p1 1 1 1).
+  const Scene cloud =
+      pbrtScene(std::string(kUnmirrored) +
+                "MakeNamedMedium \"c\" \"string type\" \"cloud\" \"float density\" 2\n"
+                "MediumInterface \"c\" \"\"\n" +
+                kTriangle);
+  ASSERT_EQ(cloud.media.size(), 1u);
+  EXPECT_EQ(cloud.media[0].type, kMediumCloud);
+  EXPECT_EQ(cloud.media[0].Le, vec3(2.0f, 1.0f, 5.0f));
+  EXPECT_EQ(cloud.media[0].boundsMin, vec3(0.0f));
+  EXPECT_EQ(cloud.media[0].boundsMax, vec3(1.0f));
+  EXPECT_TRUE(cloud.warnings.empty());
+  // A nanovdb medium names its file: a missing one is an error at the parameter.
+  EXPECT_EQ(pbrtError(std::string(kUnmirrored) +
+                      "MakeNamedMedium \"vdb\" \"string type\" \"nanovdb\"\n"
+                      "MediumInterface \"vdb\" \"\"\n" +
+                      kTriangle),
+            "scene.pbrt:5:1: MakeNamedMedium 'vdb': a \"nanovdb\" medium needs a \"string "
+            "filename\"");
   // A uniformgrid's temperature (blackbody emission): warned, the medium does not emit.
   const Scene hot = pbrtScene(std::string(kUnmirrored) +
                               "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" "
@@ -644,8 +644,12 @@ TEST(MediaJson, EveryErrorNamesItsField) {
       {jsonText(R"([)" + fog + "}, " + fog + "}]"),
        "media[1].name: duplicate medium name 'fog' (also used by media[0])"},
       {jsonText(R"([{"name": "m", "type": "nanovdb"}])"),
-       "media[0].type: unknown medium type 'nanovdb' (expected \"homogeneous\", \"uniformgrid\" "
-       "or \"rgbgrid\")"},
+       "media[0].filename: required key is missing"},
+      {jsonText(R"([{"name": "m", "type": "vdb"}])"),
+       "media[0].type: unknown medium type 'vdb' (expected \"homogeneous\", \"uniformgrid\", "
+       "\"rgbgrid\", \"nanovdb\" or \"cloud\")"},
+      {jsonText(R"([{"name": "m", "type": "cloud", "density": -1}])"),
+       "media[0].density: expected a non-negative number that fits a 32-bit float, got -1"},
       {jsonText(R"([{"name": "m", "type": "homogeneous", "density": [1]}])"),
        "media[0].density: unknown key (expected 'name', 'type', 'sigma_a', 'sigma_s', 'scale', "
        "'g', 'Le', 'Lescale' or 'preset')"},
@@ -702,7 +706,7 @@ TEST(MediaFuzzSeeds, AreAcceptedByTheFuzzEntryPoints) {
             fuzz::Outcome::kAccepted);
   // And they do have media.
   const Scene s = loadPbrtSceneText(pbrt, "media.pbrt");
-  EXPECT_EQ(s.mediumNames, (std::vector<std::string>{"air", "fog", "smoke", "cloud"}));
+  EXPECT_EQ(s.mediumNames, (std::vector<std::string>{"air", "fog", "smoke", "cloud", "puff"}));
   EXPECT_EQ(s.cameraMedium, 0u);
 }
 

@@ -929,7 +929,7 @@ TEST(PbrtCameraFilm, BadCameraAndFilmParametersAreErrors) {
 TEST(PbrtCameraFilm, StrictMakesEveryWarningAnError) {
   const std::string text = std::string(kUnmirrored) +
                            "MakeNamedMedium \"fog\" \"string type\" "
-                           "\"nanovdb\"\n" +
+                           "\"uniformgrid\" \"float density\" [1] \"float temperature\" [900]\n" +
                            kTriangle;
   EXPECT_EQ(load(text).warnings.size(), 1u);
   try {
@@ -937,9 +937,8 @@ TEST(PbrtCameraFilm, StrictMakesEveryWarningAnError) {
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "scene.pbrt:6:1: MakeNamedMedium 'fog': \"nanovdb\" media are not simulated (no "
-              "NanoVDB reader): left out, vacuum where a MediumInterface names it (an error with "
-              "--strict)");
+              "scene.pbrt:6:71: MakeNamedMedium 'fog': \"temperature\" (blackbody emission) is "
+              "not simulated: the medium does not emit (an error with --strict)");
   }
   // Through loadScene, with a parameter nothing reads.
   test::TempDir dir;

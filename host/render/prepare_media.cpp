@@ -5,10 +5,48 @@
 #include <utility>
 
 #include "common/check.h"
+#include "scene/voxel_grid.h"
 
 namespace pt {
 
+namespace {
+
+// A nanovdb medium's majorant grid (m.size cells over its bounds, x fastest): per cell, the
+// largest density of the voxels that trilinear lookups in it reach (the index box of the cell's
+// corners, floor to floor + 1), widened by a voxel on every side against rounding.
+std::vector<float> voxelGridMajorants(const Medium& m, const float* grid) {
+  glm::dmat4 indexFromMedium(1.0);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) indexFromMedium[c][r] = double(grid[4 * r + c]);
+  }
+  const glm::dvec3 lo(m.boundsMin), extent = glm::dvec3(m.boundsMax) - glm::dvec3(m.boundsMin);
+  std::vector<float> out(size_t(m.size.x) * m.size.y * m.size.z, 0.0f);
+  for (uint z = 0; z < m.size.z; ++z) {
+    for (uint y = 0; y < m.size.y; ++y) {
+      for (uint x = 0; x < m.size.x; ++x) {
+        const glm::dvec3 c0 = lo + extent * glm::dvec3(x, y, z) / glm::dvec3(m.size);
+        const glm::dvec3 c1 = lo + extent * glm::dvec3(x + 1, y + 1, z + 1) / glm::dvec3(m.size);
+        glm::dvec3 iMin(INFINITY), iMax(-INFINITY);
+        for (int k = 0; k < 8; ++k) {
+          const glm::dvec3 p((k & 1) ? c1.x : c0.x, (k & 2) ? c1.y : c0.y, (k & 4) ? c1.z : c0.z);
+          const glm::dvec3 i = glm::dvec3(indexFromMedium * glm::dvec4(p, 1.0));
+          iMin = glm::min(iMin, i);
+          iMax = glm::max(iMax, i);
+        }
+        const glm::ivec3 first = glm::ivec3(glm::floor(iMin)) - 1;
+        const glm::ivec3 last = glm::ivec3(glm::floor(iMax)) + 2;
+        out[(size_t(z) * m.size.y + y) * m.size.x + x] = voxelGridMax(grid, first, last);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<float> majorantGrid(const Medium& m, const std::vector<float>& grids) {
+  if (m.type == kMediumCloud) return {1.0f};  // its density is at most 1
+  if (m.type == kMediumNanoVdb) return voxelGridMajorants(m, grids.data() + m.density);
   const uint r = kMajorantGridRes;
   const size_t voxels = size_t(m.size.x) * m.size.y * m.size.z;
   // The largest value over the voxels whose interpolation reaches cell (x, y, z): a cell's

@@ -4,12 +4,15 @@
 
 #include <cmath>
 #include <cstddef>
+#include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "common/check.h"
 #include "scene/json_transform.h"
 #include "scene/media.h"
 
@@ -21,6 +24,25 @@ constexpr std::int64_t kMaxVoxels = std::numeric_limits<int>::max();
 
 // The keys a medium of `type` takes.
 std::vector<std::string_view> mediumKeys(uint type) {
+  if (type == kMediumNanoVdb) {
+    return {"name",
+            "type",
+            "sigma_a",
+            "sigma_s",
+            "scale",
+            "g",
+            "Lescale",
+            "filename",
+            "gridname",
+            "temperaturename",
+            "temperatureoffset",
+            "temperaturescale",
+            "transform"};
+  }
+  if (type == kMediumCloud) {
+    return {"name",      "type",      "sigma_a", "sigma_s", "g",        "density",
+            "wispiness", "frequency", "p0",      "p1",      "transform"};
+  }
   std::vector<std::string_view> keys = {"name",  "type", "sigma_a", "sigma_s",
                                         "scale", "g",    "Le",      "Lescale"};
   if (type == kMediumHomogeneous) {
@@ -70,9 +92,14 @@ void JsonMedia::read(const JsonNode& node) {
       p.type = kMediumUniformGrid;
     } else if (type == "rgbgrid") {
       p.type = kMediumRgbGrid;
+    } else if (type == "nanovdb") {
+      p.type = kMediumNanoVdb;
+    } else if (type == "cloud") {
+      p.type = kMediumCloud;
     } else {
       typeNode.fail("unknown medium type " + singleQuoted(type) +
-                    " (expected \"homogeneous\", \"uniformgrid\" or \"rgbgrid\")");
+                    " (expected \"homogeneous\", \"uniformgrid\", \"rgbgrid\", \"nanovdb\" "
+                    "or \"cloud\")");
     }
     m.checkKeys(mediumKeys(p.type));
     const JsonNode nameNode = m.require("name");
@@ -108,6 +135,31 @@ void JsonMedia::read(const JsonNode& node) {
       if (auto n = m.find("sigma_s")) p.sigmaS = vec3(n->vec3());
       if (auto n = m.find("Le")) p.Le = vec3(n->vec3());
     }
+    if (p.type == kMediumNanoVdb) {
+      if (auto n = m.find("temperatureoffset")) p.temperatureOffset = n->floatNumber();
+      if (auto n = m.find("temperaturescale")) p.temperatureScale = n->floatNumber();
+      const JsonNode fileNode = m.require("filename");
+      const std::filesystem::path given(fileNode.string());
+      if (given.empty()) fileNode.fail("expected a file name");
+      const std::filesystem::path path =
+          given.is_absolute() ? given : std::filesystem::path(m.file()).parent_path() / given;
+      const std::string grid = m.find("gridname") ? m.find("gridname")->string() : "density";
+      const std::string temperature =
+          m.find("temperaturename") ? m.find("temperaturename")->string() : "temperature";
+      try {
+        p.nanovdb =
+            std::make_shared<const NanoVdbMediumGrids>(readNanoVdbMedium(path, grid, temperature));
+      } catch (const InputError& e) {
+        fileNode.fail(e.what());
+      }
+    }
+    if (p.type == kMediumCloud) {
+      if (auto n = m.find("density")) p.cloudDensity = n->floatNumber();
+      if (auto n = m.find("wispiness")) p.wispiness = n->floatNumber();
+      if (auto n = m.find("frequency")) p.frequency = n->floatNumber();
+      if (auto n = m.find("p0")) p.p0 = n->vec3();
+      if (auto n = m.find("p1")) p.p1 = n->vec3();
+    }
     if (auto n = m.find("Lescale")) {
       if (p.type == kMediumUniformGrid) {
         p.LeScaleGrid = readFloats(*n);  // one per voxel, as pbrt-v4's
@@ -115,7 +167,7 @@ void JsonMedia::read(const JsonNode& node) {
         p.LeScale = n->floatNumber();
       }
     }
-    if (p.type != kMediumHomogeneous) {
+    if (p.type == kMediumUniformGrid || p.type == kMediumRgbGrid) {
       if (auto n = m.find("nx")) p.nx = n->integer(1, kMaxVoxels);
       if (auto n = m.find("ny")) p.ny = n->integer(1, kMaxVoxels);
       if (auto n = m.find("nz")) p.nz = n->integer(1, kMaxVoxels);

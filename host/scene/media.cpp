@@ -13,7 +13,10 @@
 #include <glm/matrix.hpp>
 
 #include "common/check.h"
+#include "medium.h"  // kNoisePermutation (noise.h)
 #include "scene/json_reader.h"
+#include "scene/pbrt/spectra.h"
+#include "scene/voxel_grid.h"
 
 namespace pt {
 
@@ -176,6 +179,21 @@ std::vector<float> scaledRgbGrid(const std::vector<float>& grid, double scale, s
   return out;
 }
 
+// The blackbody table of a nanovdb medium whose temperatures reach `hottest` kelvin
+// (shared_types.h): pbrt-v4's BlackbodySpectrum (Planck's law divided by its peak) as linear
+// sRGB through the CIE 1931 observer, as its film records it.
+std::vector<float> blackbodyTable(double hottest) {
+  std::vector<float> table(kBlackbodyTableFloats);
+  table[0] = static_cast<float>(hottest);
+  const double top = double(table[0]);
+  for (uint i = 0; i < kBlackbodyEntries; ++i) {
+    const double kelvin = 100.0 + (top - 100.0) * double(i) / double(kBlackbodyEntries - 1);
+    const glm::dvec3 rgb = spectra::xyzToLinearSrgb() * spectra::toXyz(spectra::blackbody(kelvin));
+    for (int c = 0; c < 3; ++c) table[1 + 3 * i + uint(c)] = static_cast<float>(rgb[c]);
+  }
+  return table;
+}
+
 }  // namespace
 
 const MediumPreset* findMediumPreset(std::string_view name) {
@@ -207,6 +225,21 @@ std::optional<MediumProblem> checkMedium(const MediumParams& m) {
   if (m.type == kMediumHomogeneous) {
     return checkScaled("Le", "Lescale", maxComponent(m.Le), m.LeScale);
   }
+  if (m.type == kMediumNanoVdb) {
+    PT_CHECK(m.nanovdb != nullptr, "checkMedium: a nanovdb medium without its grids");
+    for (const auto& [name, v] : {std::pair{"temperatureoffset", m.temperatureOffset},
+                                  std::pair{"temperaturescale", m.temperatureScale}}) {
+      if (!fitsFloat(v)) return problem(name, "expected a number that fits a 32-bit float");
+    }
+    return std::nullopt;
+  }
+  if (m.type == kMediumCloud) {
+    if (auto p = checkNonNegative("density", &m.cloudDensity, 1)) return p;
+    for (const auto& [name, v] :
+         {std::pair{"wispiness", m.wispiness}, std::pair{"frequency", m.frequency}}) {
+      if (!fitsFloat(v)) return problem(name, "expected a number that fits a 32-bit float");
+    }
+  }
   const std::int64_t sizes[3] = {m.nx, m.ny, m.nz};
   const char* const sizeNames[3] = {"nx", "ny", "nz"};
   for (int a = 0; a < 3; ++a) {
@@ -226,6 +259,7 @@ std::optional<MediumProblem> checkMedium(const MediumParams& m) {
       if (!fitsFloat(p[a])) return problem(name, "does not fit 32-bit floats: " + point(p));
     }
   }
+  if (m.type == kMediumCloud) return std::nullopt;
   if (m.type == kMediumUniformGrid) {
     if (m.density.empty()) return problem("density", "is required: one value per voxel");
     if (auto p = checkGrid("density", m.density, 1, voxels)) return p;
@@ -269,6 +303,38 @@ uint addMedium(Scene& scene, const std::string& name, const MediumParams& m) {
     out.sigmaS = scaled(m.sigmaS, m.scale);
     out.Le = scaled(m.Le, m.LeScale);
     out.emissive = maxComponent(out.Le) > 0.0f ? 1u : 0u;
+  } else if (m.type == kMediumNanoVdb) {
+    const NanoVdbMediumGrids& grids = *m.nanovdb;
+    out.sigmaA = scaled(m.sigmaA, m.scale);
+    out.sigmaS = scaled(m.sigmaS, m.scale);
+    out.boundsMin = vec3(grids.boundsMin);
+    out.boundsMax = vec3(grids.boundsMax);
+    out.size = uvec3(kNanoVdbMajorantRes);
+    out.Le = vec3(float(m.LeScale), float(m.temperatureOffset), float(m.temperatureScale));
+    out.density = appendGrid(scene, packVoxelGrid(grids.density));
+    // The hottest temperature the grid gives (pbrt-v4 emits above 100 K).
+    const double hottest =
+        std::max((double(grids.temperatureMin) - m.temperatureOffset) * m.temperatureScale,
+                 (double(grids.temperatureMax) - m.temperatureOffset) * m.temperatureScale);
+    if (grids.temperature && m.LeScale > 0.0 && hottest > 100.0) {
+      out.emissive = 1u;
+      std::vector<float> emission = blackbodyTable(hottest);
+      const std::vector<float> temperature = packVoxelGrid(*grids.temperature);
+      emission.insert(emission.end(), temperature.begin(), temperature.end());
+      out.emission = appendGrid(scene, emission);
+    }
+  } else if (m.type == kMediumCloud) {
+    out.sigmaA = m.sigmaA;
+    out.sigmaS = m.sigmaS;
+    out.boundsMin = vec3(m.p0);
+    out.boundsMax = vec3(m.p1);
+    out.size = uvec3(1u);
+    out.Le = vec3(float(m.cloudDensity), float(m.wispiness), float(m.frequency));
+    std::vector<float> permutation(kNoisePermutationSize);
+    for (uint i = 0; i < kNoisePermutationSize; ++i) {
+      permutation[i] = glm::uintBitsToFloat(uint(kNoisePermutation[i]));
+    }
+    out.density = appendGrid(scene, permutation);
   } else {
     out.boundsMin = vec3(m.p0);
     out.boundsMax = vec3(m.p1);
@@ -309,15 +375,21 @@ void setMediumTransform(Medium& m, const glm::dmat4& mediumFromWorld) {
   }
 }
 
-std::size_t densityFloats(const Medium& m) {
+std::size_t densityFloats(const Medium& m, const std::vector<float>& grids) {
   const std::size_t voxels = std::size_t(m.size.x) * m.size.y * m.size.z;
   if (m.type == kMediumUniformGrid) return voxels;
   if (m.type == kMediumRgbGrid) return 6 * voxels;
+  if (m.type == kMediumNanoVdb) return packedVoxelGridFloats(grids.data() + m.density);
+  if (m.type == kMediumCloud) return kNoisePermutationSize;
   return 0;
 }
 
-std::size_t emissionFloats(const Medium& m) {
+std::size_t emissionFloats(const Medium& m, const std::vector<float>& grids) {
   if (m.emission == kNoGrid) return 0;
+  if (m.type == kMediumNanoVdb) {
+    return kBlackbodyTableFloats +
+           packedVoxelGridFloats(grids.data() + m.emission + kBlackbodyTableFloats);
+  }
   const std::size_t voxels = std::size_t(m.size.x) * m.size.y * m.size.z;
   return m.type == kMediumRgbGrid ? 3 * voxels : voxels;
 }
@@ -349,8 +421,8 @@ void keepUsedMedia(Scene& scene) {
       offset = static_cast<uint>(grids.size());
       grids.insert(grids.end(), first, first + std::ptrdiff_t(count));
     };
-    move(m.density, densityFloats(m));
-    move(m.emission, emissionFloats(m));
+    move(m.density, densityFloats(m, scene.mediumGrids));
+    move(m.emission, emissionFloats(m, scene.mediumGrids));
     media.push_back(m);
     names.push_back(scene.mediumNames[i]);
   }

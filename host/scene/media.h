@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -15,6 +16,7 @@
 #include <glm/vec3.hpp>
 
 #include "common/shared.h"
+#include "scene/nanovdb_file.h"
 #include "scene/scene.h"
 
 namespace pt {
@@ -35,13 +37,13 @@ std::vector<std::string_view> mediumPresetNames();
 // functions), as either reader gives them. Colours are linear RGB: a pbrt file's spectra are
 // already their RGB (Le a light's colour at luminance 1, as pbrt-v4 normalizes it).
 struct MediumParams {
-  uint type = kMediumHomogeneous;  // kMediumHomogeneous, kMediumUniformGrid or kMediumRgbGrid
+  uint type = kMediumHomogeneous;  // kMedium*
   vec3 sigmaA{1.0f};               // homogeneous, uniformgrid: "sigma_a" (before "scale")
   vec3 sigmaS{1.0f};               // "sigma_s"
   double scale = 1.0;              // "scale" of sigma_a and sigma_s
   double g = 0.0;                  // Henyey-Greenstein asymmetry
   vec3 Le{0.0f};                   // homogeneous, uniformgrid: "Le"
-  double LeScale = 1.0;            // homogeneous, rgbgrid: "Lescale"
+  double LeScale = 1.0;            // homogeneous, rgbgrid, nanovdb: "Lescale"
   // Grids: voxels along x, y and z, and the bounds p0, p1 they fill in the medium's space. Every
   // grid is pbrt-v4's SampledGrid order, x fastest: voxel (x, y, z) is value (z * ny + y) * nx + x
   // (for RGB grids, three floats each).
@@ -52,6 +54,16 @@ struct MediumParams {
   std::vector<float> sigmaAGrid;   // rgbgrid: "sigma_a", RGB per voxel, or none
   std::vector<float> sigmaSGrid;   // rgbgrid: "sigma_s", likewise
   std::vector<float> LeGrid;       // rgbgrid: "Le", likewise
+  // nanovdb: the grids of its "filename" (read by the reader, which knows where the file is),
+  // and its emission: Lescale times the blackbody at (T - temperatureoffset) *
+  // temperaturescale, T the temperature grid's value.
+  std::shared_ptr<const NanoVdbMediumGrids> nanovdb;
+  double temperatureOffset = 0.0;  // "temperatureoffset" (or pbrt-v4's "temperaturecutoff")
+  double temperatureScale = 1.0;   // "temperaturescale"
+  // cloud (bounds p0, p1): "density", "wispiness", "frequency".
+  double cloudDensity = 1.0;
+  double wispiness = 1.0;
+  double frequency = 5.0;
 };
 
 // What is wrong with a medium: the parameter at fault (pbrt-v4's name), the index of the value
@@ -78,16 +90,19 @@ std::size_t voxelCount(const MediumParams& m);
 // transport multiplies the grid by them, and where it does not, the values are the same); a
 // missing sigma_a or sigma_s grid is stored as ones (pbrt-v4's constant 1). A uniformgrid's
 // Lescale grid is its emission grid, none without one; grids of a medium that does not emit
-// are not stored. The transform is identity: setMediumTransform sets it.
+// are not stored. A nanovdb medium's grids are packed (voxel_grid.h), its emission a blackbody
+// table over the temperatures its grid reaches and the grid. The transform is identity:
+// setMediumTransform sets it.
 uint addMedium(Scene& scene, const std::string& name, const MediumParams& m);
 
 // Sets medium `m`'s world-to-medium rows from the matrix that maps world to medium space
 // (affine: its last row is taken as 0 0 0 1).
 void setMediumTransform(Medium& m, const glm::dmat4& mediumFromWorld);
 
-// The floats of medium `m`'s density and emission grids (0 where it has none).
-std::size_t densityFloats(const Medium& m);
-std::size_t emissionFloats(const Medium& m);
+// The floats of medium `m`'s density and emission grids (0 where it has none), `grids` the
+// floats they are in.
+std::size_t densityFloats(const Medium& m, const std::vector<float>& grids);
+std::size_t emissionFloats(const Medium& m, const std::vector<float>& grids);
 
 // Keeps the media that some triangle's interface or the camera names, in their order, their
 // grids packed in the same order, and renumbers the references. Where none is left, media,

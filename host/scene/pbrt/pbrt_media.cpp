@@ -1,14 +1,17 @@
-// pbrt-v4's MakeNamedMedium (its media.cpp Create functions: homogeneous, uniformgrid and
-// rgbgrid read; cloud and nanovdb warned and left out) and MediumInterface, resolved at the end
-// of the file into Scene::media, the triangles' interfaces and the camera's medium.
+// pbrt-v4's MakeNamedMedium (its media.cpp Create functions: homogeneous, uniformgrid,
+// rgbgrid, cloud and nanovdb) and MediumInterface, resolved at the end of the file into
+// Scene::media, the triangles' interfaces and the camera's medium.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <limits>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "common/check.h"
 #include "scene/json_reader.h"
 #include "scene/media.h"
 #include "scene/pbrt/pbrt_builder.h"
@@ -57,12 +60,10 @@ void Builder::makeNamedMedium(Statement& s) {
     m.type = kMediumUniformGrid;
   } else if (type == "rgbgrid") {
     m.type = kMediumRgbGrid;
-  } else if (type == "cloud" || type == "nanovdb") {
-    p.markAllUsed();
-    warnOnce("medium " + type, s.location,
-             context + ": \"" + type + "\" media are not simulated" +
-                 (type == "nanovdb" ? " (no NanoVDB reader)" : "") +
-                 ": left out, vacuum where a MediumInterface names it");
+  } else if (type == "nanovdb") {
+    m.type = kMediumNanoVdb;
+  } else if (type == "cloud") {
+    m.type = kMediumCloud;
   } else {
     fail(t->location, context + ": unknown medium type " + singleQuoted(type) +
                           (type == "heterogeneous"
@@ -70,11 +71,12 @@ void Builder::makeNamedMedium(Statement& s) {
                                : scene_detail::didYouMean(
                                      type, {std::begin(kMediumTypes), std::end(kMediumTypes)})));
   }
-  const bool simulated = type == "homogeneous" || type == "uniformgrid" || type == "rgbgrid";
-  if (simulated) {
+  {
     // pbrt-v4's parameters and defaults (media.cpp): sigma_a and sigma_s 1, scale 1, g 0, no
     // emission; grids nx = ny = nz = 1 over p0 (0 0 0) to p1 (1 1 1).
-    if (auto v = p.number("scale")) m.scale = *v;
+    if (m.type != kMediumCloud) {
+      if (auto v = p.number("scale")) m.scale = *v;
+    }
     if (auto v = p.number("g")) m.g = *v;
     const auto count = [&](const char* axis, std::int64_t& out) {
       const Param* q = p.find(axis, {ParamType::kInteger});
@@ -126,7 +128,37 @@ void Builder::makeNamedMedium(Statement& s) {
       }
       emission();
       if (auto v = p.number("Lescale")) m.LeScale = *v;
-    } else {
+    } else if (m.type == kMediumNanoVdb || m.type == kMediumCloud) {
+      if (auto v = spectrum(p, "sigma_a", Use::kUnbounded)) m.sigmaA = *v;
+      if (auto v = spectrum(p, "sigma_s", Use::kUnbounded)) m.sigmaS = *v;
+    }
+    if (m.type == kMediumNanoVdb) {
+      if (auto v = p.number("Lescale")) m.LeScale = *v;
+      // pbrt-v4 reads "temperatureoffset", and "temperaturecutoff" where that is missing.
+      if (auto v = p.number("temperaturecutoff")) m.temperatureOffset = *v;
+      if (auto v = p.number("temperatureoffset")) m.temperatureOffset = *v;
+      if (auto v = p.number("temperaturescale")) m.temperatureScale = *v;
+      const Param* file = p.find("filename", {ParamType::kString});
+      if (file == nullptr || file->strings.empty() || file->strings[0].empty()) {
+        fail(s.location, context + ": a \"nanovdb\" medium needs a \"string filename\"");
+      }
+      p.expectCount(*file, 1);
+      const std::string grid = p.string("gridname").value_or("density");
+      const std::string temperature = p.string("temperaturename").value_or("temperature");
+      const std::filesystem::path path = resolvePath(file->strings[0], file->location, mainFile_);
+      try {
+        m.nanovdb =
+            std::make_shared<const NanoVdbMediumGrids>(readNanoVdbMedium(path, grid, temperature));
+      } catch (const InputError& e) {
+        fail(file->location, context + ": " + e.what());
+      }
+    } else if (m.type == kMediumCloud) {
+      if (auto v = p.number("density")) m.cloudDensity = *v;
+      if (auto v = p.number("wispiness")) m.wispiness = *v;
+      if (auto v = p.number("frequency")) m.frequency = *v;
+      point("p0", m.p0);
+      point("p1", m.p1);
+    } else if (m.type == kMediumUniformGrid || m.type == kMediumRgbGrid) {
       count("nx", m.nx);
       count("ny", m.ny);
       count("nz", m.nz);
@@ -187,7 +219,7 @@ void Builder::makeNamedMedium(Statement& s) {
              context + " ignored: \"\" names the vacuum in MediumInterface, not a medium");
     return;
   }
-  if (simulated) entry.index = addMedium(scene_, name, m);
+  entry.index = addMedium(scene_, name, m);
   namedMedia_.emplace(name, entry);
 }
 

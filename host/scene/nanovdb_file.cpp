@@ -1,0 +1,216 @@
+// Reading NanoVDB files into sparse voxel grids (nanovdb_file.h).
+#include "scene/nanovdb_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <iostream>  // before GridValidator.h, which uses std::cerr without it
+
+#include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/GridValidator.h>
+#include <nanovdb/util/IO.h>
+
+#include "common/check.h"
+
+namespace pt {
+
+namespace {
+
+// The most bricks a grid's map may have (a map entry per 8^3 voxels of its bounds).
+constexpr double kMaxBricks = 64.0 * 1024.0 * 1024.0;
+
+using Handle = nanovdb::GridHandle<nanovdb::HostBuffer>;
+
+// Grid `name` of `file`, validated; an empty handle where the file has no grid of that name.
+Handle readGrid(const std::filesystem::path& file, const std::string& name) {
+  Handle handle;
+  try {
+    handle = nanovdb::io::readGrid<nanovdb::HostBuffer>(file.string(), name);
+  } catch (const std::exception& e) {
+    throw InputError(file.string() + ": " + e.what());
+  }
+  if (!handle) return handle;
+  const nanovdb::GridMetaData* meta = handle.gridMetaData();
+  if (meta == nullptr || handle.size() < sizeof(nanovdb::GridData) ||
+      meta->gridSize() > handle.size()) {
+    throw InputError(file.string() + ": grid '" + name + "' is truncated");
+  }
+  const nanovdb::NanoGrid<float>* grid = handle.grid<float>();
+  if (grid == nullptr) {
+    throw InputError(
+        file.string() + ": grid '" + name +
+        "' does not hold 32-bit floats (its type: " + nanovdb::toStr(meta->gridType()) + ")");
+  }
+  const std::string problem = nanovdb::GridValidator<float>::check(*grid, true);
+  if (!problem.empty()) {
+    throw InputError(file.string() + ": grid '" + name + "' is damaged: " + problem);
+  }
+  if (!grid->isFogVolume() && !grid->isUnknown()) {
+    throw InputError(file.string() + ": grid '" + name +
+                     "' is not a fog volume (pbrt-v4 reads densities and temperatures from "
+                     "fog volumes)");
+  }
+  return handle;
+}
+
+// The world-to-index map of `grid` as a matrix (NanoVDB's world is the medium's space).
+glm::dmat4 indexFromMedium(const nanovdb::NanoGrid<float>& grid) {
+  const nanovdb::Map& map = grid.map();
+  glm::dmat4 inverse(1.0);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) inverse[c][r] = map.mInvMatD[3 * r + c];
+  }
+  glm::dmat4 translate(1.0);
+  translate[3] = glm::dvec4(-map.mVecD[0], -map.mVecD[1], -map.mVecD[2], 1.0);
+  return inverse * translate;
+}
+
+// The grid's bricks over the index-space box that covers the medium-space box [lo, hi] and the
+// voxels its trilinear lookups there reach.
+VoxelBricks bricksOf(const std::filesystem::path& file, const std::string& name,
+                     const nanovdb::NanoGrid<float>& grid, const glm::dvec3& lo,
+                     const glm::dvec3& hi) {
+  VoxelBricks out;
+  out.indexFromMedium = indexFromMedium(grid);
+  out.background = grid.tree().background();
+  glm::dvec3 iMin(INFINITY), iMax(-INFINITY);
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::dvec3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y,
+                       (corner & 4) ? hi.z : lo.z);
+    const glm::dvec3 i = glm::dvec3(out.indexFromMedium * glm::dvec4(p, 1.0));
+    iMin = glm::min(iMin, i);
+    iMax = glm::max(iMax, i);
+  }
+  glm::dvec3 first = glm::floor(iMin) - 1.0, last = glm::floor(iMax) + 1.0;
+  // The index box of the grid's values; beyond it every value is the background or a tile's.
+  const double limit = 1 << 30;
+  for (int a = 0; a < 3; ++a) {
+    if (!(first[a] >= -limit && last[a] <= limit)) {
+      throw InputError(file.string() + ": grid '" + name +
+                       "': its bounds reach beyond 2^30 voxels from the origin");
+    }
+  }
+  const glm::ivec3 origin = glm::ivec3(glm::floor(first / 8.0)) * 8;
+  const glm::ivec3 end = glm::ivec3(glm::floor(last / 8.0)) * 8 + 8;
+  const glm::ivec3 bricks = (end - origin) / 8;
+  if (double(bricks.x) * double(bricks.y) * double(bricks.z) > kMaxBricks) {
+    throw InputError(file.string() + ": grid '" + name + "' covers " + std::to_string(bricks.x) +
+                     " x " + std::to_string(bricks.y) + " x " + std::to_string(bricks.z) +
+                     " bricks of 8^3 voxels, more than this renderer holds");
+  }
+  out.origin = origin;
+  out.bricks = glm::uvec3(bricks);
+  out.map.assign(std::size_t(bricks.x) * std::size_t(bricks.y) * std::size_t(bricks.z), 0u);
+
+  // The leaves by brick.
+  const auto& tree = grid.tree();
+  std::unordered_map<std::size_t, const nanovdb::NanoLeaf<float>*> leaves;
+  const nanovdb::NanoLeaf<float>* leaf = tree.getFirstLeaf();
+  const auto brickIndex = [&](const nanovdb::Coord& c) -> std::optional<std::size_t> {
+    const glm::ivec3 b = (glm::ivec3(c[0], c[1], c[2]) - origin) >> 3;
+    if (glm::any(glm::lessThan(b, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(b, bricks))) {
+      return std::nullopt;
+    }
+    return (std::size_t(b.z) * std::size_t(bricks.y) + std::size_t(b.y)) * std::size_t(bricks.x) +
+           std::size_t(b.x);
+  };
+  for (uint32_t i = 0; i < tree.nodeCount(0); ++i) {
+    if (auto index = brickIndex(leaf[i].origin())) leaves.emplace(*index, &leaf[i]);
+  }
+  std::unordered_map<float, uint32_t> constants;
+  auto accessor = grid.getAccessor();
+  for (int bz = 0; bz < bricks.z; ++bz) {
+    for (int by = 0; by < bricks.y; ++by) {
+      for (int bx = 0; bx < bricks.x; ++bx) {
+        const std::size_t index =
+            (std::size_t(bz) * std::size_t(bricks.y) + std::size_t(by)) * std::size_t(bricks.x) +
+            std::size_t(bx);
+        const glm::ivec3 corner = origin + 8 * glm::ivec3(bx, by, bz);
+        const auto found = leaves.find(index);
+        if (found == leaves.end()) {
+          // No leaf: the whole brick lies in one tile (or the background).
+          const float v = accessor.getValue(nanovdb::Coord(corner.x, corner.y, corner.z));
+          const auto [it, added] = constants.emplace(v, uint32_t(out.constants.size()));
+          if (added) out.constants.push_back(v);
+          out.map[index] = kConstantBrick | it->second;
+          continue;
+        }
+        out.map[index] = uint32_t(out.values.size() / kBrickVoxels);
+        // NanoVDB's leaf order is z fastest; the brick's is x fastest.
+        for (uint32_t z = 0; z < 8; ++z) {
+          for (uint32_t y = 0; y < 8; ++y) {
+            for (uint32_t x = 0; x < 8; ++x) {
+              out.values.push_back(found->second->getValue((x << 6) | (y << 3) | z));
+            }
+          }
+        }
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+NanoVdbMediumGrids readNanoVdbMedium(const std::filesystem::path& file,
+                                     const std::string& densityName,
+                                     const std::string& temperatureName) {
+  const Handle density = readGrid(file, densityName);
+  if (!density) {
+    throw InputError(file.string() + ": no grid named '" + densityName + "'");
+  }
+  const Handle temperature = readGrid(file, temperatureName);
+  NanoVdbMediumGrids out;
+  const auto unite = [&](const nanovdb::NanoGrid<float>& g) {
+    const auto& box = g.worldBBox();
+    for (int a = 0; a < 3; ++a) {
+      out.boundsMin[a] = std::min(out.boundsMin[a], box.min()[a]);
+      out.boundsMax[a] = std::max(out.boundsMax[a], box.max()[a]);
+    }
+  };
+  out.boundsMin = glm::dvec3(INFINITY);
+  out.boundsMax = glm::dvec3(-INFINITY);
+  unite(*density.grid<float>());
+  if (temperature) unite(*temperature.grid<float>());
+  for (int a = 0; a < 3; ++a) {
+    if (!(out.boundsMin[a] < out.boundsMax[a]) || !std::isfinite(out.boundsMin[a]) ||
+        !std::isfinite(out.boundsMax[a])) {
+      throw InputError(file.string() + ": grid '" + densityName +
+                       "' has empty or infinite bounds (no active voxels?)");
+    }
+  }
+  out.density = bricksOf(file, densityName, *density.grid<float>(), out.boundsMin, out.boundsMax);
+  // Densities scale probabilities: non-negative and finite, as every medium's coefficients.
+  const auto check = [&](const std::string& name, const VoxelBricks& g, bool negativeToo) {
+    const auto bad = [&](float v) { return !std::isfinite(v) || (negativeToo && v < 0.0f); };
+    float worst = g.background;
+    for (float v : g.values) worst = bad(v) ? v : worst;
+    for (float v : g.constants) worst = bad(v) ? v : worst;
+    if (bad(worst)) {
+      throw InputError(file.string() + ": grid '" + name + "' holds " + std::to_string(worst) +
+                       (negativeToo ? " (densities must be non-negative and finite)"
+                                    : " (temperatures must be finite)"));
+    }
+  };
+  check(densityName, out.density, true);
+  if (temperature) {
+    out.temperature =
+        bricksOf(file, temperatureName, *temperature.grid<float>(), out.boundsMin, out.boundsMax);
+    check(temperatureName, *out.temperature, false);
+    float lo = INFINITY, hi = -INFINITY;
+    for (float v : out.temperature->values) lo = std::min(lo, v), hi = std::max(hi, v);
+    for (float v : out.temperature->constants) lo = std::min(lo, v), hi = std::max(hi, v);
+    lo = std::min(lo, out.temperature->background);
+    hi = std::max(hi, out.temperature->background);
+    out.temperatureMin = lo;
+    out.temperatureMax = hi;
+  }
+  return out;
+}
+
+}  // namespace pt
