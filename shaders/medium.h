@@ -18,6 +18,12 @@
 #ifndef PT_MEDIUM_LOOP_TICK
 #define PT_MEDIUM_LOOP_TICK()
 #endif
+// The types of media the scene has (bit 1 << kMedium* each): the shader's specialization
+// constant, so that the code of the others is compiled out; every type on the CPU.
+#ifndef PT_MEDIUM_KINDS
+#define PT_MEDIUM_KINDS 0xFFFFFFFFu
+#endif
+#define PT_HAS_MEDIUM(t) (m.type == (t) && (PT_MEDIUM_KINDS & (1u << (t))) != 0u)
 
 #ifdef __cplusplus
 namespace pt {
@@ -166,11 +172,11 @@ PT_INLINE vec3 blackbodyLookup(PT_SCENE_PARAM uint table, float kelvin) {
 // sigma_a and sigma_s times the density, Le times its grid; rgbgrid: the RGB grids times
 // sigma_a and sigma_s, its Le grid times Le (the readers fold the scales into its grids).
 PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, vec3 p) {
-  if (m.type == kMediumHomogeneous) return MediumProperties(m.sigmaA, m.sigmaS, m.Le);
+  if (PT_HAS_MEDIUM(kMediumHomogeneous)) return MediumProperties(m.sigmaA, m.sigmaS, m.Le);
   vec3 pm = toMediumSpace(m, p);
   vec3 u = (pm - m.boundsMin) / (m.boundsMax - m.boundsMin);
   MediumProperties mp = MediumProperties(vec3(0.0f), vec3(0.0f), vec3(0.0f));
-  if (m.type == kMediumNanoVdb) {
+  if (PT_HAS_MEDIUM(kMediumNanoVdb)) {
     // pbrt-v4's NanoVDBMedium: the density grid scales sigma_a and sigma_s; where it has a
     // temperature grid, Lescale times the blackbody at (T - temperatureoffset) *
     // temperaturescale.
@@ -181,13 +187,13 @@ PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, ve
       float t = voxelGridLookup(PT_SCENE_ARG m.emission + kBlackbodyTableFloats, pm);
       mp.Le = m.Le.x * blackbodyLookup(PT_SCENE_ARG m.emission, (t - m.Le.y) * m.Le.z);
     }
-  } else if (m.type == kMediumCloud) {
+  } else if (PT_HAS_MEDIUM(kMediumCloud)) {
     // pbrt-v4's CloudMedium; Le holds its density, wispiness and frequency, `density` where
     // its noise's permutation is.
     float d = cloudDensity(PT_SCENE_ARG m.density, pm, m.Le.x, m.Le.y, m.Le.z);
     mp.sigmaA = m.sigmaA * d;
     mp.sigmaS = m.sigmaS * d;
-  } else if (m.type == kMediumUniformGrid) {
+  } else if (PT_HAS_MEDIUM(kMediumUniformGrid)) {
     float d = gridLookup(PT_SCENE_ARG m.density, m.size, 1u, 0u, u);
     mp.sigmaA = m.sigmaA * d;
     mp.sigmaS = m.sigmaS * d;
@@ -198,7 +204,7 @@ PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, ve
       mp.Le = m.emission == kNoGrid ? m.Le * (f.x * f.y * f.z)
                                     : m.Le * gridLookup(PT_SCENE_ARG m.emission, m.size, 1u, 0u, u);
     }
-  } else {
+  } else if (PT_HAS_MEDIUM(kMediumRgbGrid)) {
     uint voxels = m.size.x * m.size.y * m.size.z;
     mp.sigmaA = m.sigmaA * gridLookupRgb(PT_SCENE_ARG m.density, m.size, u);
     mp.sigmaS = m.sigmaS * gridLookupRgb(PT_SCENE_ARG m.density + 3u * voxels, m.size, u);

@@ -58,6 +58,7 @@ layout(constant_id = PT_SPEC_TEXTURES) const bool kTextures = true;
 layout(constant_id = PT_SPEC_ALPHA) const bool kAlphaCutouts = true;
 layout(constant_id = PT_SPEC_BUMP) const bool kBumpMaps = true;
 layout(constant_id = PT_SPEC_TEXTURE_FEATURES) const uint kTextureFeatures = kTextureUsesAll;
+layout(constant_id = PT_SPEC_MEDIUM_KINDS) const uint kMediumKinds = 0xFFFFFFFFu;
 layout(constant_id = PT_SPEC_ENVIRONMENT_IMAGE) const bool kEnvironmentImage = true;
 #endif
 // Some emitter is one of lights.h's (not a triangle).
@@ -287,6 +288,7 @@ MediumInterface loadMediumInterface(uint primitive) {
   return (primitive & 1u) != 0u ? MediumInterface(a.z, a.w) : MediumInterface(a.x, a.y);
 }
 #define PT_MEDIUM_LOOP_TICK() gLoopIterations++
+#define PT_MEDIUM_KINDS kMediumKinds
 #include "volume_vertex.h"
 #endif
 

@@ -523,7 +523,8 @@ PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v =
 #define PT_SPEC_ALPHA 21               // bool: some material has an alpha cut-out
 #define PT_SPEC_BUMP 22                // bool: some material has a bump map
 #define PT_SPEC_TEXTURE_FEATURES 23    // uint: kTextureUses* bits of what the textures need
-#define PT_SPEC_COUNT 24
+#define PT_SPEC_MEDIUM_KINDS 24        // uint: bit 1 << kMedium* for each type of medium present
+#define PT_SPEC_COUNT 25
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever

@@ -128,6 +128,7 @@ void prepareMedia(Scene& scene, vec3 shift, SceneData& data) {
   data.params.cameraMedium = scene.cameraMedium;
   data.params.mediaPresent = 1u;
   data.effects.media = true;
+  for (const Medium& m : data.media) data.effects.mediumKinds |= 1u << m.type;
 }
 
 }  // namespace pt

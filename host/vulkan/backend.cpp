@@ -166,7 +166,8 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
                        all || fx.textures,
                        all || fx.alphaCutouts,
                        all || fx.bumpMaps,
-                       all ? kTextureUsesAll : fx.textureFeatures}};
+                       all ? kTextureUsesAll : fx.textureFeatures,
+                       all ? 0xFFFFFFFFu : fx.mediumKinds}};
   static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
                 PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
                 PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
@@ -176,7 +177,8 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
                 PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
                 PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_SPHERE_LIGHTS == 18 &&
                 PT_SPEC_ENVIRONMENT_IMAGE == 19 && PT_SPEC_TEXTURES == 20 && PT_SPEC_ALPHA == 21 &&
-                PT_SPEC_BUMP == 22 && PT_SPEC_TEXTURE_FEATURES == 23 && PT_SPEC_COUNT == 24);
+                PT_SPEC_BUMP == 22 && PT_SPEC_TEXTURE_FEATURES == 23 &&
+                PT_SPEC_MEDIUM_KINDS == 24 && PT_SPEC_COUNT == 25);
   std::vector<vk::SpecializationMapEntry> entries;
   for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));
