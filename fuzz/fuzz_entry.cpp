@@ -248,10 +248,34 @@ Outcome fuzzTexture(const std::uint8_t* data, std::size_t size) {
   });
 }
 
+// A NanoVDB file as a nanovdb medium reads it; an accepted one must pack into a sparse grid
+// whose brick map points inside it.
+Outcome fuzzNanoVdb(const std::uint8_t* data, std::size_t size) {
+  const fs::path path = workDir() / "grids.nvdb";
+  writeFile(path, data, size);
+  return guarded([&] {
+    const NanoVdbMediumGrids grids = readNanoVdbMedium(path, "density", "temperature");
+    for (const VoxelBricks* g :
+         {&grids.density, grids.temperature ? &*grids.temperature : nullptr}) {
+      if (g == nullptr) continue;
+      const std::vector<float> packed = packVoxelGrid(*g);
+      PT_CHECK(packedVoxelGridFloats(packed.data()) == packed.size(), "nvdb: packed size");
+      for (uint32_t entry : g->map) {
+        PT_CHECK((entry & kConstantBrick) ? (entry & ~kConstantBrick) < g->constants.size()
+                                          : std::size_t(entry) * kBrickVoxels < g->values.size(),
+                 "nvdb: a brick map entry outside the grid");
+      }
+    }
+    PT_CHECK(grids.boundsMin.x < grids.boundsMax.x && grids.boundsMin.y < grids.boundsMax.y &&
+                 grids.boundsMin.z < grids.boundsMax.z,
+             "nvdb: empty bounds accepted");
+  });
+}
+
 const std::vector<Target>& targets() {
   static const std::vector<Target> all = {
-      {"scene", fuzzScene}, {"obj", fuzzObj},   {"mtl", fuzzMtl},        {"ply", fuzzPly},
-      {"image", fuzzImage}, {"pbrt", fuzzPbrt}, {"texture", fuzzTexture}};
+      {"scene", fuzzScene}, {"obj", fuzzObj},   {"mtl", fuzzMtl},         {"ply", fuzzPly},
+      {"image", fuzzImage}, {"pbrt", fuzzPbrt}, {"texture", fuzzTexture}, {"nvdb", fuzzNanoVdb}};
   return all;
 }
 

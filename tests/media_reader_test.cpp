@@ -704,6 +704,10 @@ TEST(MediaFuzzSeeds, AreAcceptedByTheFuzzEntryPoints) {
             fuzz::Outcome::kAccepted);
   EXPECT_EQ(fuzz::fuzzScene(reinterpret_cast<const std::uint8_t*>(json.data()), json.size()),
             fuzz::Outcome::kAccepted);
+  const std::string nvdb = bytes(corpus / "nvdb" / "fire-zip.nvdb");
+  ASSERT_FALSE(nvdb.empty());
+  EXPECT_EQ(fuzz::fuzzNanoVdb(reinterpret_cast<const std::uint8_t*>(nvdb.data()), nvdb.size()),
+            fuzz::Outcome::kAccepted);
   // And they do have media.
   const Scene s = loadPbrtSceneText(pbrt, "media.pbrt");
   EXPECT_EQ(s.mediumNames, (std::vector<std::string>{"air", "fog", "smoke", "cloud", "puff"}));

@@ -13,7 +13,7 @@
 #include <glm/matrix.hpp>
 
 #include "common/check.h"
-#include "medium.h"  // kNoisePermutation (noise.h)
+#include "noise_permutation.h"
 #include "scene/json_reader.h"
 #include "scene/pbrt/spectra.h"
 #include "scene/voxel_grid.h"

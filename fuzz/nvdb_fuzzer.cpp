@@ -1,0 +1,12 @@
+// libFuzzer target for NanoVDB files as a nanovdb medium reads them (fuzz/fuzz_entry.cpp):
+// InputError is the one allowed failure, anything else (a crash, another exception, a leak, a
+// hang) is a finding.
+#include <cstddef>
+#include <cstdint>
+
+#include "fuzz/fuzz_entry.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  pt::fuzz::fuzzNanoVdb(data, size);
+  return 0;
+}
