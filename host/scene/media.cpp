@@ -181,14 +181,18 @@ std::vector<float> scaledRgbGrid(const std::vector<float>& grid, double scale, s
 
 // The blackbody table of a nanovdb medium whose temperatures reach `hottest` kelvin
 // (shared_types.h): pbrt-v4's BlackbodySpectrum (Planck's law divided by its peak) as linear
-// sRGB through the CIE 1931 observer, as its film records it.
+// sRGB as its film records it: pbrt-v4 normalizes a light's spectrum to luminance 1 (and an
+// emissive medium's Le), but not this one, and its film sums the matching functions times the
+// radiance without dividing by the integral of y-bar (106.86): XYZ = sum of x-bar, y-bar,
+// z-bar times the spectrum, per nanometre.
 std::vector<float> blackbodyTable(double hottest) {
   std::vector<float> table(kBlackbodyTableFloats);
   table[0] = static_cast<float>(hottest);
   const double top = double(table[0]);
   for (uint i = 0; i < kBlackbodyEntries; ++i) {
     const double kelvin = 100.0 + (top - 100.0) * double(i) / double(kBlackbodyEntries - 1);
-    const glm::dvec3 rgb = spectra::xyzToLinearSrgb() * spectra::toXyz(spectra::blackbody(kelvin));
+    const glm::dvec3 rgb = spectra::xyzToLinearSrgb() * spectra::toXyz(spectra::blackbody(kelvin)) *
+                           spectra::cieYIntegral();
     for (int c = 0; c < 3; ++c) table[1 + 3 * i + uint(c)] = static_cast<float>(rgb[c]);
   }
   return table;
