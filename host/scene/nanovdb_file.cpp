@@ -4,7 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <exception>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -26,11 +30,133 @@ constexpr double kMaxBricks = 64.0 * 1024.0 * 1024.0;
 
 using Handle = nanovdb::GridHandle<nanovdb::HostBuffer>;
 
-// Grid `name` of `file`, validated; an empty handle where the file has no grid of that name.
-Handle readGrid(const std::filesystem::path& file, const std::string& name) {
+// The node arrays and child offsets of `grid` (in a buffer of `size` bytes) checked before
+// anything follows them: each level's nodes inside the buffer and aligned, every child offset
+// of the root and the internal nodes landing on a node of the level below. NanoVDB's own
+// validator follows the offsets first and checks them after (a damaged file made it read
+// through a misaligned pointer), and its checksum may cover only the headers.
+std::string structureProblem(const nanovdb::NanoGrid<float>& grid, std::size_t size) {
+  using Root = nanovdb::NanoRoot<float>;
+  using Upper = nanovdb::NanoUpper<float>;
+  using Lower = nanovdb::NanoLower<float>;
+  using Leaf = nanovdb::NanoLeaf<float>;
+  // Positions are byte offsets from the grid, checked before they become pointers.
+  const auto* begin = reinterpret_cast<const char*>(&grid);
+  const auto within = [&](std::uint64_t at, std::uint64_t bytes) {
+    return at <= size && bytes <= size - at && at % NANOVDB_DATA_ALIGNMENT == 0;
+  };
+  const std::uint64_t treeAt = sizeof(nanovdb::GridData);
+  if (!within(0, treeAt + sizeof(nanovdb::TreeData<3>))) return "its header is truncated";
+  const auto& tree = *reinterpret_cast<const nanovdb::TreeData<3>*>(begin + treeAt);
+  const std::uint64_t sizes[4] = {sizeof(Leaf), sizeof(Lower), sizeof(Upper), sizeof(Root)};
+  std::uint64_t first[4];
+  for (int level = 0; level < 4; ++level) {
+    const std::uint64_t count = level < 3 ? tree.mNodeCount[level] : 1;
+    first[level] = treeAt + tree.mNodeOffset[level];
+    if (count == 0) continue;
+    if (tree.mNodeOffset[level] > size || count > size / sizes[level] ||
+        !within(first[level], count * sizes[level])) {
+      return "its nodes of level " + std::to_string(level) + " lie outside it";
+    }
+  }
+  // An offset `delta` from the node at `from` must land on a node of `level`'s array.
+  const auto isNode = [&](std::uint64_t from, std::int64_t delta, int level) {
+    const std::uint64_t to = from + std::uint64_t(delta);  // wraps for bad offsets: refused
+    return to >= first[level] && (to - first[level]) % sizes[level] == 0 &&
+           (to - first[level]) / sizes[level] < tree.mNodeCount[level];
+  };
+  const auto& root = *reinterpret_cast<const Root::DataType*>(begin + first[3]);
+  if (root.mTableSize > (size - first[3] - sizeof(Root)) / sizeof(Root::Tile)) {
+    return "its root's table lies outside it";
+  }
+  for (uint32_t i = 0; i < root.mTableSize; ++i) {
+    const std::int64_t child = root.tile(i)->child;
+    if (child != 0 && !isNode(first[3], child, 2)) {
+      return "a child offset of its root points outside its nodes";
+    }
+  }
+  for (uint32_t k = 0; k < tree.mNodeCount[2]; ++k) {
+    const std::uint64_t at = first[2] + k * sizeof(Upper);
+    const auto& upper = *reinterpret_cast<const Upper::DataType*>(begin + at);
+    for (uint32_t t = 0; t < Upper::SIZE; ++t) {
+      if (upper.mChildMask.isOn(t) && !isNode(at, upper.mTable[t].child, 1)) {
+        return "a child offset of an internal node points outside its nodes";
+      }
+    }
+  }
+  for (uint32_t k = 0; k < tree.mNodeCount[1]; ++k) {
+    const std::uint64_t at = first[1] + k * sizeof(Lower);
+    const auto& lower = *reinterpret_cast<const Lower::DataType*>(begin + at);
+    for (uint32_t t = 0; t < Lower::SIZE; ++t) {
+      if (lower.mChildMask.isOn(t) && !isNode(at, lower.mTable[t].child, 0)) {
+        return "a child offset of an internal node points outside its nodes";
+      }
+    }
+  }
+  return "";
+}
+
+// The largest grid a file may ask to allocate (uncompressed).
+constexpr std::uint64_t kMaxGridBytes = std::uint64_t(4) << 30;
+
+// The file's segments walked before NanoVDB's reader sees them (it trusts their sizes and
+// reads grid names up to a zero byte that may not be there): every header, description, name
+// and grid within the file, names terminated, sizes that agree with the codec.
+std::string containerProblem(const std::string& bytes) {
+  namespace io = nanovdb::io;
+  const std::uint64_t size = bytes.size();
+  std::uint64_t at = 0;
+  while (at < size) {
+    io::Header header;
+    if (size - at < sizeof header) return "a segment header is cut short";
+    std::memcpy(&header, bytes.data() + at, sizeof header);
+    at += sizeof header;
+    if (header.magic != NANOVDB_MAGIC_NUMBER) return "";  // NanoVDB's reader says what it is
+    if (header.codec != io::Codec::NONE && header.codec != io::Codec::ZIP &&
+        header.codec != io::Codec::BLOSC) {
+      return "a segment has an unknown compression codec";
+    }
+    std::vector<std::uint64_t> dataSizes;
+    for (uint32_t g = 0; g < header.gridCount; ++g) {
+      io::MetaData meta;
+      if (size - at < sizeof meta) return "a grid's description is cut short";
+      std::memcpy(&meta, bytes.data() + at, sizeof meta);
+      at += sizeof meta;
+      if (meta.nameSize == 0 || meta.nameSize > size - at || bytes[at + meta.nameSize - 1] != 0) {
+        return "a grid's name runs past the end of the file or is not terminated";
+      }
+      at += meta.nameSize;
+      if (meta.gridSize > kMaxGridBytes) return "a grid claims more than 4 GiB";
+      if (header.codec == io::Codec::NONE && meta.fileSize != meta.gridSize) {
+        return "an uncompressed grid's sizes disagree";
+      }
+      dataSizes.push_back(meta.fileSize);
+    }
+    for (std::uint64_t dataSize : dataSizes) {
+      if (dataSize > size - at) return "a grid runs past the end of the file";
+      if (header.codec == io::Codec::ZIP) {
+        std::uint64_t packed = 0;
+        if (dataSize < sizeof packed) return "a compressed grid is cut short";
+        std::memcpy(&packed, bytes.data() + at, sizeof packed);
+        if (packed != dataSize - sizeof packed) return "a compressed grid's sizes disagree";
+      }
+      at += dataSize;
+    }
+  }
+  return "";
+}
+
+// Grid `name` of `file` (its bytes `bytes`), validated; an empty handle where the file has no
+// grid of that name.
+Handle readGrid(const std::filesystem::path& file, const std::string& bytes,
+                const std::string& name) {
+  if (const std::string problem = containerProblem(bytes); !problem.empty()) {
+    throw InputError(file.string() + ": " + problem);
+  }
   Handle handle;
   try {
-    handle = nanovdb::io::readGrid<nanovdb::HostBuffer>(file.string(), name);
+    std::istringstream in(bytes);
+    handle = nanovdb::io::readGrid<nanovdb::HostBuffer>(in, name);
   } catch (const std::exception& e) {
     throw InputError(file.string() + ": " + e.what());
   }
@@ -46,7 +172,8 @@ Handle readGrid(const std::filesystem::path& file, const std::string& name) {
         file.string() + ": grid '" + name +
         "' does not hold 32-bit floats (its type: " + nanovdb::toStr(meta->gridType()) + ")");
   }
-  const std::string problem = nanovdb::GridValidator<float>::check(*grid, true);
+  std::string problem = structureProblem(*grid, std::size_t(meta->gridSize()));
+  if (problem.empty()) problem = nanovdb::GridValidator<float>::check(*grid, true);
   if (!problem.empty()) {
     throw InputError(file.string() + ": grid '" + name + "' is damaged: " + problem);
   }
@@ -160,11 +287,21 @@ VoxelBricks bricksOf(const std::filesystem::path& file, const std::string& name,
 NanoVdbMediumGrids readNanoVdbMedium(const std::filesystem::path& file,
                                      const std::string& densityName,
                                      const std::string& temperatureName) {
-  const Handle density = readGrid(file, densityName);
+  std::string bytes;
+  {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) {
+      throw InputError(file.string() + ": Unable to open file named \"" + file.string() +
+                       "\" for input");
+    }
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (in.bad()) throw InputError(file.string() + ": could not be read");
+  }
+  const Handle density = readGrid(file, bytes, densityName);
   if (!density) {
     throw InputError(file.string() + ": no grid named '" + densityName + "'");
   }
-  const Handle temperature = readGrid(file, temperatureName);
+  const Handle temperature = readGrid(file, bytes, temperatureName);
   NanoVdbMediumGrids out;
   const auto unite = [&](const nanovdb::NanoGrid<float>& g) {
     const auto& box = g.worldBBox();
