@@ -168,9 +168,13 @@ Handle readGrid(const std::filesystem::path& file, const std::string& bytes,
   }
   const nanovdb::NanoGrid<float>* grid = handle.grid<float>();
   if (grid == nullptr) {
-    throw InputError(
-        file.string() + ": grid '" + name +
-        "' does not hold 32-bit floats (its type: " + nanovdb::toStr(meta->gridType()) + ")");
+    const auto type = static_cast<uint32_t>(meta->gridType());
+    throw InputError(file.string() + ": grid '" + name +
+                     "' does not hold 32-bit floats (its type: " +
+                     (type < static_cast<uint32_t>(nanovdb::GridType::End)
+                          ? std::string(nanovdb::toStr(meta->gridType()))
+                          : "unknown, number " + std::to_string(type)) +
+                     ")");
   }
   std::string problem = structureProblem(*grid, std::size_t(meta->gridSize()));
   if (problem.empty()) problem = nanovdb::GridValidator<float>::check(*grid, true);
