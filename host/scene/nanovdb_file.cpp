@@ -112,6 +112,11 @@ std::string containerProblem(const std::string& bytes) {
     std::memcpy(&header, bytes.data() + at, sizeof header);
     at += sizeof header;
     if (header.magic != NANOVDB_MAGIC_NUMBER) return "";  // NanoVDB's reader says what it is
+    if (header.version.getMajor() != NANOVDB_MAJOR_VERSION_NUMBER) {
+      return "written by NanoVDB " + std::to_string(header.version.getMajor()) + "." +
+             std::to_string(header.version.getMinor()) + "; this renderer reads the files of " +
+             "NanoVDB " + std::to_string(NANOVDB_MAJOR_VERSION_NUMBER) + ".x";
+    }
     if (header.codec != io::Codec::NONE && header.codec != io::Codec::ZIP &&
         header.codec != io::Codec::BLOSC) {
       return "a segment has an unknown compression codec";
