@@ -6,8 +6,8 @@
 // The permutation is read from the media's grid buffer (noise_permutation.h's 512 values, as
 // integers' bits, from float `table`), through mediumGridWord, which the includer defines
 // (medium.h in C++): as a constant array in the shader, lavapipe's compiler ran for over 50
-// minutes and 9.5 GB on the volume variant (the noise's 39 lookups per call, inlined 13 times
-// per density) and was stopped.
+// minutes and 9.5 GB on the volume variant (24 lookups per noise, 13 noises per density, all
+// inlined) and was stopped.
 #ifndef PT_NOISE_H
 #define PT_NOISE_H
 
