@@ -23,7 +23,7 @@
 #ifndef PT_MEDIUM_KINDS
 #define PT_MEDIUM_KINDS 0xFFFFFFFFu
 #endif
-#define PT_HAS_MEDIUM(t) (m.type == (t) && (PT_MEDIUM_KINDS & (1u << (t))) != 0u)
+#define PT_HAS_MEDIUM(medium, t) ((medium).type == (t) && (PT_MEDIUM_KINDS & (1u << (t))) != 0u)
 
 #ifdef __cplusplus
 namespace pt {
@@ -103,50 +103,71 @@ PT_INLINE vec3 gridLookupRgb(PT_SCENE_PARAM uint first, uvec3 size, vec3 u) {
 
 // ---- Sparse voxel grids (shared_types.h's layout) ---------------------------------------------
 
-// The value of voxel v (index coordinates) of the sparse grid that starts at float g.
-PT_INLINE float voxelGridValue(PT_SCENE_PARAM uint g, ivec3 v) {
-  ivec3 origin =
-      ivec3(int(mediumGridWord(PT_SCENE_ARG g + 12u)), int(mediumGridWord(PT_SCENE_ARG g + 13u)),
-            int(mediumGridWord(PT_SCENE_ARG g + 14u)));
-  uvec3 bricks = uvec3(mediumGridWord(PT_SCENE_ARG g + 15u), mediumGridWord(PT_SCENE_ARG g + 16u),
-                       mediumGridWord(PT_SCENE_ARG g + 17u));
-  ivec3 local = v - origin;
-  ivec3 b = local >> 3;  // rounds down: negative coordinates fall outside
-  if (any(lessThan(local, ivec3(0))) || any(greaterThanEqual(b, ivec3(bricks)))) {
-    return mediumGridFloat(PT_SCENE_ARG g + 18u);
-  }
-  uint entry = mediumGridWord(PT_SCENE_ARG g + kVoxelGridHeader +
-                              (uint(b.z) * bricks.y + uint(b.y)) * bricks.x + uint(b.x));
-  if ((entry & kConstantBrick) != 0u) {
-    return mediumGridFloat(PT_SCENE_ARG g + mediumGridWord(PT_SCENE_ARG g + 19u) +
-                           (entry & ~kConstantBrick));
-  }
-  ivec3 in8 = local & 7;
-  return mediumGridFloat(PT_SCENE_ARG g + mediumGridWord(PT_SCENE_ARG g + 20u) +
-                         entry * kBrickVoxels + uint((in8.z * 8 + in8.y) * 8 + in8.x));
+// A sparse grid's header, read once per lookup (its eight corners share it).
+struct VoxelGrid {
+  uint first;     // the grid's first float
+  vec4 toIndex0;  // index-from-medium rows
+  vec4 toIndex1;
+  vec4 toIndex2;
+  ivec3 origin;      // the first voxel of brick (0, 0, 0)
+  uvec3 bricks;      // along x, y, z
+  float background;  // beyond the bricks
+  uint constants;    // where the constants start, from `first`
+  uint values;       // where the bricks' values start, likewise
+};
+
+PT_INLINE vec4 gridVec4(PT_SCENE_PARAM uint i) {
+  return vec4(mediumGridFloat(PT_SCENE_ARG i), mediumGridFloat(PT_SCENE_ARG i + 1u),
+              mediumGridFloat(PT_SCENE_ARG i + 2u), mediumGridFloat(PT_SCENE_ARG i + 3u));
 }
 
-// The grid's value at point p of the medium's space: trilinear between the voxels around its
-// index coordinates (NanoVDB's SampleFromVoxels of order 1, as pbrt-v4 samples it).
+PT_INLINE VoxelGrid loadVoxelGrid(PT_SCENE_PARAM uint g) {
+  return VoxelGrid(
+      g, gridVec4(PT_SCENE_ARG g), gridVec4(PT_SCENE_ARG g + 4u), gridVec4(PT_SCENE_ARG g + 8u),
+      ivec3(int(mediumGridWord(PT_SCENE_ARG g + 12u)), int(mediumGridWord(PT_SCENE_ARG g + 13u)),
+            int(mediumGridWord(PT_SCENE_ARG g + 14u))),
+      uvec3(mediumGridWord(PT_SCENE_ARG g + 15u), mediumGridWord(PT_SCENE_ARG g + 16u),
+            mediumGridWord(PT_SCENE_ARG g + 17u)),
+      mediumGridFloat(PT_SCENE_ARG g + 18u), mediumGridWord(PT_SCENE_ARG g + 19u),
+      mediumGridWord(PT_SCENE_ARG g + 20u));
+}
+
+// The value of voxel v (index coordinates) of sparse grid `vg`.
+PT_INLINE float voxelGridValue(PT_SCENE_PARAM PT_IN(VoxelGrid) vg, ivec3 v) {
+  ivec3 local = v - vg.origin;
+  ivec3 b = local >> 3;  // rounds down: negative coordinates fall outside
+  if (any(lessThan(local, ivec3(0))) || any(greaterThanEqual(b, ivec3(vg.bricks)))) {
+    return vg.background;
+  }
+  uint entry = mediumGridWord(PT_SCENE_ARG vg.first + kVoxelGridHeader +
+                              (uint(b.z) * vg.bricks.y + uint(b.y)) * vg.bricks.x + uint(b.x));
+  if ((entry & kConstantBrick) != 0u) {
+    return mediumGridFloat(PT_SCENE_ARG vg.first + vg.constants + (entry & ~kConstantBrick));
+  }
+  ivec3 in8 = local & 7;
+  return mediumGridFloat(PT_SCENE_ARG vg.first + vg.values + entry * kBrickVoxels +
+                         uint((in8.z * 8 + in8.y) * 8 + in8.x));
+}
+
+// The value at point p of the medium's space of the sparse grid that starts at float g:
+// trilinear between the voxels around its index coordinates (NanoVDB's SampleFromVoxels of
+// order 1, as pbrt-v4 samples it).
 PT_INLINE float voxelGridLookup(PT_SCENE_PARAM uint g, vec3 p) {
-  vec4 r0 = vec4(mediumGridFloat(PT_SCENE_ARG g), mediumGridFloat(PT_SCENE_ARG g + 1u),
-                 mediumGridFloat(PT_SCENE_ARG g + 2u), mediumGridFloat(PT_SCENE_ARG g + 3u));
-  vec4 r1 = vec4(mediumGridFloat(PT_SCENE_ARG g + 4u), mediumGridFloat(PT_SCENE_ARG g + 5u),
-                 mediumGridFloat(PT_SCENE_ARG g + 6u), mediumGridFloat(PT_SCENE_ARG g + 7u));
-  vec4 r2 = vec4(mediumGridFloat(PT_SCENE_ARG g + 8u), mediumGridFloat(PT_SCENE_ARG g + 9u),
-                 mediumGridFloat(PT_SCENE_ARG g + 10u), mediumGridFloat(PT_SCENE_ARG g + 11u));
-  vec3 s = vec3(dot(vec3(r0), p) + r0.w, dot(vec3(r1), p) + r1.w, dot(vec3(r2), p) + r2.w);
+  VoxelGrid vg = loadVoxelGrid(PT_SCENE_ARG g);
+  vec3 s =
+      vec3(dot(vec3(vg.toIndex0), p) + vg.toIndex0.w, dot(vec3(vg.toIndex1), p) + vg.toIndex1.w,
+           dot(vec3(vg.toIndex2), p) + vg.toIndex2.w);
   vec3 f = floor(s);
   ivec3 i = ivec3(f);
   vec3 d = s - f;
-  float c00 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG g, i),
-                        voxelGridValue(PT_SCENE_ARG g, i + ivec3(1, 0, 0)));
-  float c10 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG g, i + ivec3(0, 1, 0)),
-                        voxelGridValue(PT_SCENE_ARG g, i + ivec3(1, 1, 0)));
-  float c01 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG g, i + ivec3(0, 0, 1)),
-                        voxelGridValue(PT_SCENE_ARG g, i + ivec3(1, 0, 1)));
-  float c11 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG g, i + ivec3(0, 1, 1)),
-                        voxelGridValue(PT_SCENE_ARG g, i + ivec3(1, 1, 1)));
+  float c00 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG vg, i),
+                        voxelGridValue(PT_SCENE_ARG vg, i + ivec3(1, 0, 0)));
+  float c10 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG vg, i + ivec3(0, 1, 0)),
+                        voxelGridValue(PT_SCENE_ARG vg, i + ivec3(1, 1, 0)));
+  float c01 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG vg, i + ivec3(0, 0, 1)),
+                        voxelGridValue(PT_SCENE_ARG vg, i + ivec3(1, 0, 1)));
+  float c11 = lerpValue(d.x, voxelGridValue(PT_SCENE_ARG vg, i + ivec3(0, 1, 1)),
+                        voxelGridValue(PT_SCENE_ARG vg, i + ivec3(1, 1, 1)));
   return lerpValue(d.z, lerpValue(d.y, c00, c10), lerpValue(d.y, c01, c11));
 }
 
@@ -172,11 +193,11 @@ PT_INLINE vec3 blackbodyLookup(PT_SCENE_PARAM uint table, float kelvin) {
 // sigma_a and sigma_s times the density, Le times its grid; rgbgrid: the RGB grids times
 // sigma_a and sigma_s, its Le grid times Le (the readers fold the scales into its grids).
 PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, vec3 p) {
-  if (PT_HAS_MEDIUM(kMediumHomogeneous)) return MediumProperties(m.sigmaA, m.sigmaS, m.Le);
+  if (PT_HAS_MEDIUM(m, kMediumHomogeneous)) return MediumProperties(m.sigmaA, m.sigmaS, m.Le);
   vec3 pm = toMediumSpace(m, p);
   vec3 u = (pm - m.boundsMin) / (m.boundsMax - m.boundsMin);
   MediumProperties mp = MediumProperties(vec3(0.0f), vec3(0.0f), vec3(0.0f));
-  if (PT_HAS_MEDIUM(kMediumNanoVdb)) {
+  if (PT_HAS_MEDIUM(m, kMediumNanoVdb)) {
     // pbrt-v4's NanoVDBMedium: the density grid scales sigma_a and sigma_s; where it has a
     // temperature grid, Lescale times the blackbody at (T - temperatureoffset) *
     // temperaturescale.
@@ -187,13 +208,13 @@ PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, ve
       float t = voxelGridLookup(PT_SCENE_ARG m.emission + kBlackbodyTableFloats, pm);
       mp.Le = m.Le.x * blackbodyLookup(PT_SCENE_ARG m.emission, (t - m.Le.y) * m.Le.z);
     }
-  } else if (PT_HAS_MEDIUM(kMediumCloud)) {
+  } else if (PT_HAS_MEDIUM(m, kMediumCloud)) {
     // pbrt-v4's CloudMedium; Le holds its density, wispiness and frequency, `density` where
     // its noise's permutation is.
     float d = cloudDensity(PT_SCENE_ARG m.density, pm, m.Le.x, m.Le.y, m.Le.z);
     mp.sigmaA = m.sigmaA * d;
     mp.sigmaS = m.sigmaS * d;
-  } else if (PT_HAS_MEDIUM(kMediumUniformGrid)) {
+  } else if (PT_HAS_MEDIUM(m, kMediumUniformGrid)) {
     float d = gridLookup(PT_SCENE_ARG m.density, m.size, 1u, 0u, u);
     mp.sigmaA = m.sigmaA * d;
     mp.sigmaS = m.sigmaS * d;
@@ -204,7 +225,7 @@ PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, ve
       mp.Le = m.emission == kNoGrid ? m.Le * (f.x * f.y * f.z)
                                     : m.Le * gridLookup(PT_SCENE_ARG m.emission, m.size, 1u, 0u, u);
     }
-  } else if (PT_HAS_MEDIUM(kMediumRgbGrid)) {
+  } else if (PT_HAS_MEDIUM(m, kMediumRgbGrid)) {
     uint voxels = m.size.x * m.size.y * m.size.z;
     mp.sigmaA = m.sigmaA * gridLookupRgb(PT_SCENE_ARG m.density, m.size, u);
     mp.sigmaS = m.sigmaS * gridLookupRgb(PT_SCENE_ARG m.density + 3u * voxels, m.size, u);

@@ -101,6 +101,7 @@ TEST(NanoVdb, SparseGridHoldsEveryVoxelAndSamplesAsNanoVdb) {
   const std::vector<float> packed = packVoxelGrid(read.density);
   EXPECT_EQ(packedVoxelGridFloats(packed.data()), packed.size());
   const PathScene scene = gridScene(packed);
+  const VoxelGrid vg = loadVoxelGrid(scene, 0u);
   const nanovdb::NanoGrid<float>& grid = *handle.grid<float>();
   auto acc = grid.getAccessor();
   // Bounds: the grid's world box, as pbrt-v4 takes them.
@@ -112,7 +113,7 @@ TEST(NanoVdb, SparseGridHoldsEveryVoxelAndSamplesAsNanoVdb) {
   for (int z = -14; z <= 22; ++z) {
     for (int y = -12; y <= 20; ++y) {
       for (int x = -14; x <= 23; ++x) {
-        const float v = voxelGridValue(scene, 0u, ivec3(x, y, z));
+        const float v = voxelGridValue(scene, vg, ivec3(x, y, z));
         ASSERT_EQ(v, acc.getValue(nanovdb::Coord(x, y, z))) << x << " " << y << " " << z;
         nonzero += v != 0.0f;
       }

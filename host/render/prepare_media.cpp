@@ -15,10 +15,7 @@ namespace {
 // largest density of the voxels that trilinear lookups in it reach (the index box of the cell's
 // corners, floor to floor + 1), widened by a voxel on every side against rounding.
 std::vector<float> voxelGridMajorants(const Medium& m, const float* grid) {
-  glm::dmat4 indexFromMedium(1.0);
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 4; ++c) indexFromMedium[c][r] = double(grid[4 * r + c]);
-  }
+  const glm::dmat4 indexFromMedium = voxelGridIndexFromMedium(grid);
   const glm::dvec3 lo(m.boundsMin), extent = glm::dvec3(m.boundsMax) - glm::dvec3(m.boundsMin);
   std::vector<float> out(size_t(m.size.x) * m.size.y * m.size.z, 0.0f);
   for (uint z = 0; z < m.size.z; ++z) {

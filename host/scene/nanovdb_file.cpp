@@ -75,23 +75,19 @@ std::string structureProblem(const nanovdb::NanoGrid<float>& grid, std::size_t s
       return "a child offset of its root points outside its nodes";
     }
   }
-  for (uint32_t k = 0; k < tree.mNodeCount[2]; ++k) {
-    const std::uint64_t at = first[2] + k * sizeof(Upper);
-    const auto& upper = *reinterpret_cast<const Upper::DataType*>(begin + at);
-    for (uint32_t t = 0; t < Upper::SIZE; ++t) {
-      if (upper.mChildMask.isOn(t) && !isNode(at, upper.mTable[t].child, 1)) {
-        return "a child offset of an internal node points outside its nodes";
+  // The internal nodes of `level` (Node: Upper or Lower): their children on the level below.
+  const auto childrenAreNodes = [&]<typename Node>(int level) {
+    for (uint32_t k = 0; k < tree.mNodeCount[level]; ++k) {
+      const std::uint64_t at = first[level] + k * sizeof(Node);
+      const auto& node = *reinterpret_cast<const typename Node::DataType*>(begin + at);
+      for (uint32_t t = 0; t < Node::SIZE; ++t) {
+        if (node.mChildMask.isOn(t) && !isNode(at, node.mTable[t].child, level - 1)) return false;
       }
     }
-  }
-  for (uint32_t k = 0; k < tree.mNodeCount[1]; ++k) {
-    const std::uint64_t at = first[1] + k * sizeof(Lower);
-    const auto& lower = *reinterpret_cast<const Lower::DataType*>(begin + at);
-    for (uint32_t t = 0; t < Lower::SIZE; ++t) {
-      if (lower.mChildMask.isOn(t) && !isNode(at, lower.mTable[t].child, 0)) {
-        return "a child offset of an internal node points outside its nodes";
-      }
-    }
+    return true;
+  };
+  if (!childrenAreNodes.operator()<Upper>(2) || !childrenAreNodes.operator()<Lower>(1)) {
+    return "a child offset of an internal node points outside its nodes";
   }
   return "";
 }

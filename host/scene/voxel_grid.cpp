@@ -45,6 +45,14 @@ std::size_t packedVoxelGridFloats(const float* grid) {
   return glm::floatBitsToUint(grid[21]);
 }
 
+glm::dmat4 voxelGridIndexFromMedium(const float* grid) {
+  glm::dmat4 m(1.0);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) m[c][r] = double(grid[4 * r + c]);
+  }
+  return m;
+}
+
 float voxelGridMax(const float* grid, glm::ivec3 lo, glm::ivec3 hi) {
   const glm::ivec3 origin(int32_t(glm::floatBitsToUint(grid[12])),
                           int32_t(glm::floatBitsToUint(grid[13])),

@@ -34,6 +34,9 @@ std::vector<float> packVoxelGrid(const VoxelBricks& grid);
 // The floats a packed grid starting at `grid` occupies (its header says).
 std::size_t packedVoxelGridFloats(const float* grid);
 
+// The index-from-medium transform of a packed grid (its header's rows).
+glm::dmat4 voxelGridIndexFromMedium(const float* grid);
+
 // The largest value of a packed grid over the voxels [lo, hi] (inclusive; index coordinates),
 // the background included where the range leaves the bricks.
 float voxelGridMax(const float* grid, glm::ivec3 lo, glm::ivec3 hi);
