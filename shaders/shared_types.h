@@ -194,6 +194,11 @@ PT_CONST uint kMediumRgbGrid = 2u;      // RGB grids of sigma_a, sigma_s and Le
 PT_CONST uint kMediumNanoVdb = 3u;  // sigma_a, sigma_s times a sparse density grid; blackbody Le
 PT_CONST uint kMediumCloud = 4u;    // sigma_a, sigma_s times pbrt-v4's procedural cloud density
 PT_CONST uint kMediumTypeCount = 5u;
+// What a medium emits (Medium::emissive): nothing; Le (times a grid where it has one); or
+// pbrt-v4's blackbody at the temperature its grid gives.
+PT_CONST uint kEmitsNothing = 0u;
+PT_CONST uint kEmitsLe = 1u;
+PT_CONST uint kEmitsBlackbody = 2u;
 PT_CONST uint kNoGrid = 0xFFFFFFFFu;  // a grid medium's missing grid (no Le grid)
 // The majorant grid of a grid medium: this many cells on each axis over its bounds (pbrt-v4's
 // 16^3), each the largest density of the voxels it overlaps.
@@ -204,8 +209,11 @@ PT_CONST uint kNanoVdbMajorantRes = 64u;
 // Grids hold a value per voxel (RGB: three) in pbrt-v4's SampledGrid order, x fastest: voxel
 // (x, y, z) is number (z * size.y + y) * size.x + x. An rgbgrid's scales are folded into its
 // grids by the readers (its sigmaA, sigmaS and Le are then ones). A nanovdb medium's grids are
-// sparse voxel grids (below), its emission a blackbody table followed by its temperature grid;
-// a cloud's density is a function of the point (shaders/noise.h), its "density grid" the
+// sparse voxel grids (below), its emission a blackbody table followed by its temperature grid.
+// A uniformgrid that emits by temperature (emissive kEmitsBlackbody) has the same: a blackbody
+// table, then its temperature grid, then its Lescale grid where it has one (Le.x 1; 0 without:
+// pbrt-v4's grid of one voxel of 1), and (Le.y, Le.z) its (temperatureoffset, temperaturescale).
+// A cloud's density is a function of the point (shaders/noise.h), its "density grid" the
 // permutation its noise reads. "Grids" below means every medium but the homogeneous one.
 struct Medium {
   vec3 sigmaA;     // 12 bytes: absorption (homogeneous), or what the density multiplies
@@ -215,7 +223,7 @@ struct Medium {
   vec3 Le;         // 12 bytes: emitted radiance (homogeneous, uniformgrid: times its grid);
                    //           nanovdb: (Lescale, temperatureoffset, temperaturescale);
                    //           cloud: (density, wispiness, frequency)
-  uint emissive;   //  4 bytes: 1 when some of it emits
+  uint emissive;   //  4 bytes: kEmitsNothing, kEmitsLe or kEmitsBlackbody
   vec3 boundsMin;  // 12 bytes: grids: p0, in the medium's space (nanovdb: its grids' bounds)
   uint density;    //  4 bytes: grids: the first float of its density grid (uniformgrid: one
                    //           float per voxel; rgbgrid: sigma_a's RGB then sigma_s's RGB;
@@ -252,10 +260,11 @@ PT_CONST uint kMediumTexels = 9u;
 PT_CONST uint kVoxelGridHeader = 24u;
 PT_CONST uint kBrickVoxels = 512u;
 PT_CONST uint kConstantBrick = 0x80000000u;
-// A nanovdb medium's blackbody table (its emission): float 0 the highest temperature T1 it
+// A blackbody table (the emission of a nanovdb medium, or of a uniformgrid with
+// temperatures): float 0 the highest temperature T1 it
 // covers, then kBlackbodyEntries RGB triples of pbrt-v4's normalized blackbody spectrum at
-// temperatures evenly spaced from 100 K to T1, interpolated linearly; its temperature grid
-// follows the table.
+// temperatures evenly spaced from 100 K to T1, interpolated linearly; the medium's
+// temperature grid follows the table.
 PT_CONST uint kBlackbodyEntries = 2048u;
 PT_CONST uint kBlackbodyTableFloats = 1u + 3u * kBlackbodyEntries;
 

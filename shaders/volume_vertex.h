@@ -2,7 +2,8 @@
 // the steps of pbrt-v4's VolPathIntegrator::Li and its SampleLd that path_vertex.h does not
 // have. A ray's flight through a medium by delta tracking against the majorants (medium.h),
 // with absorption, scattering, null collisions and the medium's emission; the transmittance of
-// a shadow ray's segment by ratio tracking; light sampling from a point in a medium (the
+// a shadow ray's segment by ratio tracking (a homogeneous medium's in closed form, as a flight
+// through one that only absorbs); light sampling from a point in a medium (the
 // Henyey-Greenstein phase function for BSDF); the phase function's sample; emission found and
 // light samples weighed by the MIS of the null-scattering path integral (Miller et al. 2019),
 // and Russian roulette; the medium a ray enters through a surface.
@@ -159,6 +160,20 @@ PT_INLINE bool nextCollision(PT_SCENE_PARAM PT_INOUT(CollisionWalk) c, uint h,
   }
 }
 
+// ---- Homogeneous media in closed form -----------------------------------------------------
+
+// A homogeneous medium's transmittance exp(-sigma_t t) over a ray's length t (infinite where
+// the ray leaves the scene: then zero, or one in a medium that neither absorbs nor scatters).
+PT_INLINE vec3 homogeneousTransmittance(PT_IN(Medium) m, float t) {
+  return exp(-min(t, kMaxFloat) * (m.sigmaA + m.sigmaS));
+}
+
+// A homogeneous medium in which nothing happens along a ray but absorption (no scattering, no
+// emission): a flight through it passes with the transmittance's weight, in every channel.
+PT_INLINE bool onlyAbsorbs(PT_IN(Medium) m) {
+  return PT_HAS_MEDIUM(m, kMediumHomogeneous) && m.emissive == 0u && maxComponent(m.sigmaS) == 0.0f;
+}
+
 // ---- Delta tracking of a flight ------------------------------------------------------------
 
 PT_CONST uint kFlightPassed = 0u;     // the ray reached tMax (the surface, or nothing)
@@ -170,13 +185,19 @@ PT_CONST uint kFlightEnded = 2u;      // absorbed, or nothing left to carry
 // scattering or a null collision with the probabilities of the hero channel's coefficients
 // (pbrt-v4's SampleT_maj and the events of its volpath), the medium's emission added at each.
 // Updates beta, rU and rL; on kFlightScattered, p is the point and g the phase function's
-// asymmetry there.
+// asymmetry there. Through a medium that only absorbs (onlyAbsorbs) the flight passes with
+// beta times the transmittance, where pbrt-v4's delta tracking would end the path with the
+// probability of absorption: the same mean, without that noise.
 PT_INLINE uint trackFlight(PT_SCENE_PARAM PT_INOUT(VolumePath) v, vec3 o, vec3 d, float tMax,
                            PT_OUT(vec3) p, PT_OUT(float) g) {
   uint h = v.hero;
   Medium m = loadMedium(PT_SCENE_ARG v.medium);
   g = m.g;
   p = o;
+  if (onlyAbsorbs(m)) {
+    v.path.beta *= homogeneousTransmittance(m, tMax);
+    return maxComponent(v.path.beta) > 0.0f ? kFlightPassed : kFlightEnded;
+  }
   CollisionWalk c = startCollisionWalk(m, o, d, tMax);
   float uMode = nextRandom(v.rng);
   float t;
@@ -246,10 +267,17 @@ PT_INLINE ShadowTransmittance startShadowTransmittance(PT_SCENE_PARAM VertexKey 
 
 // Ratio tracking over the shadow ray's segment o + t d (d unit), t in [0, tMax), in `medium`
 // (the hero's majorant), with pbrt-v4's roulette where the estimate falls below 0.05. False
-// when the transmittance has become zero.
+// when the transmittance has become zero. A homogeneous medium's segment takes its
+// transmittance in closed form: there the majorant is sigma_t, and ratio tracking (pbrt-v4's
+// for every medium) would estimate it by zero or one. No choice depends on the hero there, so
+// rU and rL are unchanged.
 PT_INLINE bool trackShadowSegment(PT_SCENE_PARAM PT_INOUT(ShadowTransmittance) tr, uint medium,
                                   uint h, vec3 o, vec3 d, float tMax) {
   Medium m = loadMedium(PT_SCENE_ARG medium);
+  if (PT_HAS_MEDIUM(m, kMediumHomogeneous)) {
+    tr.T *= homogeneousTransmittance(m, tMax);
+    return maxComponent(tr.T) > 0.0f;
+  }
   CollisionWalk c = startCollisionWalk(m, o, d, tMax);
   float t;
   while (nextCollision(PT_SCENE_ARG c, h, tr.rng, t)) {

@@ -89,7 +89,7 @@ TEST(MediaPbrt, HomogeneousTakesPbrtV4sDefaults) {
   EXPECT_EQ(m.sigmaS, vec3(1.0f));
   EXPECT_EQ(m.g, 0.0f);
   EXPECT_EQ(m.Le, vec3(0.0f));
-  EXPECT_EQ(m.emissive, 0u);
+  EXPECT_EQ(m.emissive, kEmitsNothing);
   EXPECT_EQ(m.density, kNoGrid);
   EXPECT_EQ(m.majorants, kNoGrid);
   EXPECT_EQ(m.emission, kNoGrid);
@@ -110,7 +110,7 @@ TEST(MediaPbrt, HomogeneousScalesCoefficientsAndEmission) {
   EXPECT_EQ(m.sigmaS, vec3(8.0f, 10.0f, 12.0f));
   EXPECT_EQ(m.g, 0.5f);
   EXPECT_EQ(m.Le, vec3(3.0f, 6.0f, 9.0f));
-  EXPECT_EQ(m.emissive, 1u);
+  EXPECT_EQ(m.emissive, kEmitsLe);
   // One name: the medium on both sides.
   ASSERT_EQ(s.mediumInterfaces.size(), 1u);
   EXPECT_EQ(s.mediumInterfaces[0].inside, 0u);
@@ -175,7 +175,7 @@ TEST(MediaPbrt, UniformGridStoresDensityXFastestAndItsEmissionGrid) {
   EXPECT_EQ(m.sigmaA, vec3(2.0f, 4.0f, 8.0f));  // times scale
   EXPECT_EQ(m.sigmaS, vec3(4.0f));              // pbrt-v4's default 1, times scale
   EXPECT_EQ(m.Le, vec3(1.0f, 0.5f, 0.25f));
-  EXPECT_EQ(m.emissive, 1u);
+  EXPECT_EQ(m.emissive, kEmitsLe);
   EXPECT_EQ(m.majorants, kNoGrid);
   // The file's order is pbrt-v4's SampledGrid order, (z * ny + y) * nx + x: kept as it is.
   EXPECT_EQ(grid(s, m.density, 6), (std::vector<float>{0, 1, 2, 3, 4, 5}));
@@ -193,7 +193,7 @@ TEST(MediaPbrt, UniformGridStoresDensityXFastestAndItsEmissionGrid) {
                                "MediumInterface \"smoke\" \"\"\n" +
                                kTriangle);
   const Medium& d = dark.media[0];
-  EXPECT_EQ(d.emissive, 0u);
+  EXPECT_EQ(d.emissive, kEmitsNothing);
   EXPECT_EQ(d.emission, kNoGrid);
   EXPECT_EQ(d.size, uvec3(1));
   EXPECT_EQ(d.boundsMin, vec3(0.0f));
@@ -218,7 +218,7 @@ TEST(MediaPbrt, RgbGridHasItsScalesInItsGrids) {
   EXPECT_EQ(m.sigmaA, vec3(1.0f));
   EXPECT_EQ(m.sigmaS, vec3(1.0f));
   EXPECT_EQ(m.Le, vec3(1.0f));
-  EXPECT_EQ(m.emissive, 1u);
+  EXPECT_EQ(m.emissive, kEmitsLe);
   // sigma_a's RGB per voxel, then sigma_s's, times scale; then Le times Lescale.
   EXPECT_EQ(grid(s, m.density, 12), (std::vector<float>{2, 4, 6, 8, 10, 12, 1, 1, 1, 2, 2, 2}));
   EXPECT_EQ(grid(s, m.emission, 6), (std::vector<float>{1, 2, 3, 4, 5, 6}));
@@ -233,7 +233,7 @@ TEST(MediaPbrt, RgbGridHasItsScalesInItsGrids) {
                               kTriangle);
   EXPECT_EQ(one.mediumGrids, (std::vector<float>{3, 6, 9, 3, 3, 3}));
   EXPECT_EQ(one.media[0].emission, kNoGrid);
-  EXPECT_EQ(one.media[0].emissive, 0u);
+  EXPECT_EQ(one.media[0].emissive, kEmitsNothing);
   ASSERT_EQ(one.warnings.size(), 1u);
   EXPECT_NE(one.warnings[0].find("grid of ones"), std::string::npos) << one.warnings[0];
 }
@@ -390,7 +390,7 @@ TEST(MediaPbrt, UnusedMediaAndTheirGridsAreLeftOut) {
   EXPECT_EQ(s.media[0].emission, 2u);
 }
 
-TEST(MediaPbrt, CloudsAreReadAndUniformGridTemperaturesWarned) {
+TEST(MediaPbrt, CloudsAreRead) {
   // A cloud: pbrt-v4's parameters and defaults (wispiness 1, frequency 5, p0 0 0 0, p1 1 1 1).
   const Scene cloud =
       pbrtScene(std::string(kUnmirrored) +
@@ -410,19 +410,59 @@ TEST(MediaPbrt, CloudsAreReadAndUniformGridTemperaturesWarned) {
                       kTriangle),
             "scene.pbrt:5:1: MakeNamedMedium 'vdb': a \"nanovdb\" medium needs a \"string "
             "filename\"");
-  // A uniformgrid's temperature (blackbody emission): warned, the medium does not emit.
-  const Scene hot = pbrtScene(std::string(kUnmirrored) +
+}
+
+// A uniformgrid's temperature grid: pbrt-v4's blackbody emission, stored after a blackbody
+// table up to the hottest voxel, then the Lescale grid where there is one; "temperaturecutoff"
+// is read where "temperatureoffset" is missing.
+TEST(MediaPbrt, UniformGridTemperaturesEmitBlackbody) {
+  const auto medium = [](const std::string& params) {
+    const Scene s = pbrtScene(std::string(kUnmirrored) +
                               "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" "
-                              "\"float density\" [1] \"float temperature\" [1500] "
-                              "\"float temperaturescale\" 2\n"
-                              "MediumInterface \"g\" \"\"\n" +
-                              kTriangle);
+                              "\"integer nx\" 2 \"float density\" [1 1] " +
+                              params + "\nMediumInterface \"g\" \"\"\n" + kTriangle);
+    EXPECT_TRUE(s.warnings.empty());
+    return s;
+  };
+  const Scene hot = medium(
+      "\"float temperature\" [1500 800] \"float temperaturecutoff\" 300 "
+      "\"float temperaturescale\" 2");
   ASSERT_EQ(hot.media.size(), 1u);
-  EXPECT_EQ(hot.media[0].emissive, 0u);
-  ASSERT_EQ(hot.warnings.size(), 1u);
-  EXPECT_EQ(hot.warnings[0],
-            "scene.pbrt:5: MakeNamedMedium 'g': \"temperature\" (blackbody emission) is not "
-            "simulated: the medium does not emit");
+  const Medium& m = hot.media[0];
+  EXPECT_EQ(m.emissive, kEmitsBlackbody);
+  EXPECT_EQ(m.Le, vec3(0.0f, 300.0f, 2.0f));  // no Lescale grid: pbrt-v4's one voxel of 1
+  EXPECT_EQ(hot.mediumGrids[m.emission], (1500.0f - 300.0f) * 2.0f);  // the table's top
+  EXPECT_EQ(emissionFloats(m, hot.mediumGrids), kBlackbodyTableFloats + 2u);
+  EXPECT_EQ(hot.mediumGrids[m.emission + kBlackbodyTableFloats + 1u], 800.0f);
+
+  const Scene scaled = medium("\"float temperature\" [1500 800] \"float Lescale\" [0.5 0.25]");
+  const Medium& s = scaled.media[0];
+  EXPECT_EQ(s.emissive, kEmitsBlackbody);
+  EXPECT_EQ(s.Le, vec3(1.0f, 0.0f, 1.0f));
+  EXPECT_EQ(emissionFloats(s, scaled.mediumGrids), kBlackbodyTableFloats + 4u);
+  EXPECT_EQ(scaled.mediumGrids[s.emission + kBlackbodyTableFloats + 3u], 0.25f);
+
+  // Nothing above 100 K once offset, or a Lescale of zeros: it does not emit.
+  EXPECT_EQ(
+      medium("\"float temperature\" [150 90] \"float temperatureoffset\" 60").media[0].emissive,
+      kEmitsNothing);
+  EXPECT_EQ(medium("\"float temperature\" [1500 800] \"float Lescale\" [0 0]").media[0].emissive,
+            kEmitsNothing);
+
+  EXPECT_EQ(pbrtError(std::string(kUnmirrored) +
+                      "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" "
+                      "\"float density\" [1] \"float temperature\" [1 2]\n"
+                      "MediumInterface \"g\" \"\"\n" +
+                      kTriangle),
+            "scene.pbrt:5:69: 'temperature' of MakeNamedMedium 'g': has 2 values; expected nx * "
+            "ny * nz = 1");
+  EXPECT_EQ(pbrtError(std::string(kUnmirrored) +
+                      "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" "
+                      "\"float density\" [1] \"float temperature\" [1000] \"rgb Le\" [1 1 1]\n"
+                      "MediumInterface \"g\" \"\"\n" +
+                      kTriangle),
+            "scene.pbrt:5:69: 'temperature' of MakeNamedMedium 'g': a medium emits by \"Le\" or "
+            "by \"temperature\", not both (pbrt-v4's rule)");
 }
 
 TEST(MediaPbrt, EveryErrorIsOneLineAtItsPlace) {
@@ -487,10 +527,11 @@ TEST(MediaPbrt, EveryErrorIsOneLineAtItsPlace) {
        "scene.pbrt:5:86: 'Lescale' of MakeNamedMedium 'm': has 1 value; expected nx * ny * nz "
        "= 2"},
       {grid("\"float density\" [1] \"rgb Le\" [1 1 1] \"float temperature\" [1000]"),
-       "scene.pbrt:5:86: MakeNamedMedium 'm': both \"Le\" and \"temperature\" given (pbrt-v4 "
-       "takes one or the other)"},
+       "scene.pbrt:5:86: 'temperature' of MakeNamedMedium 'm': a medium emits by \"Le\" or by "
+       "\"temperature\", not both (pbrt-v4's rule)"},
       {grid("\"float density\" [1] \"float temperature\" [1000 2000]"),
-       "scene.pbrt:5:69: 'temperature' of MakeNamedMedium 'm' has 2 values for 1 density values"},
+       "scene.pbrt:5:69: 'temperature' of MakeNamedMedium 'm': has 2 values; expected nx * ny * "
+       "nz = 1"},
       {rgb("\"float scale\" 2"),
        "scene.pbrt:5:1: 'sigma_a' of MakeNamedMedium 'm': an rgbgrid needs \"sigma_a\" or "
        "\"sigma_s\" (or both)"},
@@ -552,13 +593,13 @@ TEST(MediaJson, HomogeneousWithDefaultsAndPbrtV4sNames) {
   EXPECT_EQ(s.media[0].sigmaA, vec3(1.0f));
   EXPECT_EQ(s.media[0].sigmaS, vec3(1.0f));
   EXPECT_EQ(s.media[0].g, 0.0f);
-  EXPECT_EQ(s.media[0].emissive, 0u);
+  EXPECT_EQ(s.media[0].emissive, kEmitsNothing);
   const Medium& tea = s.media[1];
   EXPECT_EQ(tea.sigmaA, vec3(2, 4, 6));
   EXPECT_EQ(tea.sigmaS, vec3(8, 10, 12));
   EXPECT_EQ(tea.g, -0.5f);
   EXPECT_EQ(tea.Le, vec3(4, 0, 0));
-  EXPECT_EQ(tea.emissive, 1u);
+  EXPECT_EQ(tea.emissive, kEmitsLe);
   ASSERT_EQ(s.mediumInterfaces.size(), 1u);
   EXPECT_EQ(s.mediumInterfaces[0].inside, 1u);
   EXPECT_EQ(s.mediumInterfaces[0].outside, 0u);
@@ -609,6 +650,20 @@ TEST(MediaJson, GridsTheirOrderOffsetsAndTransform) {
   expectNear(toMedium(smoke, {10, 0, 0}), {0, 0, 0}, "origin");
   expectNear(toMedium(smoke, {12, 0, 0}), {1, 0, 0}, "x");
   EXPECT_EQ(cloud.toMedium0, vec4(1, 0, 0, 0));
+}
+
+// A uniformgrid's temperatures, offset and scale, as the pbrt-v4 reader takes them.
+TEST(MediaJson, UniformGridTemperatures) {
+  const Scene s = jsonScene(jsonText(
+      R"([{"name": "fire", "type": "uniformgrid", "nx": 2, "density": [1, 1],
+           "temperature": [1200, 2000], "temperatureoffset": 200, "temperaturescale": 3}])",
+      R"(, "interior": "fire")"));
+  ASSERT_EQ(s.media.size(), 1u);
+  const Medium& m = s.media[0];
+  EXPECT_EQ(m.emissive, kEmitsBlackbody);
+  EXPECT_EQ(m.Le, vec3(0.0f, 200.0f, 3.0f));
+  EXPECT_EQ(s.mediumGrids[m.emission], (2000.0f - 200.0f) * 3.0f);
+  EXPECT_EQ(s.mediumGrids[m.emission + kBlackbodyTableFloats], 1200.0f);
 }
 
 TEST(MediaJson, InterfaceShapesAreKeptOnlyWhereTheyBoundAMedium) {
@@ -665,6 +720,13 @@ TEST(MediaJson, EveryErrorNamesItsField) {
        "media[0].density: has 1 value; expected nx * ny * nz = 2"},
       {jsonText(R"([{"name": "m", "type": "uniformgrid"}])"),
        "media[0]: 'density': is required: one value per voxel"},
+      {jsonText(R"([{"name": "m", "type": "uniformgrid", "nx": 2, "density": [1, 1],
+                     "temperature": [900]}])"),
+       "media[0].temperature: has 1 value; expected nx * ny * nz = 2"},
+      {jsonText(R"([{"name": "m", "type": "uniformgrid", "density": [1], "temperature": [900],
+                     "Le": [1, 1, 1]}])"),
+       "media[0].temperature: a medium emits by \"Le\" or by \"temperature\", not both "
+       "(pbrt-v4's rule)"},
       {jsonText(R"([{"name": "m", "type": "uniformgrid", "density": [1, -1], "nx": 2}])"),
        "media[0].density[1]: expected a non-negative number that fits a 32-bit float, got -1"},
       {jsonText(R"([{"name": "m", "type": "uniformgrid", "density": [1], "p0": [0, 2, 0]}])"),

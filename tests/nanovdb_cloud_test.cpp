@@ -194,7 +194,7 @@ TEST(NanoVdb, BlackbodyEmissionFollowsTheTemperatureGrid) {
   p.temperatureScale = 2.0;
   Scene scene;
   const Medium m = scene.media[addMedium(scene, "fire", p)];
-  ASSERT_EQ(m.emissive, 1u);
+  ASSERT_EQ(m.emissive, kEmitsBlackbody);
   const PathScene s = gridScene(scene.mediumGrids);
   // Voxel centres: index i is at 0.1 + 0.05 i in x (and likewise in y, z).
   const auto at = [](int x, int y, int z) {
@@ -214,7 +214,7 @@ TEST(NanoVdb, BlackbodyEmissionFollowsTheTemperatureGrid) {
   // Below 100 K nothing is emitted; and where T never passes 100 K the medium does not emit.
   p.temperatureOffset = 2400.0;
   Scene cold;
-  EXPECT_EQ(cold.media[addMedium(cold, "cold", p)].emissive, 0u);
+  EXPECT_EQ(cold.media[addMedium(cold, "cold", p)].emissive, kEmitsNothing);
 }
 
 // The file's problems, one line each, naming it.

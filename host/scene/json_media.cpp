@@ -49,7 +49,9 @@ std::vector<std::string_view> mediumKeys(uint type) {
     keys.push_back("preset");
   } else {
     keys.insert(keys.end(), {"nx", "ny", "nz", "p0", "p1", "transform"});
-    if (type == kMediumUniformGrid) keys.push_back("density");
+    if (type == kMediumUniformGrid) {
+      keys.insert(keys.end(), {"density", "temperature", "temperatureoffset", "temperaturescale"});
+    }
   }
   return keys;
 }
@@ -135,9 +137,11 @@ void JsonMedia::read(const JsonNode& node) {
       if (auto n = m.find("sigma_s")) p.sigmaS = vec3(n->vec3());
       if (auto n = m.find("Le")) p.Le = vec3(n->vec3());
     }
-    if (p.type == kMediumNanoVdb) {
+    if (p.type == kMediumNanoVdb || p.type == kMediumUniformGrid) {
       if (auto n = m.find("temperatureoffset")) p.temperatureOffset = n->floatNumber();
       if (auto n = m.find("temperaturescale")) p.temperatureScale = n->floatNumber();
+    }
+    if (p.type == kMediumNanoVdb) {
       const JsonNode fileNode = m.require("filename");
       const std::filesystem::path given(fileNode.string());
       if (given.empty()) fileNode.fail("expected a file name");
@@ -174,6 +178,7 @@ void JsonMedia::read(const JsonNode& node) {
       if (auto n = m.find("p0")) p.p0 = n->vec3();
       if (auto n = m.find("p1")) p.p1 = n->vec3();
       if (auto n = m.find("density")) p.density = readFloats(*n);
+      if (auto n = m.find("temperature")) p.temperature = readFloats(*n);
     }
     if (const std::optional<MediumProblem> problem = checkMedium(p)) {
       const std::optional<JsonNode> n = m.find(problem->param);

@@ -155,6 +155,34 @@ std::optional<MediumProblem> checkGrid(const char* param, const std::vector<floa
   return std::nullopt;
 }
 
+// A uniformgrid's temperature grid: one finite value per voxel (kelvin; those the offset and
+// scale take to 100 K or below emit nothing), without "Le" (pbrt-v4's rule), and the offset
+// and scale within 32-bit floats.
+std::optional<MediumProblem> checkTemperatures(const MediumParams& m, double voxels) {
+  if (m.temperature.empty()) return std::nullopt;
+  if (maxComponent(m.Le) > 0.0f) {
+    return problem("temperature",
+                   "a medium emits by \"Le\" or by \"temperature\", not both "
+                   "(pbrt-v4's rule)");
+  }
+  const std::size_t count = m.temperature.size();
+  if (static_cast<double>(count) != voxels) {
+    return problem("temperature", "has " + std::to_string(count) + " value" +
+                                      (count == 1 ? "" : "s") +
+                                      "; expected nx * ny * nz = " + number(voxels));
+  }
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!std::isfinite(m.temperature[i])) {
+      return problem("temperature", "expected a number that fits a 32-bit float", i);
+    }
+  }
+  for (const auto& [name, v] : {std::pair{"temperatureoffset", m.temperatureOffset},
+                                std::pair{"temperaturescale", m.temperatureScale}}) {
+    if (!fitsFloat(v)) return problem(name, "expected a number that fits a 32-bit float");
+  }
+  return std::nullopt;
+}
+
 float gridMax(const std::vector<float>& grid) {
   float m = 0.0f;
   for (float v : grid) m = std::max(m, v);
@@ -267,7 +295,8 @@ std::optional<MediumProblem> checkMedium(const MediumParams& m) {
   if (m.type == kMediumUniformGrid) {
     if (m.density.empty()) return problem("density", "is required: one value per voxel");
     if (auto p = checkGrid("density", m.density, 1, voxels)) return p;
-    return checkGrid("Lescale", m.LeScaleGrid, 1, voxels);
+    if (auto p = checkGrid("Lescale", m.LeScaleGrid, 1, voxels)) return p;
+    return checkTemperatures(m, voxels);
   }
   PT_CHECK(m.type == kMediumRgbGrid, "checkMedium: unknown medium type");
   if (m.sigmaAGrid.empty() && m.sigmaSGrid.empty()) {
@@ -306,7 +335,7 @@ uint addMedium(Scene& scene, const std::string& name, const MediumParams& m) {
     out.sigmaA = scaled(m.sigmaA, m.scale);
     out.sigmaS = scaled(m.sigmaS, m.scale);
     out.Le = scaled(m.Le, m.LeScale);
-    out.emissive = maxComponent(out.Le) > 0.0f ? 1u : 0u;
+    out.emissive = maxComponent(out.Le) > 0.0f ? kEmitsLe : kEmitsNothing;
   } else if (m.type == kMediumNanoVdb) {
     const NanoVdbMediumGrids& grids = *m.nanovdb;
     out.sigmaA = scaled(m.sigmaA, m.scale);
@@ -321,7 +350,7 @@ uint addMedium(Scene& scene, const std::string& name, const MediumParams& m) {
         std::max((double(grids.temperatureMin) - m.temperatureOffset) * m.temperatureScale,
                  (double(grids.temperatureMax) - m.temperatureOffset) * m.temperatureScale);
     if (grids.temperature && m.LeScale > 0.0 && hottest > 100.0) {
-      out.emissive = 1u;
+      out.emissive = kEmitsBlackbody;
       std::vector<float> emission = blackbodyTable(hottest);
       const std::vector<float> temperature = packVoxelGrid(*grids.temperature);
       emission.insert(emission.end(), temperature.begin(), temperature.end());
@@ -348,9 +377,25 @@ uint addMedium(Scene& scene, const std::string& name, const MediumParams& m) {
       out.sigmaA = scaled(m.sigmaA, m.scale);
       out.sigmaS = scaled(m.sigmaS, m.scale);
       out.Le = m.Le;
-      out.emissive = maxComponent(m.Le) > 0.0f ? 1u : 0u;
+      out.emissive = maxComponent(m.Le) > 0.0f ? kEmitsLe : kEmitsNothing;
       out.density = appendGrid(scene, m.density);
       if (out.emissive && !m.LeScaleGrid.empty()) out.emission = appendGrid(scene, m.LeScaleGrid);
+      // Emission by temperature, where some voxel is above 100 K once offset and scaled, and
+      // the Lescale grid (if any) is not all zero.
+      double hottest = 0.0;
+      for (float t : m.temperature) {
+        hottest = std::max(hottest, (double(t) - m.temperatureOffset) * m.temperatureScale);
+      }
+      const bool scaled = m.LeScaleGrid.empty() || gridMax(m.LeScaleGrid) > 0.0f;
+      if (hottest > 100.0 && scaled && fitsFloat(hottest)) {
+        out.emissive = kEmitsBlackbody;
+        out.Le = vec3(m.LeScaleGrid.empty() ? 0.0f : 1.0f, float(m.temperatureOffset),
+                      float(m.temperatureScale));
+        std::vector<float> emission = blackbodyTable(hottest);
+        emission.insert(emission.end(), m.temperature.begin(), m.temperature.end());
+        emission.insert(emission.end(), m.LeScaleGrid.begin(), m.LeScaleGrid.end());
+        out.emission = appendGrid(scene, emission);
+      }
     } else {
       out.sigmaA = vec3(1.0f);
       out.sigmaS = vec3(1.0f);
@@ -358,7 +403,7 @@ uint addMedium(Scene& scene, const std::string& name, const MediumParams& m) {
       const std::vector<float> sigmaS = scaledRgbGrid(m.sigmaSGrid, m.scale, voxels);
       sigma.insert(sigma.end(), sigmaS.begin(), sigmaS.end());
       out.density = appendGrid(scene, sigma);
-      out.emissive = !m.LeGrid.empty() && m.LeScale > 0.0 ? 1u : 0u;
+      out.emissive = !m.LeGrid.empty() && m.LeScale > 0.0 ? kEmitsLe : kEmitsNothing;
       if (out.emissive) {
         out.Le = vec3(1.0f);
         out.emission = appendGrid(scene, scaledRgbGrid(m.LeGrid, m.LeScale, voxels));
@@ -395,6 +440,9 @@ std::size_t emissionFloats(const Medium& m, const std::vector<float>& grids) {
            packedVoxelGridFloats(grids.data() + m.emission + kBlackbodyTableFloats);
   }
   const std::size_t voxels = std::size_t(m.size.x) * m.size.y * m.size.z;
+  if (m.emissive == kEmitsBlackbody) {
+    return kBlackbodyTableFloats + (m.Le.x == 0.0f ? voxels : 2 * voxels);
+  }
   return m.type == kMediumRgbGrid ? 3 * voxels : voxels;
 }
 

@@ -51,12 +51,14 @@ struct MediumParams {
   glm::dvec3 p0{0.0}, p1{1.0};
   std::vector<float> density;      // uniformgrid: "density", one per voxel
   std::vector<float> LeScaleGrid;  // uniformgrid: "Lescale", one per voxel, or none
+  std::vector<float> temperature;  // uniformgrid: "temperature" in kelvin, one per voxel, or none
   std::vector<float> sigmaAGrid;   // rgbgrid: "sigma_a", RGB per voxel, or none
   std::vector<float> sigmaSGrid;   // rgbgrid: "sigma_s", likewise
   std::vector<float> LeGrid;       // rgbgrid: "Le", likewise
   // nanovdb: the grids of its "filename" (read by the reader, which knows where the file is),
   // and its emission: Lescale times the blackbody at (T - temperatureoffset) *
-  // temperaturescale, T the temperature grid's value.
+  // temperaturescale, T the temperature grid's value (a uniformgrid's with "temperature"
+  // likewise, its Lescale a grid).
   std::shared_ptr<const NanoVdbMediumGrids> nanovdb;
   double temperatureOffset = 0.0;  // "temperatureoffset" (or pbrt-v4's "temperaturecutoff")
   double temperatureScale = 1.0;   // "temperaturescale"
@@ -91,7 +93,8 @@ std::size_t voxelCount(const MediumParams& m);
 // missing sigma_a or sigma_s grid is stored as ones (pbrt-v4's constant 1). A uniformgrid's
 // Lescale grid is its emission grid, none without one; grids of a medium that does not emit
 // are not stored. A nanovdb medium's grids are packed (voxel_grid.h), its emission a blackbody
-// table over the temperatures its grid reaches and the grid. The transform is identity:
+// table over the temperatures its grid reaches and the grid; a uniformgrid's temperatures
+// likewise, its Lescale grid after them. The transform is identity:
 // setMediumTransform sets it.
 uint addMedium(Scene& scene, const std::string& name, const MediumParams& m);
 

@@ -170,26 +170,12 @@ void Builder::makeNamedMedium(Statement& s) {
         emission();
         m.density = floats(p, "density", ParamType::kFloat);
         m.LeScaleGrid = floats(p, "Lescale", ParamType::kFloat);
-        if (const Param* temperature = p.find("temperature", {ParamType::kFloat})) {
-          if (p.find("Le")) {
-            fail(temperature->location,
-                 context +
-                     ": both \"Le\" and \"temperature\" given (pbrt-v4 takes one or the "
-                     "other)");
-          }
-          if (temperature->numbers.size() != m.density.size()) {
-            fail(temperature->location, "'temperature' of " + context + " has " +
-                                            std::to_string(temperature->numbers.size()) +
-                                            " values for " + std::to_string(m.density.size()) +
-                                            " density values");
-          }
-          for (const char* key : {"temperatureoffset", "temperaturecutoff", "temperaturescale"}) {
-            p.number(key);
-          }
-          warnOnce("medium temperature", temperature->location,
-                   context +
-                       ": \"temperature\" (blackbody emission) is not simulated: the "
-                       "medium does not emit");
+        m.temperature = floats(p, "temperature", ParamType::kFloat);
+        if (!m.temperature.empty()) {
+          // pbrt-v4 reads "temperatureoffset", and "temperaturecutoff" where that is missing.
+          if (auto v = p.number("temperaturecutoff")) m.temperatureOffset = *v;
+          if (auto v = p.number("temperatureoffset")) m.temperatureOffset = *v;
+          if (auto v = p.number("temperaturescale")) m.temperatureScale = *v;
         }
       } else {
         m.sigmaAGrid = floats(p, "sigma_a", ParamType::kRgb);
