@@ -683,14 +683,12 @@ TEST(CliStrict, AWarningBecomesExitStatus2AndOneLine) {
       "AttributeBegin\n  AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
       "  Shape \"trianglemesh\" \"point3 P\" [-1 -1 3  1 -1 3  0 1 3] \"integer indices\" [0 2 1]\n"
       "AttributeEnd\n"
-      "MakeNamedMedium \"fog\" \"string type\" \"uniformgrid\" \"float density\" [1] "
-      "\"float temperature\" [900]\n");
+      "Shape \"curve\" \"point3 P\" [0 0 0 1 0 0 2 0 0 3 0 0]\n");
   const std::string out = " --backend cpu --out " + (dir / "a.exr").string();
   const test::PtResult plain = test::runPt("render " + scene.string() + out);
   EXPECT_EQ(plain.status, 0) << plain.err;
   EXPECT_NE(plain.err.find("warning: " + scene.string() +
-                           ":8: MakeNamedMedium 'fog': \"temperature\" (blackbody emission) is not "
-                           "simulated"),
+                           ":8: Shape \"curve\" skipped: curves (hair) are not supported yet"),
             std::string::npos)
       << plain.err;
   fs::remove(dir / "a.exr");
@@ -698,8 +696,8 @@ TEST(CliStrict, AWarningBecomesExitStatus2AndOneLine) {
   EXPECT_EQ(strict.status, 2);
   EXPECT_EQ(strict.err,
             scene.string() +
-                ":8:71: MakeNamedMedium 'fog': \"temperature\" (blackbody emission) "
-                "is not simulated: the medium does not emit (an error with --strict)\n");
+                ":8:1: Shape \"curve\" skipped: curves (hair) are not supported yet (an error "
+                "with --strict)\n");
   EXPECT_FALSE(fs::exists(dir / "a.exr"));
   // A file without warnings renders under --strict.
   EXPECT_EQ(test::runPt("render " + (test::kConfigs / "cornell-box.pbrt").string() +

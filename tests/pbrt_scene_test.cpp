@@ -928,17 +928,15 @@ TEST(PbrtCameraFilm, BadCameraAndFilmParametersAreErrors) {
 
 TEST(PbrtCameraFilm, StrictMakesEveryWarningAnError) {
   const std::string text = std::string(kUnmirrored) +
-                           "MakeNamedMedium \"fog\" \"string type\" "
-                           "\"uniformgrid\" \"float density\" [1] \"float temperature\" [900]\n" +
-                           kTriangle;
+                           "Shape \"curve\" \"point3 P\" [0 0 0 1 0 0 2 0 0 3 0 0]\n" + kTriangle;
   EXPECT_EQ(load(text).warnings.size(), 1u);
   try {
     loadPbrtSceneText(text, "scene.pbrt", SceneLoadOptions{.strict = true});
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "scene.pbrt:6:71: MakeNamedMedium 'fog': \"temperature\" (blackbody emission) is "
-              "not simulated: the medium does not emit (an error with --strict)");
+              "scene.pbrt:6:1: Shape \"curve\" skipped: curves (hair) are not supported yet (an "
+              "error with --strict)");
   }
   // Through loadScene, with a parameter nothing reads.
   test::TempDir dir;
