@@ -209,8 +209,10 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
   MaterialTextures textures;
   bool textured = (PT_HAS_TEXTURES || PT_HAS_BUMP_MAPS) && PT_PARAMS.texturesPresent != 0u;
   if (textured) {
-    uv = interpolatedUV(uvsAt(PT_SCENE_TEXTURES tri.primitive), b);
     textures = materialTexturesAt(PT_SCENE_TEXTURES tri.material);
+    // The texture coordinates only where the material reads them: on a large mesh without
+    // textures their load is a cache miss at every hit.
+    if (anyTexture(textures)) uv = interpolatedUV(uvsAt(PT_SCENE_TEXTURES tri.primitive), b);
     if (PT_HAS_TEXTURES) s.material = resolveMaterial(PT_SCENE_TEXTURES s.material, textures, uv);
   }
 #endif

@@ -223,6 +223,14 @@ PT_INLINE float evalFloatTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
 
 // ---- Materials ----------------------------------------------------------------------------
 
+// Whether a material reads any texture (and so the hit's texture coordinates).
+PT_INLINE bool anyTexture(MaterialTextures t) {
+  return t.reflectance != kNoTexture || t.transmittance != kNoTexture ||
+         t.uRoughness != kNoTexture || t.vRoughness != kNoTexture || t.eta != kNoTexture ||
+         t.k != kNoTexture || t.displacement != kNoTexture || t.alpha != kNoTexture ||
+         t.thickness != kNoTexture || t.g != kNoTexture;
+}
+
 // The material's parameters at texture coordinates uv: each parameter that has a texture takes
 // the texture's value there, as pbrt-v4's materials evaluate theirs (reflectances clamped to
 // [0, 1] as its albedo spectra are; roughness remapped to alpha where the material asks;

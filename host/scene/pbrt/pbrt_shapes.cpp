@@ -37,27 +37,25 @@ void reverseMesh(Mesh& mesh) {
   }
 }
 
-Mesh transformMesh(const Mesh& mesh, const glm::dmat4& m) {
+Mesh transformMesh(Mesh mesh, const glm::dmat4& m) {
   const glm::dmat3 linear(m);
   const double det = glm::determinant(linear);
   const bool swap = det < 0.0;
   const bool invertible = det != 0.0 && std::isfinite(det);
   const glm::dmat3 normalMatrix =
       invertible ? glm::transpose(glm::inverse(linear)) : glm::dmat3(0.0);
-  Mesh out;
-  out.triangles.reserve(mesh.triangles.size());
-  out.normals.reserve(mesh.normals.size());
-  out.uvs.reserve(mesh.uvs.size());
+  // In place: a large mesh's copy would cost as much as its transform (fresh pages).
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
-    Tri t = mesh.triangles[i];
-    UVs uv = mesh.uvs.empty() ? UVs{} : mesh.uvs[i];
+    Tri& t = mesh.triangles[i];
+    UVs unused{};
+    UVs& uv = mesh.uvs.empty() ? unused : mesh.uvs[i];
     for (glm::dvec3& p : t) p = transformPoint(m, p);
     if (swap) {
       std::swap(t[1], t[2]);
       std::swap(uv[1], uv[2]);
     }
     if (!mesh.normals.empty()) {
-      Tri n = mesh.normals[i];
+      Tri& n = mesh.normals[i];
       for (glm::dvec3& v : n) v = normalMatrix * v;  // zero where singular: see emit
       if (swap) std::swap(n[1], n[2]);
       glm::dvec3 sum(0.0);
@@ -70,12 +68,9 @@ Mesh transformMesh(const Mesh& mesh, const glm::dmat4& m) {
         std::swap(n[1], n[2]);
         std::swap(uv[1], uv[2]);
       }
-      out.normals.push_back(n);
     }
-    out.triangles.push_back(t);
-    if (!mesh.uvs.empty()) out.uvs.push_back(uv);
   }
-  return out;
+  return mesh;
 }
 
 void Builder::shape(Statement& s) {
@@ -109,7 +104,7 @@ void Builder::shape(Statement& s) {
   // are kept only where it is a transition (finish).
   mediumInterfaces_[gs_.mediumInterface].used = true;
   if (gs_.reverseOrientation) reverseMesh(mesh);
-  Mesh world = transformMesh(mesh, gs_.ctm.m);
+  Mesh world = transformMesh(std::move(mesh), gs_.ctm.m);
   if (!activeInstance_.empty()) {
     if (gs_.areaLight) {
       warnOnce("instance area light", s.location,

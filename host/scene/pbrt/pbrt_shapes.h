@@ -40,6 +40,6 @@ void reverseMesh(Mesh& mesh);
 // triangle is rewound to keep its front (pbrt-v4 flips its normal instead, by
 // transformSwapsHandedness). A triangle with vertex normals is wound to face where they
 // point, as pbrt-v4 faces its geometric normal towards the interpolated one.
-Mesh transformMesh(const Mesh& mesh, const glm::dmat4& m);
+Mesh transformMesh(Mesh mesh, const glm::dmat4& m);
 
 }  // namespace pt::pbrt
