@@ -39,6 +39,12 @@ inline uint bitfieldReverse(uint x) {
 #define PT_OUT(T) out T
 #define PT_IN(T) T
 #define PT_HOT_INLINE
+// normalize as GLM computes it on the CPU: v times 1 / sqrt(dot(v, v)), sqrt and the division
+// rounded as IEEE rounds them. Lavapipe's own normalize differs in the last bit, and a last bit
+// in a triangle's normal or a sampled direction grows over a few bounces into another path: at
+// 16 spp the backends differed beyond 1e-3 on 3.1 % of classroom's pixels and 2.0 % of
+// bathroom's with it, on 0.014 % and 0.007 % with this.
+#define normalize(v) ((v) * (1.0f / sqrt(dot((v), (v)))))
 #endif
 
 // ---- BVH -------------------------------------------------------------------------------
