@@ -176,6 +176,21 @@ PT_INLINE bool onlyAbsorbs(PT_IN(Medium) m) {
 
 // ---- Delta tracking of a flight ------------------------------------------------------------
 
+// How far along its unit ray a flight through homogeneous medium m, which scatters, makes its
+// first tentative collision: trackFlight below draws the same two numbers from v.rng (the
+// event's, then the distance's), so a surface beyond this distance cannot end the flight.
+// kMaxFloat where that is not known ahead (another medium, one that only absorbs, a hero
+// channel without extinction). The CPU searches a flight's surface only up to there.
+PT_INLINE float firstCollisionAhead(PT_IN(Medium) m, PT_IN(VolumePath) v) {
+  float sigmaT = (m.sigmaA + m.sigmaS)[v.hero];
+  if (!PT_HAS_MEDIUM(m, kMediumHomogeneous) || onlyAbsorbs(m) || !(sigmaT > 0.0f)) {
+    return kMaxFloat;
+  }
+  RandomStream ahead = v.rng;
+  nextRandom(ahead);
+  return sampleExponential(nextRandom(ahead), sigmaT);
+}
+
 PT_CONST uint kFlightPassed = 0u;     // the ray reached tMax (the surface, or nothing)
 PT_CONST uint kFlightScattered = 1u;  // it scattered at `p`
 PT_CONST uint kFlightEnded = 2u;      // absorbed, or nothing left to carry
@@ -187,7 +202,8 @@ PT_CONST uint kFlightEnded = 2u;      // absorbed, or nothing left to carry
 // Updates beta, rU and rL; on kFlightScattered, p is the point and g the phase function's
 // asymmetry there. Through a medium that only absorbs (onlyAbsorbs) the flight passes with
 // beta times the transmittance, where pbrt-v4's delta tracking would end the path with the
-// probability of absorption: the same mean, without that noise.
+// probability of absorption: the same mean, without that noise. Its draws from v.rng are
+// firstCollisionAhead's: change both together.
 PT_INLINE uint trackFlight(PT_SCENE_PARAM PT_INOUT(VolumePath) v, vec3 o, vec3 d, float tMax,
                            PT_OUT(vec3) p, PT_OUT(float) g) {
   uint h = v.hero;

@@ -49,11 +49,11 @@ bool occluded(const SceneData& scene, const Ray& ray, Intersection test, vec2 uL
 }  // namespace
 
 std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Intersection test,
-                                  uvec2 pixel, uint32_t sampleIndex, uint depth) {
-  if (!scene.effects.alphaCutouts) return closestHit(scene.wideBvh(), ray, INFINITY, test);
+                                  uvec2 pixel, uint32_t sampleIndex, uint depth, float tMax) {
+  if (!scene.effects.alphaCutouts) return closestHit(scene.wideBvh(), ray, tMax, test);
   const AlphaCutouts cutouts = AlphaCutouts::ofPathRay(scene, pixel, sampleIndex, depth);
   const HitFilter filter = cutouts.filter();
-  return closestHit(scene.wideBvh(), ray, INFINITY, test, &filter);
+  return closestHit(scene.wideBvh(), ray, tMax, test, &filter);
 }
 
 std::optional<Hit> closestShadowHit(const SceneData& scene, const Ray& ray, Intersection test,

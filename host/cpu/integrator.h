@@ -39,9 +39,11 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, u
                     bool debugPrint = false);
 
 // The closest surface along a path's ray after `depth` scattering events, and on a shadow ray's
-// segment t in [0, 1) whose light sample drew uLight; alpha cut-outs passed by.
+// segment t in [0, 1) whose light sample drew uLight; alpha cut-outs passed by. A path ray is
+// searched up to tMax.
 std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Intersection test,
-                                  uvec2 pixel, uint32_t sampleIndex, uint depth);
+                                  uvec2 pixel, uint32_t sampleIndex, uint depth,
+                                  float tMax = INFINITY);
 std::optional<Hit> closestShadowHit(const SceneData& scene, const Ray& ray, Intersection test,
                                     vec2 uLight);
 
