@@ -219,23 +219,26 @@ PT_INLINE MediumProperties mediumPropertiesAt(PT_SCENE_PARAM PT_IN(Medium) m, ve
     float d = gridLookup(PT_SCENE_ARG m.density, m.size, 1u, 0u, u);
     mp.sigmaA = m.sigmaA * d;
     mp.sigmaS = m.sigmaS * d;
-    // Without a grid of its own, Le's scale is pbrt-v4's grid of one voxel of 1: the
-    // interpolation falls to a half at the faces.
-    vec3 f = vec3(1.0f) - abs(u - 0.5f);
-    float tent = f.x * f.y * f.z;
-    if (m.emissive == kEmitsBlackbody) {
-      // pbrt-v4's GridMedium with a temperature grid: the scale times the blackbody at
-      // (T - temperatureoffset) * temperaturescale.
-      uint temperatures = m.emission + kBlackbodyTableFloats;
-      float scale = m.Le.x == 0.0f
-                        ? tent
-                        : gridLookup(PT_SCENE_ARG temperatures + m.size.x * m.size.y * m.size.z,
-                                     m.size, 1u, 0u, u);
-      float t = gridLookup(PT_SCENE_ARG temperatures, m.size, 1u, 0u, u);
-      mp.Le = scale * blackbodyLookup(PT_SCENE_ARG m.emission, (t - m.Le.y) * m.Le.z);
-    } else if (m.emissive != kEmitsNothing) {
-      mp.Le = m.emission == kNoGrid ? m.Le * tent
-                                    : m.Le * gridLookup(PT_SCENE_ARG m.emission, m.size, 1u, 0u, u);
+    if (m.emissive != kEmitsNothing) {
+      // Without a grid of its own, Le's scale is pbrt-v4's grid of one voxel of 1: the
+      // interpolation falls to a half at the faces.
+      vec3 f = vec3(1.0f) - abs(u - 0.5f);
+      float tent = f.x * f.y * f.z;
+      if (m.emissive == kEmitsBlackbody) {
+        // pbrt-v4's GridMedium with a temperature grid: the scale times the blackbody at
+        // (T - temperatureoffset) * temperaturescale.
+        uint temperatures = m.emission + kBlackbodyTableFloats;
+        float scale = m.Le.x == 0.0f
+                          ? tent
+                          : gridLookup(PT_SCENE_ARG temperatures + m.size.x * m.size.y * m.size.z,
+                                       m.size, 1u, 0u, u);
+        float t = gridLookup(PT_SCENE_ARG temperatures, m.size, 1u, 0u, u);
+        mp.Le = scale * blackbodyLookup(PT_SCENE_ARG m.emission, (t - m.Le.y) * m.Le.z);
+      } else {
+        mp.Le = m.emission == kNoGrid
+                    ? m.Le * tent
+                    : m.Le * gridLookup(PT_SCENE_ARG m.emission, m.size, 1u, 0u, u);
+      }
     }
   } else if (PT_HAS_MEDIUM(m, kMediumRgbGrid)) {
     uint voxels = m.size.x * m.size.y * m.size.z;

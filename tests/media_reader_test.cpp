@@ -529,6 +529,9 @@ TEST(MediaPbrt, EveryErrorIsOneLineAtItsPlace) {
       {grid("\"float density\" [1] \"rgb Le\" [1 1 1] \"float temperature\" [1000]"),
        "scene.pbrt:5:86: 'temperature' of MakeNamedMedium 'm': a medium emits by \"Le\" or by "
        "\"temperature\", not both (pbrt-v4's rule)"},
+      {grid("\"integer nx\" 2 \"float density\" [1 1] \"float temperature\" [-20 1e39]"),
+       "scene.pbrt:5:86: 'temperature' of MakeNamedMedium 'm', its value [1]: expected a number "
+       "that fits a 32-bit float, got inf"},
       {grid("\"float density\" [1] \"float temperature\" [1000 2000]"),
        "scene.pbrt:5:69: 'temperature' of MakeNamedMedium 'm': has 2 values; expected nx * ny * "
        "nz = 1"},

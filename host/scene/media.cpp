@@ -132,9 +132,10 @@ std::optional<MediumProblem> checkScaled(const char* param, const char* scaleNam
 }
 
 // A grid of `perVoxel` floats per voxel: none (when allowed), or one value per voxel, each
-// non-negative and finite.
+// finite and (unless `signedValues`) non-negative.
 std::optional<MediumProblem> checkGrid(const char* param, const std::vector<float>& grid,
-                                       std::size_t perVoxel, double voxels) {
+                                       std::size_t perVoxel, double voxels,
+                                       bool signedValues = false) {
   if (grid.empty()) return std::nullopt;
   const char* what = perVoxel == 3 ? " RGB value" : " value";
   if (grid.size() % perVoxel != 0) {
@@ -146,11 +147,22 @@ std::optional<MediumProblem> checkGrid(const char* param, const std::vector<floa
                               "; expected nx * ny * nz = " + number(voxels));
   }
   for (std::size_t i = 0; i < grid.size(); ++i) {
-    if (!(grid[i] >= 0.0f) || !std::isfinite(grid[i])) {
+    if (!std::isfinite(grid[i]) || (!signedValues && !(grid[i] >= 0.0f))) {
       return problem(
-          param, "expected a non-negative number that fits a 32-bit float, got " + number(grid[i]),
+          param,
+          std::string(signedValues ? "expected a number" : "expected a non-negative number") +
+              " that fits a 32-bit float, got " + number(grid[i]),
           i);
     }
+  }
+  return std::nullopt;
+}
+
+// "temperatureoffset" and "temperaturescale" (nanovdb, a uniformgrid with temperatures).
+std::optional<MediumProblem> checkTemperatureMapping(const MediumParams& m) {
+  for (const auto& [name, v] : {std::pair{"temperatureoffset", m.temperatureOffset},
+                                std::pair{"temperaturescale", m.temperatureScale}}) {
+    if (!fitsFloat(v)) return problem(name, "expected a number that fits a 32-bit float");
   }
   return std::nullopt;
 }
@@ -165,22 +177,15 @@ std::optional<MediumProblem> checkTemperatures(const MediumParams& m, double vox
                    "a medium emits by \"Le\" or by \"temperature\", not both "
                    "(pbrt-v4's rule)");
   }
-  const std::size_t count = m.temperature.size();
-  if (static_cast<double>(count) != voxels) {
-    return problem("temperature", "has " + std::to_string(count) + " value" +
-                                      (count == 1 ? "" : "s") +
-                                      "; expected nx * ny * nz = " + number(voxels));
-  }
-  for (std::size_t i = 0; i < count; ++i) {
-    if (!std::isfinite(m.temperature[i])) {
-      return problem("temperature", "expected a number that fits a 32-bit float", i);
-    }
-  }
-  for (const auto& [name, v] : {std::pair{"temperatureoffset", m.temperatureOffset},
-                                std::pair{"temperaturescale", m.temperatureScale}}) {
-    if (!fitsFloat(v)) return problem(name, "expected a number that fits a 32-bit float");
-  }
-  return std::nullopt;
+  if (auto p = checkGrid("temperature", m.temperature, 1, voxels, /*signedValues=*/true)) return p;
+  return checkTemperatureMapping(m);
+}
+
+// The hottest temperature of a grid whose values lie in [lo, hi] once offset and scaled
+// (pbrt-v4 emits above 100 K).
+double hottestKelvin(double lo, double hi, const MediumParams& m) {
+  return std::max((lo - m.temperatureOffset) * m.temperatureScale,
+                  (hi - m.temperatureOffset) * m.temperatureScale);
 }
 
 float gridMax(const std::vector<float>& grid) {
@@ -259,11 +264,7 @@ std::optional<MediumProblem> checkMedium(const MediumParams& m) {
   }
   if (m.type == kMediumNanoVdb) {
     PT_CHECK(m.nanovdb != nullptr, "checkMedium: a nanovdb medium without its grids");
-    for (const auto& [name, v] : {std::pair{"temperatureoffset", m.temperatureOffset},
-                                  std::pair{"temperaturescale", m.temperatureScale}}) {
-      if (!fitsFloat(v)) return problem(name, "expected a number that fits a 32-bit float");
-    }
-    return std::nullopt;
+    return checkTemperatureMapping(m);
   }
   if (m.type == kMediumCloud) {
     if (auto p = checkNonNegative("density", &m.cloudDensity, 1)) return p;
@@ -345,10 +346,7 @@ uint addMedium(Scene& scene, const std::string& name, const MediumParams& m) {
     out.size = uvec3(kNanoVdbMajorantRes);
     out.Le = vec3(float(m.LeScale), float(m.temperatureOffset), float(m.temperatureScale));
     out.density = appendGrid(scene, packVoxelGrid(grids.density));
-    // The hottest temperature the grid gives (pbrt-v4 emits above 100 K).
-    const double hottest =
-        std::max((double(grids.temperatureMin) - m.temperatureOffset) * m.temperatureScale,
-                 (double(grids.temperatureMax) - m.temperatureOffset) * m.temperatureScale);
+    const double hottest = hottestKelvin(grids.temperatureMin, grids.temperatureMax, m);
     if (grids.temperature && m.LeScale > 0.0 && hottest > 100.0) {
       out.emissive = kEmitsBlackbody;
       std::vector<float> emission = blackbodyTable(hottest);
@@ -382,10 +380,9 @@ uint addMedium(Scene& scene, const std::string& name, const MediumParams& m) {
       if (out.emissive && !m.LeScaleGrid.empty()) out.emission = appendGrid(scene, m.LeScaleGrid);
       // Emission by temperature, where some voxel is above 100 K once offset and scaled, and
       // the Lescale grid (if any) is not all zero.
-      double hottest = 0.0;
-      for (float t : m.temperature) {
-        hottest = std::max(hottest, (double(t) - m.temperatureOffset) * m.temperatureScale);
-      }
+      const auto [coolest, warmest] =
+          std::minmax_element(m.temperature.begin(), m.temperature.end());
+      const double hottest = m.temperature.empty() ? 0.0 : hottestKelvin(*coolest, *warmest, m);
       const bool scaled = m.LeScaleGrid.empty() || gridMax(m.LeScaleGrid) > 0.0f;
       if (hottest > 100.0 && scaled && fitsFloat(hottest)) {
         out.emissive = kEmitsBlackbody;

@@ -6,6 +6,7 @@
 
 #include "common/check.h"
 #include "image/texture_image.h"
+#include "texture.h"
 
 namespace pt {
 
@@ -65,7 +66,7 @@ bool parseWrapMode(const std::string& name, uint& wrap) {
 
 void setMaterialTextures(Scene& scene, std::size_t material, const MaterialTextures& t) {
   PT_CHECK(material < scene.materials.size(), "textures for a material that does not exist");
-  if (scene.materialTextures.empty() && !hasTextures(t)) return;
+  if (scene.materialTextures.empty() && !anyTexture(t)) return;
   scene.materialTextures.resize(scene.materials.size(), noMaterialTextures());
   scene.materialTextures[material] = t;
 }

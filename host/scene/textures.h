@@ -44,14 +44,6 @@ inline MaterialTextures noMaterialTextures() {
   return t;
 }
 
-// True where some parameter of t is a texture.
-inline bool hasTextures(const MaterialTextures& t) {
-  return t.reflectance != kNoTexture || t.transmittance != kNoTexture ||
-         t.uRoughness != kNoTexture || t.vRoughness != kNoTexture || t.eta != kNoTexture ||
-         t.k != kNoTexture || t.displacement != kNoTexture || t.alpha != kNoTexture ||
-         t.thickness != kNoTexture || t.g != kNoTexture;
-}
-
 // Sets the textures of scene.materials[material], making scene.materialTextures parallel to
 // scene.materials first (noMaterialTextures for the others) unless t has none.
 void setMaterialTextures(Scene& scene, std::size_t material, const MaterialTextures& t);
