@@ -25,6 +25,7 @@
 #define PT_PATH_VERTEX_H
 
 #include "bsdf.h"
+#include "light_bvh.h"
 #include "sampling.h"
 #include "shared_types.h"
 #ifndef PT_NO_BSDF_MATERIALS
@@ -43,6 +44,7 @@
 #define PT_HAS_SHADING_NORMALS true
 #define PT_HAS_TWO_SIDED_EMITTERS true
 #define PT_HAS_SPHERE_LIGHTS true
+#define PT_HAS_LIGHT_BVH true
 #define PT_HAS_ANALYTIC_LIGHTS true
 #define PT_HAS_ENVIRONMENT true
 #define PT_HAS_ENVIRONMENT_IMAGE true
@@ -88,6 +90,10 @@ struct PathScene {
   const Medium* media;
   const float* mediumGrids;                 // grid floats, majorant grids included
   const MediumInterface* mediumInterfaces;  // by Triangle::primitive
+  // The light BVH (light_bvh.h), null without one: its nodes, and its words (each Emitter's
+  // leaf, then the unbounded Emitters).
+  const LightBvhNode* lightBvh;
+  const uint* lightBvhWords;
 };
 #define PT_SCENE_PARAM const PathScene &scene,
 #define PT_SCENE_ARG scene,
@@ -109,6 +115,15 @@ inline const Emitter& loadEmitter(const PathScene& scene, uint i) {
 }
 inline const Light& loadLight(const PathScene& scene, uint i) {
   return scene.lights[i];
+}
+inline const LightBvhNode& loadLightBvhNode(const PathScene& scene, uint i) {
+  return scene.lightBvh[i];
+}
+inline uint loadEmitterLeaf(const PathScene& scene, uint emitter) {
+  return scene.lightBvhWords[emitter];
+}
+inline uint loadUnboundedEmitter(const PathScene& scene, uint k) {
+  return scene.lightBvhWords[scene.params->emitterCount + k];
 }
 inline const TriangleNormals& loadNormals(const PathScene& scene, uint primitive) {
   return scene.normals[primitive];
@@ -157,12 +172,15 @@ struct PathState {
   float etaScale;       // product of the squared relative indices refracted through (for RR)
   float bsdfPdf;        // solid-angle pdf of the BSDF sample that produced the ray
   bool specularBounce;  // the ray leaves a specular bounce (or the camera)
+  vec3 prevP;           // the last scattering vertex (the camera's position at first) and the
+  vec3 prevN;           // normal the light BVH weighs there (zero in a medium): the light
+                        // choice's probability for emission the ray finds is measured there
 };
 
 // A path at the camera: nothing gathered, throughput 1; the camera ray counts as specular, so
 // that emission it finds is taken at full weight.
 PT_INLINE PathState startPathState() {
-  return PathState(vec3(0.0f), vec3(1.0f), 1.0f, 0.0f, true);
+  return PathState(vec3(0.0f), vec3(1.0f), 1.0f, 0.0f, true, vec3(0.0f), vec3(0.0f));
 }
 
 // The coordinates of a scattering event's random numbers (sampling.h): the BSDFs' random
@@ -276,19 +294,109 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
   return s;
 }
 
+// ---- Choosing an emitter ------------------------------------------------------------------
+// Light sampling chooses its emitter from the alias table (by power or uniformly, as the
+// renderer's --light-sampler asks) or, where the scene has a light BVH, from the shading point
+// p and the normal n it weighs, as pbrt-v4's BVHLightSampler does: one of the U unbounded
+// emitters (distant and infinite lights) with probability U / (U + 1), shared equally, else
+// down the tree, each step by the two children's importance (light_bvh.h).
+
+struct EmitterChoice {
+  Emitter emitter;  // emitter.triangle kNoEmitter: no light can reach the point
+  float pmf;        // the probability of the choice
+};
+
+PT_INLINE bool lightBvhOn(PT_SCENE_PARAM_ONLY) {
+  return PT_HAS_LIGHT_BVH && PT_PARAMS.lightBvhNodes > 0u;
+}
+
+// The normal the light BVH weighs at s: its shading normal; none at a point of a medium.
+PT_INLINE vec3 lightChoiceNormal(PT_IN(SurfacePoint) s) {
+  return (PT_HAS_MEDIA && s.scatter == kScatterPhase) ? vec3(0.0f) : s.ns;
+}
+
+// The probability that the light BVH's choice is an unbounded emitter.
+PT_INLINE float unboundedShare(PT_SCENE_PARAM_ONLY) {
+  return float(PT_PARAMS.unboundedEmitters) / float(PT_PARAMS.unboundedEmitters + 1u);
+}
+
+PT_INLINE EmitterChoice chooseEmitter(PT_SCENE_PARAM vec3 p, vec3 n, vec2 u) {
+  if (lightBvhOn(PT_SCENE_ONLY)) {
+    Emitter none = Emitter(kNoEmitter, 0.0f, 0.0f, 0u);
+    float pInfinite = unboundedShare(PT_SCENE_ONLY);
+    if (u.x < pInfinite) {
+      uint count = PT_PARAMS.unboundedEmitters;
+      uint k = min(uint(u.x / pInfinite * float(count)), count - 1u);
+      Emitter e = loadEmitter(PT_SCENE_ARG loadUnboundedEmitter(PT_SCENE_ARG k));
+      return EmitterChoice(e, e.pmf);
+    }
+    float x = min((u.x - pInfinite) / (1.0f - pInfinite), 0.99999994f);
+    float pmf = 1.0f - pInfinite;
+    uint at = 0u;
+    LightBvhNode node = loadLightBvhNode(PT_SCENE_ARG 0u);
+    while ((node.flags & kLightBvhLeaf) == 0u) {
+      PT_LOOP_TICK();
+      LightBvhNode first = loadLightBvhNode(PT_SCENE_ARG at + 1u);
+      LightBvhNode second = loadLightBvhNode(PT_SCENE_ARG node.child);
+      float c0 = lightBoundsImportance(first, p, n);
+      float c1 = lightBoundsImportance(second, p, n);
+      if (c0 == 0.0f && c1 == 0.0f) return EmitterChoice(none, 0.0f);
+      float stepPmf;
+      bool takeSecond = chooseSecondChild(c0, c1, x, stepPmf);
+      pmf *= stepPmf;
+      at = takeSecond ? node.child : at + 1u;
+      node = takeSecond ? second : first;
+    }
+    // A tree of one light: its importance is tested here.
+    if (at == 0u && !(lightBoundsImportance(node, p, n) > 0.0f)) return EmitterChoice(none, 0.0f);
+    return EmitterChoice(loadEmitter(PT_SCENE_ARG node.child), pmf);
+  }
+  uint slot = aliasTableSlot(u.x, PT_PARAMS.emitterCount);
+  Emitter e =
+      loadEmitter(PT_SCENE_ARG aliasTablePick(slot, loadEmitter(PT_SCENE_ARG slot), u.y));
+  return EmitterChoice(e, e.pmf);
+}
+
+// The probability that chooseEmitter from p and n chooses emitter `index` (its entry e): up
+// the tree from the emitter's leaf, the share of each node against its sibling.
+PT_INLINE float emitterChoicePmf(PT_SCENE_PARAM uint index, PT_IN(Emitter) e, vec3 p, vec3 n) {
+  if (!lightBvhOn(PT_SCENE_ONLY)) return e.pmf;
+  uint at = loadEmitterLeaf(PT_SCENE_ARG index);
+  if (at == kNoEmitter) return e.pmf;  // an unbounded emitter
+  LightBvhNode node = loadLightBvhNode(PT_SCENE_ARG at);
+  float mine = lightBoundsImportance(node, p, n);
+  float product = 1.0f;
+  while (at != 0u) {
+    PT_LOOP_TICK();
+    if (!(mine > 0.0f)) return 0.0f;
+    LightBvhNode parent = loadLightBvhNode(PT_SCENE_ARG node.parent);
+    uint sibling = parent.child == at ? node.parent + 1u : parent.child;
+    float other = lightBoundsImportance(loadLightBvhNode(PT_SCENE_ARG sibling), p, n);
+    product *= mine / (mine + other);
+    at = node.parent;
+    node = parent;
+    if (at != 0u) mine = lightBoundsImportance(node, p, n);
+  }
+  // mine: the root's importance where it is the emitter's leaf, else its child's (tested).
+  if (!(mine > 0.0f)) return 0.0f;
+  return (1.0f - unboundedShare(PT_SCENE_ONLY)) * product;
+}
+
 // ---- Emission found by a ray -------------------------------------------------------------
 
 // The density with which light sampling from `from` would have chosen the point of emissive
 // triangle tri (shading point s, at distance t from `from`, seen at cosine cosEmit), per solid
-// angle: uniform on the triangle, or the cone of a sphere light.
+// angle: uniform on the triangle, or the cone of a sphere light. The emitter's choice is the
+// one made at the path's last vertex (path.prevP, prevN).
 PT_INLINE float emitterPdfFound(PT_SCENE_PARAM PT_IN(Triangle) tri, PT_IN(SurfacePoint) s,
-                                float cosEmit, float t, vec3 from) {
+                                float cosEmit, float t, vec3 from, PT_IN(PathState) path) {
   Emitter emitter = loadEmitter(PT_SCENE_ARG tri.emitter);
-  float lightPdf = emitter.pmf * t * t / (cosEmit * s.area);
+  float pmf = emitterChoicePmf(PT_SCENE_ARG tri.emitter, emitter, path.prevP, path.prevN);
+  float lightPdf = pmf * t * t / (cosEmit * s.area);
 #ifndef PT_NO_BSDF_MATERIALS
   // A sphere light's triangle: light sampling draws its cone (seen from the ray's origin).
   if (PT_HAS_SPHERE_LIGHTS && (emitter.triangle & kEmitterLight) != 0u) {
-    lightPdf = emitter.pmf *
+    lightPdf = pmf *
                sphereLightPdf(loadLight(PT_SCENE_ARG emitter.triangle & ~kEmitterLight), from);
   }
 #endif
@@ -316,7 +424,7 @@ PT_INLINE void addEmissionFound(PT_SCENE_PARAM PT_INOUT(PathState) path, PT_IN(T
     float weight = 1.0f;
     if (misOn(PT_SCENE_ONLY)) {
       weight =
-          powerHeuristic(path.bsdfPdf, emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, t, rayOrigin));
+          powerHeuristic(path.bsdfPdf, emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, t, rayOrigin, path));
     }
     path.L += path.beta * weight * Le;
   }
@@ -409,8 +517,7 @@ PT_INLINE vec3 bsdfFCos(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key, vec
 }
 #endif
 
-// Samples the light from vertex s (pbrt-v4's SampleLd): an emitter from the alias table with
-// uChoose, and with uLight a uniform point on its triangle or a sample of the analytic light
+// Samples the light from vertex s (pbrt-v4's SampleLd): an emitter chosen with uChoose, and with uLight a uniform point on its triangle or a sample of the analytic light
 // (lights.h, environment.h) it names; the BSDF's value towards it (at a point of a medium, the
 // phase function's), and the shadow ray's ends. The shadow ray leaves along n from a
 // Lambertian surface without shading normals, else from the side of the geometric surface the
@@ -418,9 +525,9 @@ PT_INLINE vec3 bsdfFCos(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key, vec
 PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
                                     vec2 uChoose, vec2 uLight) {
   LightSample ls = noLightSample();
-  uint slot = aliasTableSlot(uChoose.x, PT_PARAMS.emitterCount);
-  Emitter emitter =
-      loadEmitter(PT_SCENE_ARG aliasTablePick(slot, loadEmitter(PT_SCENE_ARG slot), uChoose.y));
+  EmitterChoice choice = chooseEmitter(PT_SCENE_ARG s.p, lightChoiceNormal(s), uChoose);
+  Emitter emitter = choice.emitter;
+  if (emitter.triangle == kNoEmitter) return ls;
   ls.emitter = emitter.triangle;
   bool lambertian = s.scatter < kScatterBsdf;  // mirrors sample no light
   vec3 wi;
@@ -453,7 +560,7 @@ PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Vertex
     }
     ls.to = analytic.target;
     ls.Li = analytic.Li;
-    ls.lightPdf = emitter.pmf * analytic.pdf;
+    ls.lightPdf = choice.pmf * analytic.pdf;
     ls.delta = analytic.delta;
   } else
 #endif
@@ -493,7 +600,7 @@ PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Vertex
     }
     ls.to = offsetRayOrigin(point, lightNormal, lightShading.magnitude);
     ls.Li = lightMaterial.emission;
-    ls.lightPdf = emitter.pmf * dist2 / (cosLight * lightShading.area);
+    ls.lightPdf = choice.pmf * dist2 / (cosLight * lightShading.area);
   }
   vec3 side = (lambertian && !s.shadingNormals) ? s.n : geometricSide(s, wi);
   ls.from = offsetRayOrigin(s.p, side, s.magnitude);
@@ -533,6 +640,8 @@ PT_INLINE vec3 lightSampleContribution(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Ver
 // pdf (so f * cos / pdf = reflectance); false for a direction in the tangent plane, which
 // contributes nothing. (The CPU's lanes draw such directions for all lanes at once.)
 PT_INLINE bool continueLambertian(PT_IN(SurfacePoint) s, PT_INOUT(PathState) path, float pdf) {
+  path.prevP = s.p;
+  path.prevN = s.ns;
   path.bsdfPdf = pdf;
   if (!(pdf > 0.0f)) return false;
   path.beta *= s.material.reflectance;
@@ -556,6 +665,8 @@ PT_INLINE bool sampleBsdfAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
   }
 #ifndef PT_NO_BSDF_MATERIALS
   if (s.scatter == kScatterBsdf) {
+    path.prevP = s.p;
+    path.prevN = s.ns;
     BsdfSample bs = bsdfSample(
         s.material, s.woLocal, uLobe, uBsdf,
         makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed, kStreamSample));

@@ -25,6 +25,7 @@ layout(constant_id = PT_SPEC_MIS) const bool kMis = true;
 layout(constant_id = PT_SPEC_RR) const bool kRussianRoulette = true;
 layout(constant_id = PT_SPEC_INTERSECTION) const uint kIntersection = kSpecAtRunTime;
 layout(constant_id = PT_SPEC_SAMPLER) const uint kSampler = kSpecAtRunTime;
+layout(constant_id = PT_SPEC_LIGHT_BVH) const bool kLightBvh = true;
 #ifdef PT_NO_BSDF_MATERIALS
 // The variant for scenes of diffuse and mirror surfaces without vertex normals (the host picks
 // it): nothing of bsdf.h is compiled in, which lavapipe's compiler takes a second over even
@@ -81,6 +82,7 @@ layout(set = 0, binding = PT_BINDING_NODES) uniform usamplerBuffer nodeTexels;
 layout(set = 0, binding = PT_BINDING_TRIANGLES) uniform usamplerBuffer triangleTexels;
 layout(set = 0, binding = PT_BINDING_MATERIALS) uniform usamplerBuffer materialTexels;
 layout(set = 0, binding = PT_BINDING_EMITTERS) uniform usamplerBuffer emitterTexels;
+layout(set = 0, binding = PT_BINDING_LIGHT_BVH) uniform usamplerBuffer lightBvhTexels;
 layout(set = 0, binding = PT_BINDING_NORMALS) uniform usamplerBuffer normalTexels;
 layout(set = 0, binding = PT_BINDING_LIGHTS) uniform usamplerBuffer lightTexels;
 layout(set = 0, binding = PT_BINDING_UVS) uniform usamplerBuffer uvTexels;
@@ -220,6 +222,27 @@ Emitter loadEmitter(uint i) {
   return Emitter(a.x, uintBitsToFloat(a.y), uintBitsToFloat(a.z), a.w);
 }
 
+// The light BVH's nodes, then its words: each Emitter's leaf, then the unbounded Emitters.
+LightBvhNode loadLightBvhNode(uint i) {
+  int at = int(kLightBvhTexels * i);
+  uvec4 a = texelFetch(lightBvhTexels, at);
+  uvec4 b = texelFetch(lightBvhTexels, at + 1);
+  uvec4 c = texelFetch(lightBvhTexels, at + 2);
+  uvec4 d = texelFetch(lightBvhTexels, at + 3);
+  return LightBvhNode(uintBitsToFloat(a.xyz), uintBitsToFloat(a.w), uintBitsToFloat(b.xyz),
+                      uintBitsToFloat(b.w), uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), d.x,
+                      d.y, d.z, d.w);
+}
+uint lightBvhWord(uint i) {
+  return texelFetch(lightBvhTexels, int(kLightBvhTexels * params.lightBvhNodes + (i >> 2u)))[i & 3u];
+}
+uint loadEmitterLeaf(uint emitter) {
+  return lightBvhWord(emitter);
+}
+uint loadUnboundedEmitter(uint k) {
+  return lightBvhWord(params.emitterCount + k);
+}
+
 #ifndef PT_NO_BSDF_MATERIALS
 EnvironmentMap environmentMap() {
   return EnvironmentMap(params.environmentX, params.environmentY, params.environmentZ,
@@ -248,6 +271,7 @@ Light loadLight(uint i) {
 #define PT_HAS_SHADING_NORMALS kShadingNormals
 #define PT_HAS_TWO_SIDED_EMITTERS kTwoSidedEmitters
 #define PT_HAS_SPHERE_LIGHTS kSphereLights
+#define PT_HAS_LIGHT_BVH kLightBvh
 #define PT_HAS_ANALYTIC_LIGHTS kAnalyticLights
 #define PT_HAS_ENVIRONMENT kEnvironment
 #define PT_HAS_ENVIRONMENT_IMAGE kEnvironmentImage

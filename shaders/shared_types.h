@@ -158,6 +158,26 @@ struct Emitter {
   uint alias;            // 4 bytes
 };                       // 16 bytes
 
+// A node of the light BVH (pbrt-v4's LightBVHNode; shaders/light_bvh.h): the bounds of the
+// lights below it, their total power, and the cone of their emission (pbrt-v4's LightBounds).
+// Interior nodes have their first child next in the array and the second at `child`; a leaf
+// holds one Emitter. Built depth first from the root at 0.
+struct LightBvhNode {
+  vec3 boundsMin;    // 12 bytes: the lights' box (a point light's is its position)
+  float phi;         //  4 bytes: their power (pbrt-v4's LightBounds::phi)
+  vec3 boundsMax;    // 12 bytes
+  float cosThetaO;   //  4 bytes: cosine of the spread of their normals about w
+  vec3 w;            // 12 bytes: unit axis of their normals' cone
+  float cosThetaE;   //  4 bytes: cosine of the angle beyond the normals they emit to
+  uint child;        //  4 bytes: interior: the second child's node; leaf: its Emitter
+  uint flags;        //  4 bytes: kLightBvhLeaf, kLightBvhTwoSided
+  uint parent;       //  4 bytes: the node above (the root: itself)
+  uint reserved0;    //  4 bytes: zero
+};                   // 64 bytes
+PT_CONST uint kLightBvhTexels = 4u;
+PT_CONST uint kLightBvhLeaf = 1u;      // a leaf: `child` is an Emitter
+PT_CONST uint kLightBvhTwoSided = 2u;  // some light below emits on both sides of its normal
+
 // Lights that are not triangles: pbrt-v4's point, spot, distant and (constant) infinite lights.
 // They join the emissive triangles in the alias table: an Emitter whose `triangle` has
 // kEmitterLight set names Light number (triangle & ~kEmitterLight) instead.
@@ -431,6 +451,12 @@ PT_CONST uint kStrategyMis = 0u;   // light sampling + BSDF sampling, power heur
 PT_CONST uint kStrategyNee = 1u;   // light sampling only (emission hit by BSDF rays ignored)
 PT_CONST uint kStrategyBsdf = 2u;  // BSDF sampling only (no shadow rays)
 
+// How light sampling chooses its emitter (the host builds the table or tree; path_vertex.h's
+// chooseEmitter reads them): pbrt-v4's light samplers.
+PT_CONST uint kLightSamplerBvh = 0u;      // the light BVH, by importance at the shading point
+PT_CONST uint kLightSamplerPower = 1u;    // the alias table, by power
+PT_CONST uint kLightSamplerUniform = 2u;  // the alias table, every emitter alike
+
 // Where the integrators' random numbers come from (sampling.h).
 PT_CONST uint kSamplerIndependent = 0u;  // a hash per (pixel, sample, dimension): independent
 PT_CONST uint kSamplerSobol = 1u;        // Owen-scrambled Sobol points per dimension
@@ -468,8 +494,10 @@ struct RenderParams {
   uint environmentMapping;  //  4 bytes: kEnvironmentOctahedral or kEnvironmentLatLong
   uint cameraMedium;        //  4 bytes: the medium the camera is in, or kNoMedium
   uint mediaPresent;        //  4 bytes: 1 when the scene has media (the volume integrator)
-  uint reserved0;           //  4 bytes: zero
-  uint reserved1;           //  4 bytes: zero
+  uint lightBvhNodes;       //  4 bytes: nodes of the light BVH; 0: emitters are chosen from
+                            //           the alias table
+  uint unboundedEmitters;   //  4 bytes: with the light BVH: the emitters without a position
+                            //           (distant, infinite lights), chosen uniformly
 };                          // 304 bytes
 
 // How an environment image's (u, v) square maps to directions in its frame (environment.h).
@@ -507,7 +535,9 @@ PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v =
 #define PT_BINDING_MEDIA 14              // Medium[], texels
 #define PT_BINDING_MEDIUM_GRIDS 15       // the grids' floats, four to a texel
 #define PT_BINDING_MEDIUM_INTERFACES 16  // MediumInterface[] by primitive, two to a texel
-#define PT_BINDING_COUNT 17
+// LightBvhNode[], then (four to a texel) each Emitter's leaf and the unbounded Emitters' indices
+#define PT_BINDING_LIGHT_BVH 17
+#define PT_BINDING_COUNT 18
 
 // Specialization constant ids: the effect set. An effect switched off is compiled out.
 #define PT_SPEC_DIFFUSE 0        // bool: Lambertian surfaces occur
@@ -539,7 +569,8 @@ PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v =
 #define PT_SPEC_BUMP 22                // bool: some material has a bump map
 #define PT_SPEC_TEXTURE_FEATURES 23    // uint: kTextureUses* bits of what the textures need
 #define PT_SPEC_MEDIUM_KINDS 24        // uint: bit 1 << kMedium* for each type of medium present
-#define PT_SPEC_COUNT 25
+#define PT_SPEC_LIGHT_BVH 25           // bool: emitters are chosen by the light BVH
+#define PT_SPEC_COUNT 26
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever

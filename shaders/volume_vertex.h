@@ -63,7 +63,6 @@ struct VolumePath {
   uint hero;         // the channel distances are sampled by (0, 1, 2)
   uint medium;       // the medium the ray is in, or kNoMedium
   uint depth;        // scattering events so far (surfaces and media)
-  vec3 prevP;        // the last scattering vertex (the camera's position at first)
   RandomStream rng;  // the flight's collisions, keyed by the next event's dimension
 };
 
@@ -78,15 +77,17 @@ PT_INLINE VolumePath startVolumePath(PT_SCENE_PARAM uvec2 pixel, uint sampleInde
   RandomStream heroStream =
       makeRandomStream(pixel, sampleIndex, kDimPixel, PT_PARAMS.seed, kStreamHeroChannel);
   uint hero = min(uint(nextRandom(heroStream) * 3.0f), 2u);
-  return VolumePath(startPathState(), vec3(1.0f), vec3(1.0f), hero, PT_PARAMS.cameraMedium, 0u,
-                    origin, flightStream(PT_SCENE_ARG pixel, sampleIndex, 0u));
+  VolumePath v = VolumePath(startPathState(), vec3(1.0f), vec3(1.0f), hero, PT_PARAMS.cameraMedium,
+                            0u, flightStream(PT_SCENE_ARG pixel, sampleIndex, 0u));
+  v.path.prevP = origin;
+  return v;
 }
 
 // After a scattering event at p: the next flight's random stream, and p as the vertex that
 // light sampling's density is measured from.
 PT_INLINE void startFlight(PT_SCENE_PARAM PT_INOUT(VolumePath) v, VertexKey key, vec3 p) {
   v.rng = flightStream(PT_SCENE_ARG key.pixel, key.sampleIndex, v.depth);
-  v.prevP = p;
+  v.path.prevP = p;
 }
 
 // The medium a ray towards w is in after crossing (or leaving) the surface of triangle
@@ -373,7 +374,7 @@ PT_INLINE void addVolumeEmissionFound(PT_SCENE_PARAM PT_INOUT(VolumePath) v, PT_
     if (!bsdfEmissionOn(PT_SCENE_ONLY)) return;
     if (misOn(PT_SCENE_ONLY)) {
       float lightPdf =
-          emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, distance(v.prevP, s.p), v.prevP);
+          emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, distance(v.path.prevP, s.p), v.path.prevP, v.path);
       denominator = average(v.rU + v.rL * lightPdf);
     }
   }
@@ -405,6 +406,7 @@ PT_INLINE bool scatterInMedium(PT_INOUT(VolumePath) v, vec3 wo, float g, vec2 u,
   if (!(pdf > 0.0f)) return false;
   // The phase function's value over its density is one: beta is unchanged.
   v.rL = v.rU / pdf;
+  v.path.prevN = vec3(0.0f);  // a point of a medium: the light BVH weighs no surface
   v.path.specularBounce = false;
   return true;
 }

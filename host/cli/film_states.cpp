@@ -105,6 +105,11 @@ KeyValues imageSettings(const SceneData& data, const RenderSettings& settings,
                                            data.mediumInterfaces.size() * sizeof(MediumInterface),
                                            hashBytes(cameraMedium.data(), sizeof(uint32_t)))))));
   }
+  // The light BVH only where it chooses the emitters (the power and uniform samplers' tables
+  // are in "bvh"'s hash of the emitters, and older states stay as they were).
+  if (!data.lightBvh.empty()) {
+    s.emplace_back("light_sampler", std::string(nameOf(kLightSamplerNames, kLightSamplerBvh)));
+  }
   s.insert(s.end(), backendExtra.begin(), backendExtra.end());
   return s;
 }

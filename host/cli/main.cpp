@@ -431,6 +431,10 @@ void addOverrideOptions(CLI::App* cmd, SceneOverrides& o) {
   cmd->add_option("--sampler", o.sampler,
                   "Random numbers: " + describeNames(kSamplerNames) + "; default: the scene's")
       ->check(CLI::IsMember(namesOf(kSamplerNames)));
+  cmd->add_option("--light-sampler", o.lightSampler,
+                  "How light sampling chooses a light: " + describeNames(kLightSamplerNames) +
+                      "; default: the scene's (pbrt-v4's: bvh)")
+      ->check(CLI::IsMember(namesOf(kLightSamplerNames)));
 }
 
 }  // namespace

@@ -16,7 +16,7 @@ struct SceneOverrides {
   std::optional<uint32_t> seed;
   std::optional<int> leafSize;  // unset: the backend's default (kDefaultLeafSize*)
   // Names from the tables; empty: the scene's (strategy, roulette, sampler) or the default.
-  std::string strategy, roulette, sampler;
+  std::string strategy, roulette, sampler, lightSampler;
   std::string builder{nameOf(kBuilderNames, kDefaultBuilder)};
   std::string intersection{nameOf(kIntersectionNames, false)};
 
@@ -33,6 +33,7 @@ struct SceneOverrides {
     s.strategy = valueNamed(kStrategyNames, strategy);
     s.russianRoulette = valueNamed(kRouletteNames, roulette);
     s.sampler = valueNamed(kSamplerNames, sampler);
+    s.lightSampler = valueNamed(kLightSamplerNames, lightSampler);
     s.builder = valueNamed(kBuilderNames, builder).value_or(kDefaultBuilder);
     s.fastIntersection = valueNamed(kIntersectionNames, intersection).value_or(false);
     return s;

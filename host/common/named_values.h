@@ -81,6 +81,12 @@ inline constexpr NameTable<uint, 3> kStrategyNames{{
     {"bsdf", kStrategyBsdf, "BSDF sampling only, no shadow rays"},
 }};
 
+inline constexpr NameTable<uint, 3> kLightSamplerNames{{
+    {"bvh", kLightSamplerBvh, "pbrt-v4's light BVH: by importance at the shading point"},
+    {"power", kLightSamplerPower, "by power"},
+    {"uniform", kLightSamplerUniform, "every light alike"},
+}};
+
 inline constexpr NameTable<uint, 2> kSamplerNames{{
     {"independent", kSamplerIndependent, "a hash per sample"},
     {"sobol", kSamplerSobol, "Owen-scrambled Sobol points"},

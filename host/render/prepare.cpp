@@ -9,6 +9,7 @@
 #include "lights.h"
 #include "render/camera.h"
 #include "render/environment_map.h"
+#include "render/light_bvh.h"
 #include "render/prepare_media.h"
 
 namespace pt {
@@ -48,6 +49,7 @@ std::string EffectSet::toString() const {
   add(environmentImage, "environment-image");
   add(twoSidedEmitters, "two-sided-emitters");
   add(sphereLights, "sphere-lights");
+  add(lightBvh, "light-bvh");
   add(textures, "textures");
   add(alphaCutouts, "alpha");
   add(bumpMaps, "bump");
@@ -94,7 +96,8 @@ std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
 
 std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
                                    const std::vector<Material>& materials,
-                                   const std::vector<Light>& lights, float sceneRadius) {
+                                   const std::vector<Light>& lights, float sceneRadius,
+                                   bool uniform) {
   // Power of each emissive triangle: one-sided, so flux = pi * area * radiance; the pmf only
   // needs proportions, and luminance weights the channels.
   std::vector<Emitter> emitters;
@@ -139,7 +142,9 @@ std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
   }
   if (emitters.empty()) return emitters;
   const size_t unboundedCount = size_t(std::count(unbounded.begin(), unbounded.end(), true));
-  if (unboundedCount > 0) {
+  if (uniform) {
+    std::fill(power.begin(), power.end(), 1.0);  // pbrt-v4's UniformLightSampler
+  } else if (unboundedCount > 0) {
     double boundedPower = 0.0;
     for (size_t i = 0; i < power.size(); ++i) boundedPower += unbounded[i] ? 0.0 : power[i];
     const double share =
@@ -283,7 +288,17 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     radius = 0.5f * length(root.boundsMax - root.boundsMin);
   }
   // Emitters index triangles in leaf order, so they are built after the reorder.
-  data.emitters = buildEmitters(data.bvh.triangles, data.materials, lights, radius);
+  const uint lightSampler = settings.lightSampler.value_or(integ.lightSampler);
+  data.emitters = buildEmitters(data.bvh.triangles, data.materials, lights, radius,
+                                lightSampler == kLightSamplerUniform);
+  if (lightSampler == kLightSamplerBvh) {
+    LightBvh tree = buildLightBvh(data.emitters, data.bvh.triangles, data.materials, lights);
+    data.lightBvh = std::move(tree.nodes);
+    data.lightBvhWords = std::move(tree.words);
+    data.params.lightBvhNodes = uint32_t(data.lightBvh.size());
+    data.params.unboundedEmitters = tree.unbounded;
+    data.effects.lightBvh = !data.lightBvh.empty();
+  }
   data.lights = std::move(lights);
 
   RenderParams& p = data.params;

@@ -46,6 +46,7 @@ struct RenderSettings {
   std::optional<uint> strategy;  // kStrategy*
   std::optional<bool> russianRoulette;
   std::optional<uint> sampler;  // kSampler*
+  std::optional<uint> lightSampler;  // kLightSampler*
   int maxLeafSize = kDefaultLeafSizeCpu;
   BvhBuilder builder = kDefaultBuilder;
   bool fastIntersection = false;  // Moller-Trumbore instead of the watertight test
@@ -70,6 +71,7 @@ struct EffectSet {
   bool environmentImage = false;  // that light is an image (shaders/environment.h)
   bool twoSidedEmitters = false;  // some emissive triangle emits on both sides
   bool sphereLights = false;      // sphere area lights, sampled by the cone they subtend
+  bool lightBvh = false;          // emitters are chosen by the light BVH
   bool textures = false;          // some material has a parameter given by a texture
   bool alphaCutouts = false;      // some material has an alpha texture (any-hit tests)
   bool bumpMaps = false;          // some material has a displacement texture
@@ -153,6 +155,11 @@ struct SceneData {
   std::vector<Medium> media;
   std::vector<float> mediumGrids;
   std::vector<MediumInterface> mediumInterfaces;
+  // The light BVH (render/light_bvh.h), empty unless the light sampler is the BVH and some
+  // emitter has a position: its nodes, and each emitter's leaf followed by the unbounded
+  // emitters.
+  std::vector<LightBvhNode> lightBvh;
+  std::vector<uint32_t> lightBvhWords;
   RenderParams params{};
   int spp = 0;
   EffectSet effects;
@@ -182,7 +189,9 @@ struct SceneData {
                      environmentTexels.data(),
                      media.empty() ? nullptr : media.data(),
                      mediumGrids.empty() ? nullptr : mediumGrids.data(),
-                     mediumInterfaces.empty() ? nullptr : mediumInterfaces.data()};
+                     mediumInterfaces.empty() ? nullptr : mediumInterfaces.data(),
+                     lightBvh.empty() ? nullptr : lightBvh.data(),
+                     lightBvhWords.empty() ? nullptr : lightBvhWords.data()};
   }
 };
 
@@ -200,9 +209,10 @@ std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
 // take 1 / (U + 1) each (U of them; 1 / U when nothing else emits), as pbrt-v4's default
 // light sampler gives them; point and spot lights join the triangles, which share the rest
 // by power, a light's as pbrt-v4's Light::Phi gives it (divided by pi, as the triangles'
-// area x luminance is).
+// area x luminance is). `uniform`: every emitter alike instead (pbrt-v4's "uniform").
 std::vector<Emitter> buildEmitters(std::vector<Triangle>& triangles,
                                    const std::vector<Material>& materials,
-                                   const std::vector<Light>& lights, float sceneRadius);
+                                   const std::vector<Light>& lights, float sceneRadius,
+                                   bool uniform = false);
 
 }  // namespace pt

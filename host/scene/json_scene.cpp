@@ -229,7 +229,8 @@ CameraDesc readCamera(const JsonNode& node) {
 
 IntegratorSettings readIntegrator(const JsonNode& node) {
   node.checkKeys(
-      {"spp", "maxDepth", "seed", "russianRoulette", "rrStartDepth", "strategy", "sampler"});
+      {"spp", "maxDepth", "seed", "russianRoulette", "rrStartDepth", "strategy", "sampler",
+       "lightSampler"});
   IntegratorSettings s;
   if (auto n = node.find("spp")) s.spp = static_cast<int>(n->integer(1, kIntMax));
   if (auto n = node.find("maxDepth")) s.maxDepth = static_cast<int>(n->integer(0, kIntMax));
@@ -240,6 +241,9 @@ IntegratorSettings readIntegrator(const JsonNode& node) {
   }
   if (auto n = node.find("strategy")) s.strategy = readChoice(*n, kStrategyNames, "strategy");
   if (auto n = node.find("sampler")) s.sampler = readChoice(*n, kSamplerNames, "sampler");
+  if (auto n = node.find("lightSampler")) {
+    s.lightSampler = readChoice(*n, kLightSamplerNames, "lightSampler");
+  }
   return s;
 }
 

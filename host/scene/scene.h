@@ -60,6 +60,7 @@ struct IntegratorSettings {
   int rrStartDepth = 3;  // Russian roulette from this many scattering events on
   uint strategy = kStrategyMis;
   uint sampler = kSamplerSobol;  // see docs/accuracy.md for what it buys
+  uint lightSampler = kLightSamplerBvh;  // pbrt-v4's default
 };
 
 // An infinite light whose radiance is an image over the directions (shaders/environment.h):

@@ -81,6 +81,11 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   mediumGrids.resize((mediumGrids.size() + 3) / 4 * 4, 0.0f);
   std::vector<MediumInterface> mediumInterfaces = orDummy(scene.mediumInterfaces);
   mediumInterfaces.resize((mediumInterfaces.size() + 1) / 2 * 2, MediumInterface{});
+  // The light BVH's nodes and then its words, in whole texels (one zeroed texel without it).
+  std::vector<uint32_t> lightBvh(scene.lightBvh.size() * sizeof(LightBvhNode) / sizeof(uint32_t));
+  if (!lightBvh.empty()) std::memcpy(lightBvh.data(), scene.lightBvh.data(), lightBvh.size() * 4);
+  lightBvh.insert(lightBvh.end(), scene.lightBvhWords.begin(), scene.lightBvhWords.end());
+  lightBvh.resize(std::max<size_t>(4, (lightBvh.size() + 3) / 4 * 4), 0u);
   const GpuBvh bvh = buildGpuBvh(scene.bvh);
   const std::vector<uint32_t> traversal = gpuTraversalTexels(bvh, scene.bvh.triangles);
   // In PT_BINDING_* order, followed by the accumulation and the counters.
@@ -102,6 +107,7 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       {"medium grid", mediumGrids.data(), mediumGrids.size() * sizeof(float), true},
       {"medium interface", mediumInterfaces.data(),
        mediumInterfaces.size() * sizeof(MediumInterface), true},
+      {"light BVH", lightBvh.data(), lightBvh.size() * sizeof(uint32_t), true},
   };
   static_assert(PT_BINDING_PARAMS == 0 && PT_BINDING_NODES == 1 && PT_BINDING_TRIANGLES == 2 &&
                 PT_BINDING_MATERIALS == 3 && PT_BINDING_EMITTERS == 4 && PT_BINDING_NORMALS == 5 &&
@@ -109,7 +115,7 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
                 PT_BINDING_ENVIRONMENT == 9 && PT_BINDING_UVS == 10 && PT_BINDING_TEXTURES == 11 &&
                 PT_BINDING_IMAGES == 12 && PT_BINDING_MATERIAL_TEXTURES == 13 &&
                 PT_BINDING_MEDIA == 14 && PT_BINDING_MEDIUM_GRIDS == 15 &&
-                PT_BINDING_MEDIUM_INTERFACES == 16);
+                PT_BINDING_MEDIUM_INTERFACES == 16 && PT_BINDING_LIGHT_BVH == 17);
   static_assert(std::size(uploads) + 2 == PT_BINDING_COUNT, "every binding is a buffer");
 
   // Every size is checked before anything is allocated: a scene too large for the device is
@@ -167,7 +173,8 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
                        all || fx.alphaCutouts,
                        all || fx.bumpMaps,
                        all ? kTextureUsesAll : fx.textureFeatures,
-                       all ? 0xFFFFFFFFu : fx.mediumKinds}};
+                       all ? 0xFFFFFFFFu : fx.mediumKinds,
+                       all || fx.lightBvh}};
   static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
                 PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
                 PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
@@ -178,7 +185,7 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
                 PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_SPHERE_LIGHTS == 18 &&
                 PT_SPEC_ENVIRONMENT_IMAGE == 19 && PT_SPEC_TEXTURES == 20 && PT_SPEC_ALPHA == 21 &&
                 PT_SPEC_BUMP == 22 && PT_SPEC_TEXTURE_FEATURES == 23 &&
-                PT_SPEC_MEDIUM_KINDS == 24 && PT_SPEC_COUNT == 25);
+                PT_SPEC_MEDIUM_KINDS == 24 && PT_SPEC_LIGHT_BVH == 25 && PT_SPEC_COUNT == 26);
   std::vector<vk::SpecializationMapEntry> entries;
   for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));

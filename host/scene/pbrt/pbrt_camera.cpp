@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "common/check.h"
+#include "common/named_values.h"
 #include "scene/camera_filter.h"
 #include "scene/json_reader.h"
 #include "scene/pbrt/pbrt_builder.h"
@@ -252,7 +253,17 @@ void Builder::options(Statement& s) {
     if (auto v = p.boolean("regularize"); v && *v) {
       warnOnce("regularize", s.location, "Integrator: \"regularize\" ignored");
     }
-    p.string("lightsampler");  // how lights are chosen: the noise, not the image
+    if (auto v = p.string("lightsampler")) {
+      // pbrt-v4's light samplers (its "exhaustive" is not one of ours: an error, as an
+      // unknown name is in pbrt-v4).
+      const auto sampler = valueNamed(kLightSamplerNames, *v);
+      if (!sampler) {
+        fail(p.find("lightsampler")->location,
+             "unknown light sampler " + singleQuoted(*v) + " (expected " +
+                 quotedNames(kLightSamplerNames) + ")");
+      }
+      scene_.integrator.lightSampler = *sampler;
+    }
     if (type != "path" && type != "volpath") p.markAllUsed();
   } else if (d == "Accelerator") {
     p.markAllUsed();  // the BVH is this renderer's own: nothing to take from the file
