@@ -8,7 +8,8 @@
 // Where we differ from pbrt-v4: its nodes store their bounds quantized to 16 bits and their
 // cosines to 15 (a slightly wider cone and box); ours are floats. A point at the exact centre
 // of a node's bounds takes the node's axis as its direction to the lights, where pbrt-v4's
-// normalization of a zero vector gives NaN.
+// normalization of a zero vector gives NaN; a point on the sphere about the bounds counts as
+// inside it (pbrt-v4: outside, at a right angle).
 #ifndef PT_LIGHT_BVH_H
 #define PT_LIGHT_BVH_H
 
@@ -34,25 +35,27 @@ PT_INLINE float sinSubClamped(float sinA, float cosA, float sinB, float cosB) {
 // cone of normals and the direction to p, less the angle the bounds subtend from p) and at
 // p's surface; zero where every light faces away beyond its emission angle theta_e.
 PT_INLINE float lightBoundsImportance(PT_IN(LightBvhNode) node, vec3 p, vec3 n) {
-  vec3 pc = 0.5f * (node.boundsMin + node.boundsMax);
-  vec3 fromCentre = p - pc;
+  vec3 fromCentre = p - 0.5f * (node.boundsMin + node.boundsMax);
   float d2 = dot(fromCentre, fromCentre);
-  vec3 wi = d2 > 0.0f ? normalize(fromCentre) : node.w;
-  float halfDiagonal = 0.5f * length(node.boundsMax - node.boundsMin);
-  // pbrt-v4's BoundSubtendedDirections: the cone of directions from p to the bounds' sphere.
+  float invD = 1.0f / sqrt(d2);
+  vec3 wi = d2 > 0.0f ? fromCentre * invD : node.w;
+  vec3 diagonal = node.boundsMax - node.boundsMin;
+  float halfDiagonal = 0.5f * sqrt(dot(diagonal, diagonal));
+  // pbrt-v4's BoundSubtendedDirections: the cone of directions from p to the bounds' sphere
+  // (all directions from inside it), its sine the sphere's radius over the distance.
+  float sinThetaB = 0.0f;
   float cosThetaB = -1.0f;
-  if (!(d2 < halfDiagonal * halfDiagonal)) {
-    cosThetaB = sqrt(max(0.0f, 1.0f - halfDiagonal * halfDiagonal / d2));
+  if (d2 > halfDiagonal * halfDiagonal) {
+    sinThetaB = min(halfDiagonal * invD, 1.0f);
+    cosThetaB = sqrt(max(0.0f, 1.0f - sinThetaB * sinThetaB));
   }
   d2 = max(d2, halfDiagonal);
   float cosThetaW = dot(node.w, wi);
   if ((node.flags & kLightBvhTwoSided) != 0u) cosThetaW = abs(cosThetaW);
   float sinThetaW = sqrt(max(0.0f, 1.0f - cosThetaW * cosThetaW));
-  float sinThetaB = sqrt(max(0.0f, 1.0f - cosThetaB * cosThetaB));
-  float sinThetaO = sqrt(max(0.0f, 1.0f - node.cosThetaO * node.cosThetaO));
   // The angle between the cone of normals and wi, less the cone's spread, less theta_b.
-  float cosThetaX = cosSubClamped(sinThetaW, cosThetaW, sinThetaO, node.cosThetaO);
-  float sinThetaX = sinSubClamped(sinThetaW, cosThetaW, sinThetaO, node.cosThetaO);
+  float cosThetaX = cosSubClamped(sinThetaW, cosThetaW, node.sinThetaO, node.cosThetaO);
+  float sinThetaX = sinSubClamped(sinThetaW, cosThetaW, node.sinThetaO, node.cosThetaO);
   float cosThetaP = cosSubClamped(sinThetaX, cosThetaX, sinThetaB, cosThetaB);
   if (cosThetaP <= node.cosThetaE) return 0.0f;
   float importance = node.phi * cosThetaP / d2;

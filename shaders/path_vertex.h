@@ -320,6 +320,14 @@ PT_INLINE float unboundedShare(PT_SCENE_PARAM_ONLY) {
   return float(PT_PARAMS.unboundedEmitters) / float(PT_PARAMS.unboundedEmitters + 1u);
 }
 
+// The weights of a node's two children at p (first, second): their importance, or where their
+// bounds differ in power alone, their power (the same ratio, without evaluating it).
+PT_INLINE vec2 childWeights(PT_IN(LightBvhNode) node, PT_IN(LightBvhNode) first,
+                            PT_IN(LightBvhNode) second, vec3 p, vec3 n) {
+  if ((node.flags & kLightBvhSameBounds) != 0u) return vec2(first.phi, second.phi);
+  return vec2(lightBoundsImportance(first, p, n), lightBoundsImportance(second, p, n));
+}
+
 PT_INLINE EmitterChoice chooseEmitter(PT_SCENE_PARAM vec3 p, vec3 n, vec2 u) {
   if (lightBvhOn(PT_SCENE_ONLY)) {
     Emitter none = Emitter(kNoEmitter, 0.0f, 0.0f, 0u);
@@ -338,11 +346,10 @@ PT_INLINE EmitterChoice chooseEmitter(PT_SCENE_PARAM vec3 p, vec3 n, vec2 u) {
       PT_LOOP_TICK();
       LightBvhNode first = loadLightBvhNode(PT_SCENE_ARG at + 1u);
       LightBvhNode second = loadLightBvhNode(PT_SCENE_ARG node.child);
-      float c0 = lightBoundsImportance(first, p, n);
-      float c1 = lightBoundsImportance(second, p, n);
-      if (c0 == 0.0f && c1 == 0.0f) return EmitterChoice(none, 0.0f);
+      vec2 c = childWeights(node, first, second, p, n);
+      if (c.x == 0.0f && c.y == 0.0f) return EmitterChoice(none, 0.0f);
       float stepPmf;
-      bool takeSecond = chooseSecondChild(c0, c1, x, stepPmf);
+      bool takeSecond = chooseSecondChild(c.x, c.y, x, stepPmf);
       pmf *= stepPmf;
       at = takeSecond ? node.child : at + 1u;
       node = takeSecond ? second : first;
@@ -364,22 +371,22 @@ PT_INLINE float emitterChoicePmf(PT_SCENE_PARAM uint index, PT_IN(Emitter) e, ve
   uint at = loadEmitterLeaf(PT_SCENE_ARG index);
   if (at == kNoEmitter) return e.pmf;  // an unbounded emitter
   LightBvhNode node = loadLightBvhNode(PT_SCENE_ARG at);
-  float mine = lightBoundsImportance(node, p, n);
+  float share = 1.0f - unboundedShare(PT_SCENE_ONLY);
+  if (at == 0u) return lightBoundsImportance(node, p, n) > 0.0f ? share : 0.0f;
   float product = 1.0f;
   while (at != 0u) {
     PT_LOOP_TICK();
-    if (!(mine > 0.0f)) return 0.0f;
     LightBvhNode parent = loadLightBvhNode(PT_SCENE_ARG node.parent);
-    uint sibling = parent.child == at ? node.parent + 1u : parent.child;
-    float other = lightBoundsImportance(loadLightBvhNode(PT_SCENE_ARG sibling), p, n);
-    product *= mine / (mine + other);
+    bool second = parent.child == at;
+    LightBvhNode sibling = loadLightBvhNode(PT_SCENE_ARG second ? node.parent + 1u : parent.child);
+    vec2 c = childWeights(parent, second ? sibling : node, second ? node : sibling, p, n);
+    float mine = second ? c.y : c.x;
+    if (!(mine > 0.0f)) return 0.0f;
+    product *= mine / (c.x + c.y);
     at = node.parent;
     node = parent;
-    if (at != 0u) mine = lightBoundsImportance(node, p, n);
   }
-  // mine: the root's importance where it is the emitter's leaf, else its child's (tested).
-  if (!(mine > 0.0f)) return 0.0f;
-  return (1.0f - unboundedShare(PT_SCENE_ONLY)) * product;
+  return share * product;
 }
 
 // ---- Emission found by a ray -------------------------------------------------------------

@@ -172,11 +172,14 @@ struct LightBvhNode {
   uint child;        //  4 bytes: interior: the second child's node; leaf: its Emitter
   uint flags;        //  4 bytes: kLightBvhLeaf, kLightBvhTwoSided
   uint parent;       //  4 bytes: the node above (the root: itself)
-  uint reserved0;    //  4 bytes: zero
+  float sinThetaO;   //  4 bytes: sine of that spread (kept, not recomputed per visit)
 };                   // 64 bytes
 PT_CONST uint kLightBvhTexels = 4u;
 PT_CONST uint kLightBvhLeaf = 1u;      // a leaf: `child` is an Emitter
 PT_CONST uint kLightBvhTwoSided = 2u;  // some light below emits on both sides of its normal
+// The two children's bounds differ in power alone (the two triangles of an axis-aligned quad):
+// their importance is in the ratio of their power wherever it is not zero for both.
+PT_CONST uint kLightBvhSameBounds = 4u;
 
 // Lights that are not triangles: pbrt-v4's point, spot, distant and (constant) infinite lights.
 // They join the emissive triangles in the alias table: an Emitter whose `triangle` has

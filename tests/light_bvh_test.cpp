@@ -27,7 +27,9 @@ namespace pt {
 namespace {
 
 // Forty emissive triangles of random size, orientation, emission and sidedness in a 10^3 box,
-// two point lights, a spot light and two unbounded lights (distant, infinite).
+// three axis-aligned quads whose halves emit unequally (one of them on both sides: pairs of
+// triangles with the same bounds but their power), two point lights, a spot light and two
+// unbounded lights (distant, infinite).
 struct ManyLights {
   std::vector<Material> materials;
   std::vector<Triangle> triangles;
@@ -48,6 +50,21 @@ struct ManyLights {
       triangles.push_back(Triangle{c, uint(i), c + size * (vec3(u(rng), u(rng), u(rng)) - 0.5f),
                                    kNoEmitter, c + size * (vec3(u(rng), u(rng), u(rng)) - 0.5f),
                                    uint(i)});
+    }
+    // Quads in the planes z = 3, x = 6 and y = 8: corner a, edges e and f (their cross product
+    // the front side); the second half emits three times the first.
+    const vec3 quads[3][3] = {{vec3(2.0f, 2.0f, 3.0f), vec3(1.5f, 0.0f, 0.0f), vec3(0.0f, 1.0f, 0.0f)},
+                              {vec3(6.0f, 1.0f, 1.0f), vec3(0.0f, 2.0f, 0.0f), vec3(0.0f, 0.0f, 0.5f)},
+                              {vec3(4.0f, 8.0f, 5.0f), vec3(0.0f, 0.0f, 1.0f), vec3(1.0f, 0.0f, 0.0f)}};
+    for (int q = 0; q < 3; ++q) {
+      const vec3 a = quads[q][0], b = a + quads[q][1], c = b + quads[q][2], d = a + quads[q][2];
+      for (int half = 0; half < 2; ++half) {
+        const uint m = uint(materials.size());
+        materials.push_back(
+            Material{vec3(0.5f), kMaterialDiffuse, vec3(half == 0 ? 1.0f : 3.0f), q == 2 ? 1u : 0u});
+        triangles.push_back(half == 0 ? Triangle{a, m, b, kNoEmitter, c, m}
+                                      : Triangle{a, m, c, kNoEmitter, d, m});
+      }
     }
     Light p{};
     p.type = kLightPoint;
@@ -108,9 +125,9 @@ std::vector<std::pair<vec3, vec3>> shadingPoints() {
 
 TEST(LightBvh, TreeHoldsEveryBoundedEmitterOnceWithItsPower) {
   const ManyLights l;
-  ASSERT_EQ(l.emitters.size(), 45u);
+  ASSERT_EQ(l.emitters.size(), 51u);
   EXPECT_EQ(l.bvh.unbounded, 2u);
-  ASSERT_EQ(l.bvh.nodes.size(), 2u * 43u - 1u);
+  ASSERT_EQ(l.bvh.nodes.size(), 2u * 49u - 1u);
   ASSERT_EQ(l.bvh.words.size(), l.emitters.size() + 2u);
   std::vector<int> seen(l.emitters.size(), 0);
   for (uint32_t i = 0; i < l.bvh.nodes.size(); ++i) {
@@ -138,6 +155,37 @@ TEST(LightBvh, TreeHoldsEveryBoundedEmitterOnceWithItsPower) {
   }
 }
 
+// The two halves of each quad are siblings marked kLightBvhSameBounds, and no other node is;
+// wherever their importance is not zero, it is in the ratio of their power (what the walk
+// assumes when it weighs such children by power).
+TEST(LightBvh, SameBoundsChildrenWeighAsTheirPower) {
+  const ManyLights l;
+  int marked = 0;
+  for (uint32_t i = 0; i < l.bvh.nodes.size(); ++i) {
+    const LightBvhNode& n = l.bvh.nodes[i];
+    if ((n.flags & kLightBvhLeaf) != 0u) continue;
+    const LightBvhNode& a = l.bvh.nodes[i + 1];
+    const LightBvhNode& b = l.bvh.nodes[n.child];
+    const bool same = a.boundsMin == b.boundsMin && a.boundsMax == b.boundsMax && a.w == b.w &&
+                      a.cosThetaO == b.cosThetaO && a.cosThetaE == b.cosThetaE;
+    EXPECT_EQ((n.flags & kLightBvhSameBounds) != 0u, same) << "node " << i;
+    if (!same) continue;
+    ++marked;
+    EXPECT_NEAR(std::max(a.phi, b.phi) / std::min(a.phi, b.phi), 3.0f, 1e-5f);  // the halves
+    int lit = 0;
+    for (const auto& [p, normal] : shadingPoints()) {
+      const float ia = lightBoundsImportance(a, p, normal);
+      const float ib = lightBoundsImportance(b, p, normal);
+      EXPECT_EQ(ia == 0.0f, ib == 0.0f);
+      if (ia == 0.0f) continue;
+      ++lit;
+      EXPECT_NEAR(ib / ia, b.phi / a.phi, 1e-5f * b.phi / a.phi);
+    }
+    EXPECT_GT(lit, 0);
+  }
+  EXPECT_EQ(marked, 3);
+}
+
 // pbrt-v4's importance, worked by hand: a point light (phi = 4 pi I) at distance 2 along the
 // normal of the point: phi / d^2; at 60 degrees to the normal, times cos 60. A one-sided
 // triangle seen from behind: none; two-sided: the same as from the front.
@@ -147,6 +195,7 @@ TEST(LightBvh, ImportanceMatchesHandComputedValues) {
   point.phi = 4.0f * kPi * 3.0f;
   point.w = vec3(0.0f, 0.0f, 1.0f);
   point.cosThetaO = -1.0f;
+  point.sinThetaO = 0.0f;
   point.cosThetaE = std::cos(kPi / 2.0f);
   EXPECT_FLOAT_EQ(lightBoundsImportance(point, vec3(0.0f), vec3(0.0f, 0.0f, 1.0f)),
                   point.phi / 4.0f);
@@ -163,6 +212,7 @@ TEST(LightBvh, ImportanceMatchesHandComputedValues) {
   tri.phi = 1.0f;
   tri.w = vec3(0.0f, 0.0f, -1.0f);
   tri.cosThetaO = 1.0f;
+  tri.sinThetaO = 0.0f;
   tri.cosThetaE = std::cos(kPi / 2.0f);
   const float below = lightBoundsImportance(tri, vec3(0.0f), vec3(0.0f, 0.0f, 1.0f));
   EXPECT_NEAR(below, 1.0f / 4.0f, 1e-3f);
@@ -173,7 +223,8 @@ TEST(LightBvh, ImportanceMatchesHandComputedValues) {
 }
 
 // The tree's probabilities enumerated from the root (the test's own walk): each node's share
-// of its parent's by the children's importance, the mass of a node whose children both have
+// of its parent's by the children's importance (by their power where their bounds differ in
+// nothing else), the mass of a node whose children both have
 // none lost (light sampling draws no light there, as in pbrt-v4). Each emitter's probability
 // from emitterChoicePmf's walk up is its leaf's share, and the shares, the lost mass and the
 // unbounded emitters' sum to one.
@@ -188,8 +239,12 @@ void enumerate(const ManyLights& l, uint32_t at, double mass, vec3 p, vec3 n,
     }
     return;
   }
-  const double c0 = lightBoundsImportance(l.bvh.nodes[at + 1], p, n);
-  const double c1 = lightBoundsImportance(l.bvh.nodes[node.child], p, n);
+  double c0 = lightBoundsImportance(l.bvh.nodes[at + 1], p, n);
+  double c1 = lightBoundsImportance(l.bvh.nodes[node.child], p, n);
+  if ((node.flags & kLightBvhSameBounds) != 0u) {  // by power: never both zero
+    c0 = l.bvh.nodes[at + 1].phi;
+    c1 = l.bvh.nodes[node.child].phi;
+  }
   if (c0 == 0.0 && c1 == 0.0) {
     lost += mass;
     return;

@@ -38,7 +38,7 @@ static_assert(offsetof(Material, nSamples) == 88 && offsetof(Material, reserved1
 static_assert(sizeof(LightBvhNode) == 16 * kLightBvhTexels);
 static_assert(offsetof(LightBvhNode, phi) == 12 && offsetof(LightBvhNode, boundsMax) == 16);
 static_assert(offsetof(LightBvhNode, w) == 32 && offsetof(LightBvhNode, cosThetaE) == 44);
-static_assert(offsetof(LightBvhNode, child) == 48 && offsetof(LightBvhNode, reserved0) == 60);
+static_assert(offsetof(LightBvhNode, child) == 48 && offsetof(LightBvhNode, sinThetaO) == 60);
 
 static_assert(sizeof(TriangleNormals) == 48);
 static_assert(offsetof(TriangleNormals, n1) == 16 && offsetof(TriangleNormals, n2) == 32);

@@ -160,6 +160,7 @@ struct Builder {
     n.phi = float(b.phi);
     n.w = vec3(b.w);
     n.cosThetaO = float(b.cosThetaO);
+    n.sinThetaO = float(std::sqrt(std::max(0.0, 1.0 - b.cosThetaO * b.cosThetaO)));
     n.cosThetaE = float(b.cosThetaE);
     n.flags = b.twoSided ? kLightBvhTwoSided : 0u;
     return n;
@@ -232,8 +233,14 @@ struct Builder {
     LightBvhNode node = toNode(all);
     node.child = second;
     node.parent = parent;
+    const LightBvhNode& a = nodes[first];
+    const LightBvhNode& b = nodes[second];
+    if (a.boundsMin == b.boundsMin && a.boundsMax == b.boundsMax && a.w == b.w &&
+        a.cosThetaO == b.cosThetaO && a.cosThetaE == b.cosThetaE &&
+        (a.flags & kLightBvhTwoSided) == (b.flags & kLightBvhTwoSided)) {
+      node.flags |= kLightBvhSameBounds;
+    }
     nodes[at] = node;
-    (void)first;  // at + 1
     return {at, all};
   }
 };
@@ -262,6 +269,12 @@ LightBvh buildLightBvh(const std::vector<Emitter>& emitters, const std::vector<T
   bvh.words.insert(bvh.words.end(), unbounded.begin(), unbounded.end());
   bvh.unbounded = uint32_t(unbounded.size());
   return bvh;
+}
+
+bool choosesByPowerAlone(const LightBvh& tree) {
+  return std::all_of(tree.nodes.begin(), tree.nodes.end(), [](const LightBvhNode& n) {
+    return (n.flags & (kLightBvhLeaf | kLightBvhSameBounds)) != 0u;
+  });
 }
 
 }  // namespace pt

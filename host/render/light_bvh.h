@@ -24,4 +24,10 @@ struct LightBvh {
 LightBvh buildLightBvh(const std::vector<Emitter>& emitters, const std::vector<Triangle>& triangles,
                        const std::vector<Material>& materials, const std::vector<Light>& lights);
 
+// Whether the tree chooses by power alone: one light, or lights that all share one bounds (the
+// two triangles of an axis-aligned quad light), where the importance of every child is in the
+// ratio of its power. The power sampler's alias table then makes the same choice (weighing
+// colours by luminance where the tree weighs their largest channel) at less cost.
+bool choosesByPowerAlone(const LightBvh& tree);
+
 }  // namespace pt

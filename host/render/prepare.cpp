@@ -291,13 +291,16 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   const uint lightSampler = settings.lightSampler.value_or(integ.lightSampler);
   data.emitters = buildEmitters(data.bvh.triangles, data.materials, lights, radius,
                                 lightSampler == kLightSamplerUniform);
+  LightBvh tree;
   if (lightSampler == kLightSamplerBvh) {
-    LightBvh tree = buildLightBvh(data.emitters, data.bvh.triangles, data.materials, lights);
+    tree = buildLightBvh(data.emitters, data.bvh.triangles, data.materials, lights);
+  }
+  if (!choosesByPowerAlone(tree)) {
     data.lightBvh = std::move(tree.nodes);
     data.lightBvhWords = std::move(tree.words);
     data.params.lightBvhNodes = uint32_t(data.lightBvh.size());
     data.params.unboundedEmitters = tree.unbounded;
-    data.effects.lightBvh = !data.lightBvh.empty();
+    data.effects.lightBvh = true;
   }
   data.lights = std::move(lights);
 
