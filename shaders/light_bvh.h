@@ -35,12 +35,11 @@ PT_INLINE float sinSubClamped(float sinA, float cosA, float sinB, float cosB) {
 // cone of normals and the direction to p, less the angle the bounds subtend from p) and at
 // p's surface; zero where every light faces away beyond its emission angle theta_e.
 PT_INLINE float lightBoundsImportance(PT_IN(LightBvhNode) node, vec3 p, vec3 n) {
-  vec3 fromCentre = p - 0.5f * (node.boundsMin + node.boundsMax);
+  vec3 fromCentre = p - node.centre;
   float d2 = dot(fromCentre, fromCentre);
   float invD = 1.0f / sqrt(d2);
   vec3 wi = d2 > 0.0f ? fromCentre * invD : node.w;
-  vec3 diagonal = node.boundsMax - node.boundsMin;
-  float halfDiagonal = 0.5f * sqrt(dot(diagonal, diagonal));
+  float halfDiagonal = node.radius;
   // pbrt-v4's BoundSubtendedDirections: the cone of directions from p to the bounds' sphere
   // (all directions from inside it), its sine the sphere's radius over the distance.
   float sinThetaB = 0.0f;

@@ -230,8 +230,8 @@ LightBvhNode loadLightBvhNode(uint i) {
   uvec4 c = texelFetch(lightBvhTexels, at + 2);
   uvec4 d = texelFetch(lightBvhTexels, at + 3);
   return LightBvhNode(uintBitsToFloat(a.xyz), uintBitsToFloat(a.w), uintBitsToFloat(b.xyz),
-                      uintBitsToFloat(b.w), uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), d.x,
-                      d.y, d.z, uintBitsToFloat(d.w));
+                      uintBitsToFloat(b.w), uintBitsToFloat(c.x), uintBitsToFloat(c.y),
+                      uintBitsToFloat(c.z), c.w, d.x, d.y, d.z, d.w);
 }
 uint lightBvhWord(uint i) {
   return texelFetch(lightBvhTexels, int(kLightBvhTexels * params.lightBvhNodes + (i >> 2u)))[i & 3u];

@@ -141,8 +141,8 @@ TEST(LightBvh, TreeHoldsEveryBoundedEmitterOnceWithItsPower) {
     for (uint32_t c : {i + 1, n.child}) {
       const LightBvhNode& k = l.bvh.nodes[c];
       EXPECT_EQ(k.parent, i);
-      EXPECT_TRUE(glm::all(glm::lessThanEqual(n.boundsMin, k.boundsMin)));
-      EXPECT_TRUE(glm::all(glm::greaterThanEqual(n.boundsMax, k.boundsMax)));
+      EXPECT_TRUE(glm::all(glm::lessThanEqual(l.bvh.boxes[i].lo, l.bvh.boxes[c].lo)));
+      EXPECT_TRUE(glm::all(glm::greaterThanEqual(l.bvh.boxes[i].hi, l.bvh.boxes[c].hi)));
       EXPECT_LE(n.cosThetaO, k.cosThetaO + 1e-6f);
     }
     EXPECT_NEAR(n.phi, l.bvh.nodes[i + 1].phi + l.bvh.nodes[n.child].phi, 1e-5f * n.phi);
@@ -166,7 +166,7 @@ TEST(LightBvh, SameBoundsChildrenWeighAsTheirPower) {
     if ((n.flags & kLightBvhLeaf) != 0u) continue;
     const LightBvhNode& a = l.bvh.nodes[i + 1];
     const LightBvhNode& b = l.bvh.nodes[n.child];
-    const bool same = a.boundsMin == b.boundsMin && a.boundsMax == b.boundsMax && a.w == b.w &&
+    const bool same = a.centre == b.centre && a.radius == b.radius && a.w == b.w &&
                       a.cosThetaO == b.cosThetaO && a.cosThetaE == b.cosThetaE;
     EXPECT_EQ((n.flags & kLightBvhSameBounds) != 0u, same) << "node " << i;
     if (!same) continue;
@@ -191,7 +191,7 @@ TEST(LightBvh, SameBoundsChildrenWeighAsTheirPower) {
 // triangle seen from behind: none; two-sided: the same as from the front.
 TEST(LightBvh, ImportanceMatchesHandComputedValues) {
   LightBvhNode point{};
-  point.boundsMin = point.boundsMax = vec3(0.0f, 0.0f, 2.0f);
+  point.centre = vec3(0.0f, 0.0f, 2.0f);
   point.phi = 4.0f * kPi * 3.0f;
   point.w = vec3(0.0f, 0.0f, 1.0f);
   point.cosThetaO = -1.0f;
@@ -207,8 +207,8 @@ TEST(LightBvh, ImportanceMatchesHandComputedValues) {
 
   // A small triangle's bounds at height 2 facing down (w = -z): lit from below, dark above.
   LightBvhNode tri{};
-  tri.boundsMin = vec3(-0.01f, -0.01f, 2.0f);
-  tri.boundsMax = vec3(0.01f, 0.01f, 2.0f);
+  tri.centre = vec3(0.0f, 0.0f, 2.0f);
+  tri.radius = 0.01f * std::sqrt(2.0f);
   tri.phi = 1.0f;
   tri.w = vec3(0.0f, 0.0f, -1.0f);
   tri.cosThetaO = 1.0f;

@@ -36,9 +36,9 @@ static_assert(offsetof(Material, g) == 80 && offsetof(Material, maxDepth) == 84)
 static_assert(offsetof(Material, nSamples) == 88 && offsetof(Material, reserved1) == 92);
 
 static_assert(sizeof(LightBvhNode) == 16 * kLightBvhTexels);
-static_assert(offsetof(LightBvhNode, phi) == 12 && offsetof(LightBvhNode, boundsMax) == 16);
-static_assert(offsetof(LightBvhNode, w) == 32 && offsetof(LightBvhNode, cosThetaE) == 44);
-static_assert(offsetof(LightBvhNode, child) == 48 && offsetof(LightBvhNode, sinThetaO) == 60);
+static_assert(offsetof(LightBvhNode, phi) == 12 && offsetof(LightBvhNode, w) == 16);
+static_assert(offsetof(LightBvhNode, radius) == 32 && offsetof(LightBvhNode, flags) == 44);
+static_assert(offsetof(LightBvhNode, child) == 48 && offsetof(LightBvhNode, reserved1) == 60);
 
 static_assert(sizeof(TriangleNormals) == 48);
 static_assert(offsetof(TriangleNormals, n1) == 16 && offsetof(TriangleNormals, n2) == 32);

@@ -151,12 +151,14 @@ double splitCost(const Bounds& b, dvec3 extent, int dim) {
 struct Builder {
   std::vector<std::pair<uint32_t, Bounds>> items;  // emitter, bounds
   std::vector<LightBvhNode> nodes;
+  std::vector<LightBox> boxes;
   std::vector<uint32_t> leafOf;
 
   LightBvhNode toNode(const Bounds& b) const {
     LightBvhNode n{};
-    n.boundsMin = vec3(b.lo);
-    n.boundsMax = vec3(b.hi);
+    const vec3 lo(b.lo), hi(b.hi);
+    n.centre = 0.5f * (lo + hi);
+    n.radius = 0.5f * glm::length(hi - lo);
     n.phi = float(b.phi);
     n.w = vec3(b.w);
     n.cosThetaO = float(b.cosThetaO);
@@ -177,6 +179,7 @@ struct Builder {
       leaf.flags |= kLightBvhLeaf;
       leaf.parent = parent;
       nodes.push_back(leaf);
+      boxes.push_back(LightBox{vec3(items[start].second.lo), vec3(items[start].second.hi)});
       leafOf[items[start].first] = at;
       return {at, items[start].second};
     }
@@ -227,6 +230,7 @@ struct Builder {
       if (mid == start || mid == end) mid = (start + end) / 2;
     }
     nodes.push_back(LightBvhNode{});
+    boxes.emplace_back();
     const auto [first, firstBounds] = build(start, mid, at, depth + 1);
     const auto [second, secondBounds] = build(mid, end, at, depth + 1);
     const Bounds all = unite(firstBounds, secondBounds);
@@ -235,12 +239,13 @@ struct Builder {
     node.parent = parent;
     const LightBvhNode& a = nodes[first];
     const LightBvhNode& b = nodes[second];
-    if (a.boundsMin == b.boundsMin && a.boundsMax == b.boundsMax && a.w == b.w &&
+    if (a.centre == b.centre && a.radius == b.radius && a.w == b.w &&
         a.cosThetaO == b.cosThetaO && a.cosThetaE == b.cosThetaE &&
         (a.flags & kLightBvhTwoSided) == (b.flags & kLightBvhTwoSided)) {
       node.flags |= kLightBvhSameBounds;
     }
     nodes[at] = node;
+    boxes[at] = LightBox{vec3(all.lo), vec3(all.hi)};
     return {at, all};
   }
 };
@@ -265,6 +270,7 @@ LightBvh buildLightBvh(const std::vector<Emitter>& emitters, const std::vector<T
   b.nodes.reserve(2 * b.items.size() - 1);
   b.build(0, b.items.size(), 0u, 0);
   bvh.nodes = std::move(b.nodes);
+  bvh.boxes = std::move(b.boxes);
   bvh.words = std::move(b.leafOf);
   bvh.words.insert(bvh.words.end(), unbounded.begin(), unbounded.end());
   bvh.unbounded = uint32_t(unbounded.size());
