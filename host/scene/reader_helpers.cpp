@@ -118,6 +118,9 @@ Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3
       scene.normals.push_back(flatNormals(scene.triangles[k]));
     }
   }
+  // The per-triangle arrays grow with the triangles' room (reserveGeometric).
+  if (!scene.normals.empty() || normals != nullptr) reserveGeometric(scene.normals, scene.triangles.capacity());
+  if (!scene.uvs.empty() || uvs != nullptr) reserveGeometric(scene.uvs, scene.triangles.capacity());
   if (normals != nullptr) {
     const vec3 ng = flatNormals(t).n0;
     const std::array<glm::dvec3, 3>& n = *normals;

@@ -6,12 +6,14 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <utility>
 #include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "common/huge_pages.h"
 #include "common/shared.h"
 #include "scene/scene.h"
 
@@ -64,10 +66,16 @@ Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3
 
 // Makes room for `size` elements, at least doubling the capacity when it grows, so that
 // appending shape after shape costs amortized linear time (std::vector::reserve would allocate
-// exactly `size`, and the next shape would copy everything again).
+// exactly `size`, and the next shape would copy everything again). The new room is given huge
+// pages (common/huge_pages.h) before the elements are copied into it.
 template <typename T>
 void reserveGeometric(std::vector<T>& v, std::size_t size) {
-  if (size > v.capacity()) v.reserve(std::max(size, 2 * v.capacity()));
+  if (size <= v.capacity()) return;
+  std::vector<T> grown;
+  grown.reserve(std::max(size, 2 * v.capacity()));
+  adviseHugePages(grown.data(), grown.capacity() * sizeof(T));
+  grown.insert(grown.end(), std::make_move_iterator(v.begin()), std::make_move_iterator(v.end()));
+  v.swap(grown);
 }
 
 }  // namespace pt

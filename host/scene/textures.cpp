@@ -6,6 +6,7 @@
 
 #include "common/check.h"
 #include "image/texture_image.h"
+#include "scene/reader_helpers.h"
 #include "texture.h"
 
 namespace pt {
@@ -145,7 +146,7 @@ TextureBuilder::StoredImage TextureBuilder::storeDecoded(const TextureImage& ima
     stored.format = kTexel8;
     stored.decode = decodeTable(gamma);
     stored.texels = uint(scene_.imageWords.size());
-    scene_.imageWords.reserve(scene_.imageWords.size() + texels);
+    reserveGeometric(scene_.imageWords, scene_.imageWords.size() + texels);
     for (std::size_t i = 0; i < texels; ++i) {
       const uint8_t* t = &image.bytes[c * i];
       const uint r = t[0];
@@ -157,7 +158,7 @@ TextureBuilder::StoredImage TextureBuilder::storeDecoded(const TextureImage& ima
   } else {
     stored.format = c == 1 ? kTexelFloat1 : c == 3 ? kTexelFloat3 : kTexelFloat4;
     stored.texels = uint(scene_.imageWords.size());
-    scene_.imageWords.reserve(scene_.imageWords.size() + texels * c);
+    reserveGeometric(scene_.imageWords, scene_.imageWords.size() + texels * c);
     for (std::size_t i = 0; i < texels * c; ++i) {
       float v = image.floats[i];
       // 16-bit PNGs hold encoded values, decoded here as pbrt-v4 decodes them (to half floats;
