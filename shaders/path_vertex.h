@@ -359,8 +359,7 @@ PT_INLINE EmitterChoice chooseEmitter(PT_SCENE_PARAM vec3 p, vec3 n, vec2 u) {
     return EmitterChoice(loadEmitter(PT_SCENE_ARG node.child), pmf);
   }
   uint slot = aliasTableSlot(u.x, PT_PARAMS.emitterCount);
-  Emitter e =
-      loadEmitter(PT_SCENE_ARG aliasTablePick(slot, loadEmitter(PT_SCENE_ARG slot), u.y));
+  Emitter e = loadEmitter(PT_SCENE_ARG aliasTablePick(slot, loadEmitter(PT_SCENE_ARG slot), u.y));
   return EmitterChoice(e, e.pmf);
 }
 
@@ -403,8 +402,8 @@ PT_INLINE float emitterPdfFound(PT_SCENE_PARAM PT_IN(Triangle) tri, PT_IN(Surfac
 #ifndef PT_NO_BSDF_MATERIALS
   // A sphere light's triangle: light sampling draws its cone (seen from the ray's origin).
   if (PT_HAS_SPHERE_LIGHTS && (emitter.triangle & kEmitterLight) != 0u) {
-    lightPdf = pmf *
-               sphereLightPdf(loadLight(PT_SCENE_ARG emitter.triangle & ~kEmitterLight), from);
+    lightPdf =
+        pmf * sphereLightPdf(loadLight(PT_SCENE_ARG emitter.triangle & ~kEmitterLight), from);
   }
 #endif
   return lightPdf;
@@ -430,8 +429,8 @@ PT_INLINE void addEmissionFound(PT_SCENE_PARAM PT_INOUT(PathState) path, PT_IN(T
   } else if (bsdfEmissionOn(PT_SCENE_ONLY)) {
     float weight = 1.0f;
     if (misOn(PT_SCENE_ONLY)) {
-      weight =
-          powerHeuristic(path.bsdfPdf, emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, t, rayOrigin, path));
+      weight = powerHeuristic(path.bsdfPdf,
+                              emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, t, rayOrigin, path));
     }
     path.L += path.beta * weight * Le;
   }
@@ -524,11 +523,12 @@ PT_INLINE vec3 bsdfFCos(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key, vec
 }
 #endif
 
-// Samples the light from vertex s (pbrt-v4's SampleLd): an emitter chosen with uChoose, and with uLight a uniform point on its triangle or a sample of the analytic light
-// (lights.h, environment.h) it names; the BSDF's value towards it (at a point of a medium, the
-// phase function's), and the shadow ray's ends. The shadow ray leaves along n from a
-// Lambertian surface without shading normals, else from the side of the geometric surface the
-// light is on (a medium's point has no offset).
+// Samples the light from vertex s (pbrt-v4's SampleLd): an emitter chosen with uChoose, and with
+// uLight a uniform point on its triangle or a sample of the analytic light (lights.h,
+// environment.h) it names; the BSDF's value towards it (at a point of a medium, the phase
+// function's), and the shadow ray's ends. The shadow ray leaves along n from a Lambertian surface
+// without shading normals, else from the side of the geometric surface the light is on (a medium's
+// point has no offset).
 PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
                                     vec2 uChoose, vec2 uLight) {
   LightSample ls = noLightSample();

@@ -163,19 +163,19 @@ struct Emitter {
 // Interior nodes have their first child next in the array and the second at `child`; a leaf
 // holds one Emitter. Built depth first from the root at 0.
 struct LightBvhNode {
-  vec3 centre;       // 12 bytes: the centre of the lights' box (a point light's: its position)
-  float phi;         //  4 bytes: their power (pbrt-v4's LightBounds::phi)
-  vec3 w;            // 12 bytes: unit axis of their normals' cone
-  float cosThetaO;   //  4 bytes: cosine of the spread of their normals about w
-  float radius;      //  4 bytes: half the box's diagonal (importance sees the box as its sphere)
-  float sinThetaO;   //  4 bytes: sine of the normals' spread
-  float cosThetaE;   //  4 bytes: cosine of the angle beyond the normals they emit to
-  uint flags;        //  4 bytes: kLightBvhLeaf, kLightBvhTwoSided, kLightBvhSameBounds
-  uint child;        //  4 bytes: interior: the second child's node; leaf: its Emitter
-  uint parent;       //  4 bytes: the node above (the root: itself)
-  uint reserved0;    //  4 bytes: zero
-  uint reserved1;    //  4 bytes: zero
-};                   // 64 bytes
+  vec3 centre;      // 12 bytes: the centre of the lights' box (a point light's: its position)
+  float phi;        //  4 bytes: their power (pbrt-v4's LightBounds::phi)
+  vec3 w;           // 12 bytes: unit axis of their normals' cone
+  float cosThetaO;  //  4 bytes: cosine of the spread of their normals about w
+  float radius;     //  4 bytes: half the box's diagonal (importance sees the box as its sphere)
+  float sinThetaO;  //  4 bytes: sine of the normals' spread
+  float cosThetaE;  //  4 bytes: cosine of the angle beyond the normals they emit to
+  uint flags;       //  4 bytes: kLightBvhLeaf, kLightBvhTwoSided, kLightBvhSameBounds
+  uint child;       //  4 bytes: interior: the second child's node; leaf: its Emitter
+  uint parent;      //  4 bytes: the node above (the root: itself)
+  uint reserved0;   //  4 bytes: zero
+  uint reserved1;   //  4 bytes: zero
+};                  // 64 bytes
 PT_CONST uint kLightBvhTexels = 4u;
 PT_CONST uint kLightBvhLeaf = 1u;      // a leaf: `child` is an Emitter
 PT_CONST uint kLightBvhTwoSided = 2u;  // some light below emits on both sides of its normal

@@ -373,8 +373,8 @@ PT_INLINE void addVolumeEmissionFound(PT_SCENE_PARAM PT_INOUT(VolumePath) v, PT_
   if (!v.path.specularBounce) {
     if (!bsdfEmissionOn(PT_SCENE_ONLY)) return;
     if (misOn(PT_SCENE_ONLY)) {
-      float lightPdf =
-          emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, distance(v.path.prevP, s.p), v.path.prevP, v.path);
+      float lightPdf = emitterPdfFound(PT_SCENE_ARG tri, s, cosEmit, distance(v.path.prevP, s.p),
+                                       v.path.prevP, v.path);
       denominator = average(v.rU + v.rL * lightPdf);
     }
   }

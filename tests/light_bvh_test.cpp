@@ -53,15 +53,16 @@ struct ManyLights {
     }
     // Quads in the planes z = 3, x = 6 and y = 8: corner a, edges e and f (their cross product
     // the front side); the second half emits three times the first.
-    const vec3 quads[3][3] = {{vec3(2.0f, 2.0f, 3.0f), vec3(1.5f, 0.0f, 0.0f), vec3(0.0f, 1.0f, 0.0f)},
-                              {vec3(6.0f, 1.0f, 1.0f), vec3(0.0f, 2.0f, 0.0f), vec3(0.0f, 0.0f, 0.5f)},
-                              {vec3(4.0f, 8.0f, 5.0f), vec3(0.0f, 0.0f, 1.0f), vec3(1.0f, 0.0f, 0.0f)}};
+    const vec3 quads[3][3] = {
+        {vec3(2.0f, 2.0f, 3.0f), vec3(1.5f, 0.0f, 0.0f), vec3(0.0f, 1.0f, 0.0f)},
+        {vec3(6.0f, 1.0f, 1.0f), vec3(0.0f, 2.0f, 0.0f), vec3(0.0f, 0.0f, 0.5f)},
+        {vec3(4.0f, 8.0f, 5.0f), vec3(0.0f, 0.0f, 1.0f), vec3(1.0f, 0.0f, 0.0f)}};
     for (int q = 0; q < 3; ++q) {
       const vec3 a = quads[q][0], b = a + quads[q][1], c = b + quads[q][2], d = a + quads[q][2];
       for (int half = 0; half < 2; ++half) {
         const uint m = uint(materials.size());
-        materials.push_back(
-            Material{vec3(0.5f), kMaterialDiffuse, vec3(half == 0 ? 1.0f : 3.0f), q == 2 ? 1u : 0u});
+        materials.push_back(Material{vec3(0.5f), kMaterialDiffuse, vec3(half == 0 ? 1.0f : 3.0f),
+                                     q == 2 ? 1u : 0u});
         triangles.push_back(half == 0 ? Triangle{a, m, b, kNoEmitter, c, m}
                                       : Triangle{a, m, c, kNoEmitter, d, m});
       }
@@ -363,7 +364,8 @@ std::string manyLightsScene(const std::string& lightSampler) {
       "Shape \"trianglemesh\" \"point3 P\" [-10 10 0  10 10 0  10 10 8  -10 10 8]\n"
       "  \"integer indices\" [0 1 2 0 2 3]\n"
       "LightSource \"point\" \"point3 from\" [4 2 3] \"rgb I\" [6 6 6]\n"
-      "LightSource \"spot\" \"point3 from\" [-4 -2 6] \"point3 to\" [-4 0 0] \"rgb I\" [30 30 30]\n";
+      "LightSource \"spot\" \"point3 from\" [-4 -2 6] \"point3 to\" [-4 0 0] \"rgb I\" [30 30 "
+      "30]\n";
   for (int i = 0; i < 6; ++i) {
     for (int j = 0; j < 6; ++j) {
       const float x = -7.5f + 3.0f * float(i), y = -7.5f + 3.0f * float(j);

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "common/huge_pages.h"
-#include "scene/reader_helpers.h"
 #include "sanitizer_build.h"
+#include "scene/reader_helpers.h"
 
 namespace pt {
 namespace {
@@ -37,9 +37,9 @@ TEST(ReserveGeometric, KeepsElementsAndGrowsGeometrically) {
   EXPECT_EQ(v.capacity(), room);
 }
 
-// The kB of transparent huge pages backing the mapping that holds `address`
-// (/proc/self/smaps' AnonHugePages), or -1 where it cannot be read.
-long anonHugeKib(const void* address) {
+// A field of /proc/self/smaps for the mapping that holds `address` (e.g. THPeligible: 1 where
+// the kernel may back it with transparent huge pages), or -1 where it cannot be read.
+long smapsField(const void* address, const std::string& field) {
   std::ifstream smaps("/proc/self/smaps");
   const auto at = reinterpret_cast<std::uintptr_t>(address);
   std::string line;
@@ -52,8 +52,8 @@ long anonHugeKib(const void* address) {
       inside = lo <= at && at < hi;
       continue;
     }
-    if (inside && line.rfind("AnonHugePages:", 0) == 0) {
-      std::istringstream kib(line.substr(14));
+    if (inside && line.rfind(field + ":", 0) == 0) {
+      std::istringstream kib(line.substr(field.size() + 1));
       long value = -1;
       kib >> value;
       return value;
@@ -62,22 +62,23 @@ long anonHugeKib(const void* address) {
   return -1;
 }
 
-// Where the kernel gives transparent huge pages on request ("madvise" or "always"), the room
-// reserveGeometric makes is backed by them once touched: 64 MiB of texels hold at least some.
-TEST(ReserveGeometric, RoomIsBackedByHugePages) {
+// Where the kernel gives transparent huge pages on request only ("madvise", its default), the
+// room reserveGeometric makes is eligible for them: the advice was given. (Whether a huge page
+// is free to back it when touched is the kernel's affair, so that is not asserted.)
+TEST(ReserveGeometric, RoomIsAdvisedHugePages) {
   std::ifstream enabled("/sys/kernel/mm/transparent_hugepage/enabled");
   std::string mode;
   std::getline(enabled, mode);
-  if (mode.find("[never]") != std::string::npos || mode.empty()) {
-    GTEST_SKIP() << "transparent huge pages are off on this machine";
+  if (mode.find("[madvise]") == std::string::npos) {
+    GTEST_SKIP() << "transparent huge pages are not given on request here: " << mode;
   }
   if (test::kSanitizerBuild) GTEST_SKIP() << "the sanitizers' allocator maps memory its own way";
   std::vector<uint32_t> v;
   reserveGeometric(v, std::size_t(16) << 20);  // 64 MiB
   v.resize(v.capacity(), 1u);
-  const long kib = anonHugeKib(v.data() + v.size() / 2);
-  ASSERT_GE(kib, 0) << "no mapping in /proc/self/smaps holds the array";
-  EXPECT_GT(kib, 0) << "no huge page backs the array";
+  const long eligible = smapsField(v.data() + v.size() / 2, "THPeligible");
+  ASSERT_GE(eligible, 0) << "no mapping in /proc/self/smaps holds the array";
+  EXPECT_EQ(eligible, 1) << "the array's mapping was not advised huge pages";
 }
 
 }  // namespace

@@ -105,8 +105,8 @@ KeyValues imageSettings(const SceneData& data, const RenderSettings& settings,
                                            data.mediumInterfaces.size() * sizeof(MediumInterface),
                                            hashBytes(cameraMedium.data(), sizeof(uint32_t)))))));
   }
-  // The light BVH only where it chooses the emitters (the power and uniform samplers' tables
-  // are in "bvh"'s hash of the emitters, and older states stay as they were).
+  // The light BVH only where the render uses it: the power and uniform samplers differ in the
+  // emitter table, which the states already compare, and states written before it stay valid.
   if (!data.lightBvh.empty()) {
     s.emplace_back("light_sampler", std::string(nameOf(kLightSamplerNames, kLightSamplerBvh)));
   }

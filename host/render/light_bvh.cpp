@@ -112,8 +112,8 @@ Bounds emitterBounds(const Emitter& e, const std::vector<Triangle>& triangles,
       double cosThetaE = std::cos(std::acos(cosEnd) - std::acos(cosStart));
       // pbrt-v4's slop for the rounding of the importance's cosine.
       if (cosThetaE == 1.0 && cosEnd != cosStart) cosThetaE = 0.999;
-      return pointBounds(light.position, dvec3(light.direction),
-                         4.0 * kPiD * maxOf(light.radiance), cosStart, cosThetaE);
+      return pointBounds(light.position, dvec3(light.direction), 4.0 * kPiD * maxOf(light.radiance),
+                         cosStart, cosThetaE);
     }
     case kLightSphere: {
       // pbrt-v4's DiffuseAreaLight on a sphere: normals in every direction.
@@ -239,8 +239,8 @@ struct Builder {
     node.parent = parent;
     const LightBvhNode& a = nodes[first];
     const LightBvhNode& b = nodes[second];
-    if (a.centre == b.centre && a.radius == b.radius && a.w == b.w &&
-        a.cosThetaO == b.cosThetaO && a.cosThetaE == b.cosThetaE &&
+    if (a.centre == b.centre && a.radius == b.radius && a.w == b.w && a.cosThetaO == b.cosThetaO &&
+        a.cosThetaE == b.cosThetaE &&
         (a.flags & kLightBvhTwoSided) == (b.flags & kLightBvhTwoSided)) {
       node.flags |= kLightBvhSameBounds;
     }

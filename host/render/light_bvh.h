@@ -18,7 +18,7 @@ struct LightBox {
 
 struct LightBvh {
   std::vector<LightBvhNode> nodes;  // depth first from the root; empty without bounded lights
-  std::vector<LightBox> boxes;       // each node's box (the walk reads its centre and radius)
+  std::vector<LightBox> boxes;      // each node's box (the walk reads its centre and radius)
   // Each emitter's leaf (kNoEmitter for the unbounded ones), then the unbounded emitters.
   std::vector<uint32_t> words;
   uint32_t unbounded = 0;  // the number of unbounded emitters

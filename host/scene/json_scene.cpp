@@ -228,9 +228,8 @@ CameraDesc readCamera(const JsonNode& node) {
 }
 
 IntegratorSettings readIntegrator(const JsonNode& node) {
-  node.checkKeys(
-      {"spp", "maxDepth", "seed", "russianRoulette", "rrStartDepth", "strategy", "sampler",
-       "lightSampler"});
+  node.checkKeys({"spp", "maxDepth", "seed", "russianRoulette", "rrStartDepth", "strategy",
+                  "sampler", "lightSampler"});
   IntegratorSettings s;
   if (auto n = node.find("spp")) s.spp = static_cast<int>(n->integer(1, kIntMax));
   if (auto n = node.find("maxDepth")) s.maxDepth = static_cast<int>(n->integer(0, kIntMax));

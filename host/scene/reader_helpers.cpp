@@ -119,7 +119,8 @@ Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3
     }
   }
   // The per-triangle arrays grow with the triangles' room (reserveGeometric).
-  if (!scene.normals.empty() || normals != nullptr) reserveGeometric(scene.normals, scene.triangles.capacity());
+  if (!scene.normals.empty() || normals != nullptr)
+    reserveGeometric(scene.normals, scene.triangles.capacity());
   if (!scene.uvs.empty() || uvs != nullptr) reserveGeometric(scene.uvs, scene.triangles.capacity());
   if (normals != nullptr) {
     const vec3 ng = flatNormals(t).n0;

@@ -258,9 +258,9 @@ void Builder::options(Statement& s) {
       // unknown name is in pbrt-v4).
       const auto sampler = valueNamed(kLightSamplerNames, *v);
       if (!sampler) {
-        fail(p.find("lightsampler")->location,
-             "unknown light sampler " + singleQuoted(*v) + " (expected " +
-                 quotedNames(kLightSamplerNames) + ")");
+        fail(p.find("lightsampler")->location, "unknown light sampler " + singleQuoted(*v) +
+                                                   " (expected " + quotedNames(kLightSamplerNames) +
+                                                   ")");
       }
       scene_.integrator.lightSampler = *sampler;
     }
