@@ -292,11 +292,14 @@ PT_INLINE vec2 sampleConcentricDisk(vec2 u) {
   return r * cosSinTwoPi(turns);
 }
 
-// A camera ray: where it starts, its unit direction, and the weight of its radiance.
+// A camera ray: where it starts, its unit direction, and the weight of its radiance; the film
+// point and the lens point (offset from the camera's position) it was made of.
 struct CameraSample {
   vec3 origin;
   vec3 direction;
   float weight;
+  vec2 filmPoint;
+  vec3 lensOffset;
 };
 
 // The ray of one sample of film pixel `filmPixel` (the film's, not the crop's: see Camera):
@@ -314,10 +317,13 @@ PT_INLINE CameraSample generateCameraRay(PT_IN(Camera) cam, uvec2 filmPixel, vec
   s.origin = cam.position;
   s.direction = normalize(w);
   s.weight = film.weight;
+  s.filmPoint = vec2(filmPixel) + film.point;
+  s.lensOffset = vec3(0.0f);
 #ifndef PT_FILTER_BOX_PINHOLE
   if (cam.lensRadius > 0.0f) {
     vec2 lens = cam.lensRadius * sampleConcentricDisk(uLens);
     vec3 offset = lens.x * cam.right + lens.y * cam.up;
+    s.lensOffset = offset;
     s.origin = cam.position + offset;
     s.direction = normalize(cam.focalDistance * w - offset);
   }

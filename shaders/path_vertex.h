@@ -25,6 +25,8 @@
 #define PT_PATH_VERTEX_H
 
 #include "bsdf.h"
+#include "differentials.h"
+#include "filter.h"
 #include "light_bvh.h"
 #include "sampling.h"
 #include "shared_types.h"
@@ -50,6 +52,7 @@
 #define PT_HAS_ENVIRONMENT_IMAGE true
 #define PT_HAS_TEXTURES true
 #define PT_HAS_BUMP_MAPS true
+#define PT_HAS_FOOTPRINTS true
 #define PT_HAS_BSDF_MATERIALS true
 #define PT_HAS_MEDIA true
 #endif
@@ -162,6 +165,10 @@ PT_INLINE bool bsdfEmissionOn(PT_SCENE_PARAM_ONLY) {
 PT_INLINE bool rouletteOn(PT_SCENE_PARAM_ONLY) {
   return PT_HAS_RUSSIAN_ROULETTE && PT_PARAMS.russianRoulette != 0u;
 }
+// Whether textures read the ray's footprint (differentials.h): paths then carry differentials.
+PT_INLINE bool footprintsOn(PT_SCENE_PARAM_ONLY) {
+  return PT_HAS_FOOTPRINTS && PT_PARAMS.footprints != 0u;
+}
 
 // ---- The path and its vertex ------------------------------------------------------------------
 
@@ -175,12 +182,25 @@ struct PathState {
   vec3 prevP;           // the last scattering vertex (the camera's position at first) and the
   vec3 prevN;           // normal the light BVH weighs there (zero in a medium): the light
                         // choice's probability for emission the ray finds is measured there
+  RayDifferential rd;   // the ray's differentials, where textures read footprints
 };
 
 // A path at the camera: nothing gathered, throughput 1; the camera ray counts as specular, so
 // that emission it finds is taken at full weight.
 PT_INLINE PathState startPathState() {
-  return PathState(vec3(0.0f), vec3(1.0f), 1.0f, 0.0f, true, vec3(0.0f), vec3(0.0f));
+  return PathState(vec3(0.0f), vec3(1.0f), 1.0f, 0.0f, true, vec3(0.0f), vec3(0.0f),
+                   noRayDifferential());
+}
+
+// The path of camera sample c (filter.h): as startPathState, with the camera ray's
+// differentials where textures read footprints.
+PT_INLINE PathState cameraPathState(PT_SCENE_PARAM PT_IN(CameraSample) c) {
+  PathState path = startPathState();
+  if (footprintsOn(PT_SCENE_ONLY)) {
+    path.rd = cameraRayDifferential(PT_PARAMS.camera, c.filmPoint, c.lensOffset, c.origin,
+                                    c.direction, PT_PARAMS.differentialScale);
+  }
+  return path;
 }
 
 // The coordinates of a scattering event's random numbers (sampling.h): the BSDFs' random
@@ -214,30 +234,54 @@ struct SurfacePoint {
   uint scatter;         // kScatter*
   ShadingFrame frame;   // bsdf.h's frame about ns (kScatterBsdf only)
   vec3 woLocal;         // wo in that frame
+  vec3 dpdx;            // where textures read footprints: p's change across the pixel
+  vec3 dpdy;
+  vec3 dndx;  // and the shading normal's (zero without vertex normals)
+  vec3 dndy;
 };
 
 // The shading point of a hit on triangle `index` (tri) at barycentrics b (weights of v0, v1,
-// v2), seen from direction wo.
-PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, vec3 b, vec3 wo) {
+// v2), seen from direction wo by a ray with differentials rd (where textures read footprints).
+PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, vec3 b, vec3 wo,
+                                      PT_IN(RayDifferential) rd) {
   SurfacePoint s;
   s.material = loadMaterial(PT_SCENE_ARG tri.material);
-#ifndef PT_NO_BSDF_MATERIALS
-  // The parameters that textures give, at the hit's texture coordinates.
-  vec2 uv = vec2(0.0f);
-  MaterialTextures textures;
-  bool textured = (PT_HAS_TEXTURES || PT_HAS_BUMP_MAPS) && PT_PARAMS.texturesPresent != 0u;
-  if (textured) {
-    textures = materialTexturesAt(PT_SCENE_TEXTURES tri.material);
-    // The texture coordinates only where the material reads them: on a large mesh without
-    // textures their load is a cache miss at every hit.
-    if (anyTexture(textures)) uv = interpolatedUV(uvsAt(PT_SCENE_TEXTURES tri.primitive), b);
-    if (PT_HAS_TEXTURES) s.material = resolveMaterial(PT_SCENE_TEXTURES s.material, textures, uv);
-  }
-#endif
+  s.dpdx = vec3(0.0f);
+  s.dpdy = vec3(0.0f);
+  s.dndx = vec3(0.0f);
+  s.dndy = vec3(0.0f);
   // The normals in locals, stored into s once: reading them back from s would wait on its
   // stores (a store-to-load stall on the CPU).
   TriangleShading shading = triangleShadingAt(PT_SCENE_ARG index, tri);
   vec3 ng = shading.normal;
+#ifndef PT_NO_BSDF_MATERIALS
+  // The parameters that textures give, at the hit's texture coordinates and footprint.
+  UVFootprint uv = pointFootprint(vec2(0.0f));
+  MaterialTextures textures;
+  TriangleUVs uvs;
+  TriangleDerivatives derivatives;
+  bool textured = (PT_HAS_TEXTURES || PT_HAS_BUMP_MAPS) && PT_PARAMS.texturesPresent != 0u;
+  bool footprints = false;
+  if (textured) {
+    textures = materialTexturesAt(PT_SCENE_TEXTURES tri.material);
+    // The texture coordinates only where the material reads them: on a large mesh without
+    // textures their load is a cache miss at every hit.
+    if (anyTexture(textures)) {
+      uvs = uvsAt(PT_SCENE_TEXTURES tri.primitive);
+      uv.uv = interpolatedUV(uvs, b);
+      footprints = footprintsOn(PT_SCENE_ONLY);
+      if (footprints || (PT_HAS_BUMP_MAPS && textures.displacement != kNoTexture)) {
+        derivatives = triangleDerivatives(tri, uvs);
+      }
+      if (footprints) {
+        // pbrt-v4's ComputeDifferentials, about the geometric normal.
+        surfaceDpdxy(PT_PARAMS, rd, b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2, ng, s.dpdx, s.dpdy);
+        footprintUV(derivatives.dpdu, derivatives.dpdv, s.dpdx, s.dpdy, uv.duvdx, uv.duvdy);
+      }
+    }
+    if (PT_HAS_TEXTURES) s.material = resolveMaterialAt(PT_SCENE_TEXTURES s.material, textures, uv);
+  }
+#endif
   float cosOut = dot(ng, wo);
   // Lambertian and mirror surfaces are two-sided: shaded with the normal facing the ray. With
   // vertex normals, about the interpolated normal. (pbrt-v4 does not guard against the light
@@ -253,13 +297,24 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
     ns = interpolatedNormal(normals, b, ng);
     n = dot(ns, wo) >= 0.0f ? ns : -ns;
   }
+  bool bumped = PT_HAS_BUMP_MAPS && textured && textures.displacement != kNoTexture;
+  // The vertex normals' changes along u and v: for a bump map and for the differentials of
+  // specular bounces.
+  vec3 dndu = vec3(0.0f);
+  vec3 dndv = vec3(0.0f);
+  if (shadingNormals && (bumped || footprints)) {
+    normalDerivatives(uvs, normals, derivatives.determinant, dndu, dndv);
+  }
+  if (footprints) {
+    s.dndx = dndu * uv.duvdx.x + dndv * uv.duvdx.y;
+    s.dndy = dndu * uv.duvdy.x + dndv * uv.duvdy.y;
+  }
   // A bump map moves the shading normal (texture.h).
-  if (PT_HAS_BUMP_MAPS && textured && textures.displacement != kNoTexture) {
-    vec3 bumped =
-        bumpedNormal(PT_SCENE_TEXTURES textures.displacement, tri,
-                     uvsAt(PT_SCENE_TEXTURES tri.primitive), uv, ng, ns, shadingNormals, normals);
-    if (bumped != ns) {
-      ns = bumped;
+  if (bumped) {
+    vec3 moved = bumpedNormal(PT_SCENE_TEXTURES textures.displacement, derivatives, uv, ng, ns,
+                              shadingNormals, dndu, dndv);
+    if (moved != ns) {
+      ns = moved;
       shadingNormals = true;
       n = dot(ns, wo) >= 0.0f ? ns : -ns;
     }
@@ -650,6 +705,7 @@ PT_INLINE bool continueLambertian(PT_IN(SurfacePoint) s, PT_INOUT(PathState) pat
   path.prevP = s.p;
   path.prevN = s.ns;
   path.bsdfPdf = pdf;
+  path.rd.present = false;
   if (!(pdf > 0.0f)) return false;
   path.beta *= s.material.reflectance;
   path.specularBounce = false;
@@ -668,6 +724,10 @@ PT_INLINE bool sampleBsdfAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
     wi = d - 2.0f * dot(d, s.n) * s.n;
     path.beta *= s.material.reflectance;
     path.specularBounce = true;
+    if (footprintsOn(PT_SCENE_ONLY)) {
+      path.rd = specularRayDifferential(path.rd, s.p, s.dpdx, s.dpdy, s.n, s.dndx, s.dndy, s.wo, wi,
+                                        true, 1.0f);
+    }
     return true;
   }
 #ifndef PT_NO_BSDF_MATERIALS
@@ -687,6 +747,16 @@ PT_INLINE bool sampleBsdfAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key,
                                                   PT_PARAMS.seed, kStreamSamplePdf))
                        : bs.pdf;
     if ((bs.flags & kBsdfTransmission) != 0u) path.etaScale *= bs.eta * bs.eta;
+    if (footprintsOn(PT_SCENE_ONLY)) {
+      // Differentials through a specular reflection or transmission, none after the rest
+      // (pbrt-v4's SpawnRay).
+      uint kind = bs.flags & (kBsdfSpecular | kBsdfReflection | kBsdfTransmission);
+      path.rd =
+          (kind == (kBsdfSpecular | kBsdfReflection) || kind == (kBsdfSpecular | kBsdfTransmission))
+              ? specularRayDifferential(path.rd, s.p, s.dpdx, s.dpdy, s.ns, s.dndx, s.dndy, s.wo,
+                                        wi, kind == (kBsdfSpecular | kBsdfReflection), bs.eta)
+              : noRayDifferential();
+    }
     return true;
   }
 #endif

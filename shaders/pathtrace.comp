@@ -137,7 +137,7 @@ TextureNode textureNodeAt(uint i) {
   uvec4 c = texelFetch(textureTexels, at + 2);
   uvec4 d = texelFetch(textureTexels, at + 3);
   return TextureNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b), c.x, c.y, c.z, c.w, d.x, d.y,
-                     d.z, d.w);
+                     d.z, uintBitsToFloat(d.w));
 }
 uint imageWordAt(uint i) {
   return texelFetch(imageTexels, int(i >> 2u))[i & 3u];
@@ -277,6 +277,11 @@ Light loadLight(uint i) {
 #define PT_HAS_ENVIRONMENT_IMAGE kEnvironmentImage
 #define PT_HAS_TEXTURES kTextures
 #define PT_HAS_BUMP_MAPS kBumpMaps
+#ifdef PT_NO_BSDF_MATERIALS
+#define PT_HAS_FOOTPRINTS false
+#else
+#define PT_HAS_FOOTPRINTS ((kTextureFeatures & kTextureUsesFootprints) != 0u)
+#endif
 #define PT_HAS_BSDF_MATERIALS kBsdfMaterials
 #ifdef PT_VOLPATH
 #define PT_HAS_MEDIA true
@@ -408,10 +413,10 @@ Path startPath(uvec2 pixel, uint sampleIndex) {
   path.direction = camera.direction;
   path.weight = camera.weight;
 #ifdef PT_VOLPATH
-  path.vol = startVolumePath(pixel, sampleIndex, camera.origin);
+  path.vol = startVolumePath(pixel, sampleIndex, camera);
   path.crossings = 0u;
 #else
-  path.state = startPathState();
+  path.state = cameraPathState(camera);
 #endif
   path.hitReady = false;
   path.hitFound = false;
@@ -455,7 +460,8 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   // accurate than origin + t * direction), normals, how it scatters.
   Triangle tri = loadTriangle(hit.triangle);
   SurfacePoint s = surfacePointAt(
-      hit.triangle, tri, hitBarycentrics(path.origin, path.direction, tri), -path.direction);
+      hit.triangle, tri, hitBarycentrics(path.origin, path.direction, tri), -path.direction,
+      path.state.rd);
 #ifdef PT_DEBUG_PRINTF
   if (gDebug) {
     debugPrintfEXT(

@@ -325,7 +325,8 @@ PT_CONST uint kTextureMix = 4u;           // pops amount, tex2, tex1: (1 - a) te
 PT_CONST uint kTextureStackSize = 4u;     // the deepest a program's stack may grow
 
 // An image node's flags: its texel format in bits 0-3, wrap mode in 4-7, filter in 8-11, what
-// a float texture reads in 12-15, and bit 16 for pbrt-v4's "invert".
+// a float texture reads in 12-15, bit 16 for pbrt-v4's "invert", and in bits 24-28 the number
+// of levels of its MIP map.
 PT_CONST uint kTexel8 = 0u;       // one word per texel, RGBA bytes decoded by the image's table
 PT_CONST uint kTexelFloat1 = 1u;  // one float per texel (grey)
 PT_CONST uint kTexelFloat3 = 2u;  // three floats (RGB)
@@ -333,8 +334,13 @@ PT_CONST uint kTexelFloat4 = 3u;  // four floats (RGBA)
 PT_CONST uint kWrapRepeat = 0u;
 PT_CONST uint kWrapClamp = 1u;
 PT_CONST uint kWrapBlack = 2u;  // zero outside the image
-PT_CONST uint kTextureBilinear = 0u;
-PT_CONST uint kTexturePoint = 1u;  // the nearest texel
+// pbrt-v4's image filters: every one reads the MIP map level the ray's footprint on the
+// texture calls for (texture.h); at a footprint of zero, level 0.
+PT_CONST uint kTextureBilinear = 0u;   // bilinear in the level below the footprint's width
+PT_CONST uint kTexturePoint = 1u;      // the nearest texel of that level
+PT_CONST uint kTextureTrilinear = 2u;  // bilinear in the two levels about it, interpolated
+PT_CONST uint kTextureEwa = 3u;  // an elliptical gaussian over the footprint (pbrt-v4's default)
+PT_CONST uint kTextureLevelsShift = 24u;
 // What a float texture reads of an image (pbrt-v4's MIPMap::Bilerp<Float>): the one channel
 // of a grey image, the average of R, G and B, or the alpha of an image that has one that is
 // not all ones; a point lookup reads the first channel whatever the image (MIPMap::Texel).
@@ -355,9 +361,11 @@ struct TextureNode {
   uint flags;      //  4 bytes: image: format, wrap, filter, float channel, invert (above)
   uint decode;     //  4 bytes: image, kTexel8: the first word of its 256 decoded byte values
   uint count;      //  4 bytes: a texture's first node: the nodes of its program
-  uint reserved0;  // 4 bytes: zero
-  uint reserved1;  // 4 bytes: zero
-};                 // 64 bytes
+  uint levels;     //  4 bytes: image: the first word of its MIP map's table, whose word k is
+                   //           the first word of level k's texels (level 0 is width x height,
+                   //           powers of two; level k halves them, down to 1)
+  float maxAnisotropy;  // 4 bytes: image, kTextureEwa: pbrt-v4's "maxanisotropy"
+};                      // 64 bytes
 PT_CONST uint kTextureNodeTexels = 4u;
 
 // The texture coordinates of one triangle's vertices, in the scene's load order (indexed by
@@ -401,6 +409,9 @@ PT_CONST uint kTextureUsesEtaK = 1u << 3u;       // a conductor's eta or k
 PT_CONST uint kTextureUsesMedium = 1u << 4u;     // coateddiffuse's thickness or g
 PT_CONST uint kTextureUsesPrograms = 1u << 8u;   // a texture of more than one node
 PT_CONST uint kTextureUsesImages = 1u << 9u;     // an image lookup
+PT_CONST uint kTextureUsesEwa = 1u << 10u;       // an image filtered by kTextureEwa
+PT_CONST uint kTextureUsesFootprints = 1u << 11u;  // filtering over the ray's footprint (paths
+                                                   // carry differentials: differentials.h)
 PT_CONST uint kTextureUsesAll = 0xFFFFFFFFu;
 
 // ---- Camera and per-render parameters --------------------------------------------------
@@ -503,7 +514,19 @@ struct RenderParams {
                             //           the alias table
   uint unboundedEmitters;   //  4 bytes: with the light BVH: the emitters without a position
                             //           (distant, infinite lights), chosen uniformly
-};                          // 304 bytes
+  // Ray differentials (differentials.h), where some texture reads the ray's footprint: the
+  // camera's smallest differentials in camera space (right, up, forward), which stand in for
+  // a ray's own after a bounce that is not specular (pbrt-v4's Approximate_dp_dxy), and the
+  // scale both take for the samples per pixel.
+  vec3 minPosDifferentialX;  // 12 bytes
+  float differentialScale;   //  4 bytes: pbrt-v4's max(1/8, 1/sqrt(samples per pixel))
+  vec3 minPosDifferentialY;  // 12 bytes
+  uint footprints;           //  4 bytes: 1 when some texture reads the footprint (or bumps by it)
+  vec3 minDirDifferentialX;  // 12 bytes
+  uint reservedD0;           //  4 bytes: zero
+  vec3 minDirDifferentialY;  // 12 bytes
+  uint reservedD1;           //  4 bytes: zero
+};                           // 368 bytes
 
 // How an environment image's (u, v) square maps to directions in its frame (environment.h).
 PT_CONST uint kEnvironmentOctahedral = 0u;  // pbrt-v4's equal-area octahedral square, +z up

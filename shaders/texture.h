@@ -68,6 +68,10 @@ PT_INLINE vec2 interpolatedUV(TriangleUVs t, vec3 b) {
 PT_INLINE vec2 mapUV(vec4 mapping, vec2 uv) {
   return vec2(mapping.x * uv.x + mapping.z, mapping.y * uv.y + mapping.w);
 }
+// A change of (u, v) mapped to one of (s, t).
+PT_INLINE vec2 mapDerivative(vec4 mapping, vec2 duv) {
+  return vec2(mapping.x * duv.x, mapping.y * duv.y);
+}
 
 // ---- Image lookups ------------------------------------------------------------------------
 
@@ -87,32 +91,59 @@ PT_INLINE float decodeByte(PT_TEXTURES_PARAM uint decode, uint byteValue) {
   return uintBitsToFloat(imageWordAt(PT_TEXTURES_ARG decode + byteValue));
 }
 
-// Texel (x, y) of the image, as linear (R, G, B, A): grey repeated in R, G and B, and alpha 1
+// One level of an image's MIP map: its first word in the image buffer and its size.
+struct ImageLevel {
+  uint texels;
+  int width;
+  int height;
+};
+
+// The number of levels of the node's MIP map (1 + log2 of its larger side).
+PT_INLINE int imageLevelCount(TextureNode node) {
+  return int((node.flags >> kTextureLevelsShift) & 0x1Fu);
+}
+
+// Level `level` of the node's MIP map: level 0 is the image (at powers of two), each next one
+// half its size, down to 1 x 1.
+PT_INLINE ImageLevel imageLevel(PT_TEXTURES_PARAM TextureNode node, int level) {
+  ImageLevel l;
+  l.texels = level == 0 ? node.texels : imageWordAt(PT_TEXTURES_ARG node.levels + uint(level));
+  l.width = int(max(node.width >> uint(level), 1u));
+  l.height = int(max(node.height >> uint(level), 1u));
+  return l;
+}
+
+// Texel (x, y) of a level, as linear (R, G, B, A): grey repeated in R, G and B, and alpha 1
 // where the image has none. Zero for kWrapBlack outside the image.
-PT_INLINE vec4 imageTexel(PT_TEXTURES_PARAM TextureNode node, int x, int y) {
+PT_INLINE vec4 levelTexel(PT_TEXTURES_PARAM TextureNode node, ImageLevel level, int x, int y) {
   uint wrap = (node.flags >> 4u) & 0xFu;
-  x = wrapTexel(x, int(node.width), wrap);
-  y = wrapTexel(y, int(node.height), wrap);
+  x = wrapTexel(x, level.width, wrap);
+  y = wrapTexel(y, level.height, wrap);
   if (x < 0 || y < 0) return vec4(0.0f);
-  uint index = uint(y) * node.width + uint(x);
+  uint index = uint(y) * uint(level.width) + uint(x);
   uint format = node.flags & 0xFu;
   if (format == kTexel8) {
-    uint w = imageWordAt(PT_TEXTURES_ARG node.texels + index);
+    uint w = imageWordAt(PT_TEXTURES_ARG level.texels + index);
     return vec4(decodeByte(PT_TEXTURES_ARG node.decode, w & 0xFFu),
                 decodeByte(PT_TEXTURES_ARG node.decode, (w >> 8u) & 0xFFu),
                 decodeByte(PT_TEXTURES_ARG node.decode, (w >> 16u) & 0xFFu),
                 decodeByte(PT_TEXTURES_ARG node.decode, w >> 24u));
   }
   if (format == kTexelFloat1) {
-    float g = uintBitsToFloat(imageWordAt(PT_TEXTURES_ARG node.texels + index));
+    float g = uintBitsToFloat(imageWordAt(PT_TEXTURES_ARG level.texels + index));
     return vec4(g, g, g, 1.0f);
   }
   uint stride = format == kTexelFloat3 ? 3u : 4u;
-  uint at = node.texels + stride * index;
+  uint at = level.texels + stride * index;
   return vec4(uintBitsToFloat(imageWordAt(PT_TEXTURES_ARG at)),
               uintBitsToFloat(imageWordAt(PT_TEXTURES_ARG at + 1u)),
               uintBitsToFloat(imageWordAt(PT_TEXTURES_ARG at + 2u)),
               stride == 4u ? uintBitsToFloat(imageWordAt(PT_TEXTURES_ARG at + 3u)) : 1.0f);
+}
+
+// Texel (x, y) of the image itself (level 0).
+PT_INLINE vec4 imageTexel(PT_TEXTURES_PARAM TextureNode node, int x, int y) {
+  return levelTexel(PT_TEXTURES_ARG node, imageLevel(PT_TEXTURES_ARG node, 0), x, y);
 }
 
 // A coordinate in texels made safe to convert to int: NaN to 0, the rest within +-2^24 (beyond
@@ -129,38 +160,155 @@ PT_INLINE float roundHalfAway(float x) {
   return abs(x - t) >= 0.5f ? t + (x < 0.0f ? -1.0f : 1.0f) : t;
 }
 
-// The image's value at (s, t) in [0, 1]^2 (t = 1 at row 0, as pbrt-v4's ImageTexture flips t),
-// filtered as the node says: pbrt-v4's Image::Bilerp (texel centres at half-integers) or the
-// nearest texel. Float textures take the channel pbrt-v4's MIPMap takes (kFloatChannel*) into
-// all three; pbrt-v4's "scale" and "invert" are applied last.
-PT_INLINE vec3 imageLookup(PT_TEXTURES_PARAM TextureNode node, vec2 st) {
-  float x = safeTexelCoordinate(st.x * float(node.width) - 0.5f);
-  float y = safeTexelCoordinate((1.0f - st.y) * float(node.height) - 0.5f);
+// What a texture reads of a filtered (R, G, B, A): the colour, or for a float texture the
+// channel pbrt-v4's MIPMap::Bilerp<Float> reads (kFloatChannel*) in all three.
+PT_INLINE vec3 bilerpValue(TextureNode node, vec4 c) {
+  if ((node.flags & kTextureFloat) == 0u) return vec3(c);
   uint channel = (node.flags >> 12u) & 0xFu;
-  bool isFloat = (node.flags & kTextureFloat) != 0u;
+  if (channel == kFloatChannelAverage) return vec3((c.x + c.y + c.z) / 3.0f);
+  if (channel == kFloatChannelAlpha) return vec3(c.w);
+  return vec3(c.x);
+}
+// What a texture reads of one texel (pbrt-v4's MIPMap::Texel): a float texture its first channel.
+PT_INLINE vec3 texelValue(TextureNode node, vec4 c) {
+  return (node.flags & kTextureFloat) != 0u ? vec3(c.x) : vec3(c);
+}
+
+// pbrt-v4's Image::Bilerp of a level at st (image coordinates, row 0 at t = 0): texel centres
+// at half-integers.
+PT_INLINE vec3 levelBilerp(PT_TEXTURES_PARAM TextureNode node, ImageLevel level, vec2 st) {
+  float x = safeTexelCoordinate(st.x * float(level.width) - 0.5f);
+  float y = safeTexelCoordinate(st.y * float(level.height) - 0.5f);
+  float fx = floor(x);
+  float fy = floor(y);
+  int xi = int(fx);
+  int yi = int(fy);
+  float dx = x - fx;
+  float dy = y - fy;
+  vec4 c = (1.0f - dx) * (1.0f - dy) * levelTexel(PT_TEXTURES_ARG node, level, xi, yi) +
+           dx * (1.0f - dy) * levelTexel(PT_TEXTURES_ARG node, level, xi + 1, yi) +
+           (1.0f - dx) * dy * levelTexel(PT_TEXTURES_ARG node, level, xi, yi + 1) +
+           dx * dy * levelTexel(PT_TEXTURES_ARG node, level, xi + 1, yi + 1);
+  return bilerpValue(node, c);
+}
+
+// The nearest texel of a level to st (pbrt-v4's point filter: halves rounded away from zero).
+PT_INLINE vec3 levelPoint(PT_TEXTURES_PARAM TextureNode node, ImageLevel level, vec2 st) {
+  float x = safeTexelCoordinate(st.x * float(level.width) - 0.5f);
+  float y = safeTexelCoordinate(st.y * float(level.height) - 0.5f);
+  return texelValue(
+      node, levelTexel(PT_TEXTURES_ARG node, level, int(roundHalfAway(x)), int(roundHalfAway(y))));
+}
+
+// pbrt-v4's EWA weight at squared radius r2 in [0, 1) of the ellipse: its table of
+// exp(-2 r2) - exp(-2) at 128 steps, looked up by truncation.
+PT_INLINE float ewaWeight(float r2) {
+  float i = min(floor(r2 * 128.0f), 127.0f);
+  return exp(-2.0f * (i / 127.0f)) - 0.135335283f;
+}
+
+// pbrt-v4's MIPMap::EWA: the gaussian-weighted average of the texels of `level` inside the
+// ellipse of axes dst0, dst1 (in [0, 1]^2 units) about st, widened by a texel. Beyond the last
+// level, the last level's texel.
+PT_INLINE vec3 levelEwa(PT_TEXTURES_PARAM TextureNode node, int level, vec2 st, vec2 dst0,
+                        vec2 dst1) {
+  int count = imageLevelCount(node);
+  if (level >= count) {
+    return texelValue(
+        node, levelTexel(PT_TEXTURES_ARG node, imageLevel(PT_TEXTURES_ARG node, count - 1), 0, 0));
+  }
+  ImageLevel l = imageLevel(PT_TEXTURES_ARG node, level);
+  vec2 res = vec2(float(l.width), float(l.height));
+  st = st * res - vec2(0.5f);
+  dst0 = dst0 * res;
+  dst1 = dst1 * res;
+  float a = dst0.y * dst0.y + dst1.y * dst1.y + 1.0f;
+  float b = -2.0f * (dst0.x * dst0.y + dst1.x * dst1.y);
+  float c = dst0.x * dst0.x + dst1.x * dst1.x + 1.0f;
+  float invF = 1.0f / (a * c - b * b * 0.25f);
+  a *= invF;
+  b *= invF;
+  c *= invF;
+  float det = -b * b + 4.0f * a * c;
+  float invDet = 1.0f / det;
+  float uSqrt = sqrt(max(det * c, 0.0f));
+  float vSqrt = sqrt(max(a * det, 0.0f));
+  int s0 = int(ceil(safeTexelCoordinate(st.x - 2.0f * invDet * uSqrt)));
+  int s1 = int(floor(safeTexelCoordinate(st.x + 2.0f * invDet * uSqrt)));
+  int t0 = int(ceil(safeTexelCoordinate(st.y - 2.0f * invDet * vSqrt)));
+  int t1 = int(floor(safeTexelCoordinate(st.y + 2.0f * invDet * vSqrt)));
+  vec3 sum = vec3(0.0f);
+  float sumWeights = 0.0f;
+  for (int it = t0; it <= t1; ++it) {
+    float tt = float(it) - st.y;
+    for (int is = s0; is <= s1; ++is) {
+      PT_TEXTURE_LOOP_TICK();
+      float ss = float(is) - st.x;
+      float r2 = a * ss * ss + b * ss * tt + c * tt * tt;
+      if (r2 < 1.0f) {
+        float w = ewaWeight(r2);
+        sum += w * texelValue(node, levelTexel(PT_TEXTURES_ARG node, l, is, it));
+        sumWeights += w;
+      }
+    }
+  }
+  return sumWeights > 0.0f ? sum / sumWeights : vec3(0.0f);
+}
+
+// The image's value at (s, t) (t = 1 at row 0, as pbrt-v4's ImageTexture flips t), filtered as
+// the node says over the footprint whose changes of (s, t) across the pixel are dstdx and dstdy
+// (pbrt-v4's MIPMap::Filter, given the derivatives before the flip as pbrt-v4 gives them):
+// point, bilinear and trilinear lookups in the level that the footprint's largest extent calls
+// for (level 0 at a footprint of zero), EWA over the ellipse the two span, in the levels its
+// shorter axis calls for, the longer one clamped to maxAnisotropy times the shorter.
+// pbrt-v4's "scale" and "invert" are applied last.
+PT_INLINE vec3 imageLookup(PT_TEXTURES_PARAM TextureNode node, vec2 st, vec2 dstdx, vec2 dstdy) {
+  st.y = 1.0f - st.y;
+  uint filterType = (node.flags >> 8u) & 0xFu;
+  int count = imageLevelCount(node);
   vec3 v;
-  if (((node.flags >> 8u) & 0xFu) == kTexturePoint) {
-    vec4 c = imageTexel(PT_TEXTURES_ARG node, int(roundHalfAway(x)), int(roundHalfAway(y)));
-    v = isFloat ? vec3(c.x) : vec3(c);
-  } else {
-    float fx = floor(x);
-    float fy = floor(y);
-    int xi = int(fx);
-    int yi = int(fy);
-    float dx = x - fx;
-    float dy = y - fy;
-    vec4 c = (1.0f - dx) * (1.0f - dy) * imageTexel(PT_TEXTURES_ARG node, xi, yi) +
-             dx * (1.0f - dy) * imageTexel(PT_TEXTURES_ARG node, xi + 1, yi) +
-             (1.0f - dx) * dy * imageTexel(PT_TEXTURES_ARG node, xi, yi + 1) +
-             dx * dy * imageTexel(PT_TEXTURES_ARG node, xi + 1, yi + 1);
-    if (!isFloat) {
-      v = vec3(c);
-    } else if (channel == kFloatChannelAverage) {
-      v = vec3((c.x + c.y + c.z) / 3.0f);
-    } else if (channel == kFloatChannelAlpha) {
-      v = vec3(c.w);
+  if (!PT_TEXTURE_USES(kTextureUsesEwa) || filterType != kTextureEwa) {
+    float width = 2.0f * max(max(abs(dstdx.x), abs(dstdx.y)), max(abs(dstdy.x), abs(dstdy.y)));
+    float level = float(count - 1) + log2(max(width, 1e-8f));
+    if (level >= float(count - 1)) {
+      v = texelValue(node, levelTexel(PT_TEXTURES_ARG node,
+                                      imageLevel(PT_TEXTURES_ARG node, count - 1), 0, 0));
     } else {
-      v = vec3(c.x);
+      int iLevel = max(0, int(floor(level)));
+      ImageLevel l = imageLevel(PT_TEXTURES_ARG node, iLevel);
+      if (filterType == kTexturePoint) {
+        v = levelPoint(PT_TEXTURES_ARG node, l, st);
+      } else if (filterType == kTextureTrilinear && iLevel > 0) {
+        float delta = level - float(iLevel);
+        v = (1.0f - delta) * levelBilerp(PT_TEXTURES_ARG node, l, st) +
+            delta *
+                levelBilerp(PT_TEXTURES_ARG node, imageLevel(PT_TEXTURES_ARG node, iLevel + 1), st);
+      } else {
+        v = levelBilerp(PT_TEXTURES_ARG node, l, st);
+      }
+    }
+  } else {
+    vec2 dst0 = dstdx;
+    vec2 dst1 = dstdy;
+    if (dot(dst0, dst0) < dot(dst1, dst1)) {
+      dst0 = dstdy;
+      dst1 = dstdx;
+    }
+    float longer = length(dst0);
+    float shorter = length(dst1);
+    if (shorter * node.maxAnisotropy < longer && shorter > 0.0f) {
+      float scale = longer / (shorter * node.maxAnisotropy);
+      dst1 *= scale;
+      shorter *= scale;
+    }
+    if (shorter == 0.0f) {
+      v = levelBilerp(PT_TEXTURES_ARG node, imageLevel(PT_TEXTURES_ARG node, 0), st);
+    } else {
+      float lod = max(0.0f, float(count - 1) + log2(shorter));
+      int ilod = int(floor(lod));
+      float delta = lod - float(ilod);
+      v = (1.0f - delta) * levelEwa(PT_TEXTURES_ARG node, ilod, st, dst0, dst1) +
+          delta * levelEwa(PT_TEXTURES_ARG node, ilod + 1, st, dst0, dst1);
     }
   }
   v = node.value * v;
@@ -168,23 +316,53 @@ PT_INLINE vec3 imageLookup(PT_TEXTURES_PARAM TextureNode node, vec2 st) {
   return v;
 }
 
-// pbrt-v4's 2D checkerboard without a filter footprint: the weight of tex2, 0 on the squares
-// where floor(s) + floor(t) is even (tex1), 1 on the others.
-PT_INLINE float checkerboardWeight(vec2 st) {
-  float s = floor(safeTexelCoordinate(st.x));
-  float t = floor(safeTexelCoordinate(st.y));
-  return ((int(s) + int(t)) & 1) == 0 ? 0.0f : 1.0f;
+// pbrt-v4's 2D checkerboard, filtered over the footprint: the weight of tex2 at st, whose
+// changes across the pixel are dstdx and dstdy. The squares where floor(s) + floor(t) is even
+// are tex1's (weight 0), the others tex2's (weight 1); where the footprint's box (1.5 times
+// its largest extent on each axis) crosses an edge, the integral of the checks against a
+// triangle filter of that radius (pbrt-v4's Checkerboard()).
+PT_INLINE float checkerFiltered1D(float x, float r) {
+  float lo = floor(safeTexelCoordinate(x - r));
+  float hi = floor(safeTexelCoordinate(x + r));
+  if (lo == hi) return 1.0f - 2.0f * float(int(floor(safeTexelCoordinate(x))) & 1);
+  // d(x): the twice-integrated square wave of period 2.
+  float y0 = (x + r) / 2.0f - floor((x + r) / 2.0f) - 0.5f;
+  float y1 = x / 2.0f - floor(x / 2.0f) - 0.5f;
+  float y2 = (x - r) / 2.0f - floor((x - r) / 2.0f) - 0.5f;
+  float d0 = (x + r) / 2.0f + y0 * (1.0f - 2.0f * abs(y0));
+  float d1 = x / 2.0f + y1 * (1.0f - 2.0f * abs(y1));
+  float d2 = (x - r) / 2.0f + y2 * (1.0f - 2.0f * abs(y2));
+  return (d0 - 2.0f * d1 + d2) / (r * r);
+}
+PT_INLINE float checkerboardWeight(vec2 st, vec2 dstdx, vec2 dstdy) {
+  float ds = 1.5f * max(abs(dstdx.x), abs(dstdy.x));
+  float dt = 1.5f * max(abs(dstdx.y), abs(dstdy.y));
+  return 0.5f - checkerFiltered1D(st.x, ds) * checkerFiltered1D(st.y, dt) / 2.0f;
 }
 
 // ---- Evaluation --------------------------------------------------------------------------
 
-// The value of the texture whose program starts at node `first`, at texture coordinates uv.
-PT_INLINE vec3 evalTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
+// Where a texture is evaluated: the texture coordinates (u, v) and their changes across the
+// pixel, (du/dx, dv/dx) and (du/dy, dv/dy) (pbrt-v4's TextureEvalContext); zero changes where
+// nothing is known of the footprint (alpha tests in the traversal, as pbrt-v4's).
+struct UVFootprint {
+  vec2 uv;
+  vec2 duvdx;
+  vec2 duvdy;
+};
+PT_INLINE UVFootprint pointFootprint(vec2 uv) {
+  return UVFootprint(uv, vec2(0.0f), vec2(0.0f));
+}
+
+// The value of the texture whose program starts at node `first`, at footprint c.
+PT_INLINE vec3 evalTextureAt(PT_TEXTURES_PARAM uint first, UVFootprint c) {
   TextureNode head = textureNodeAt(PT_TEXTURES_ARG first);
   // The common case, one leaf, without the stack.
   if (head.count == 1u || !PT_TEXTURE_USES(kTextureUsesPrograms)) {
     if (PT_TEXTURE_USES(kTextureUsesImages) && head.type == kTextureImage) {
-      return imageLookup(PT_TEXTURES_ARG head, mapUV(head.mapping, uv));
+      return imageLookup(PT_TEXTURES_ARG head, mapUV(head.mapping, c.uv),
+                         mapDerivative(head.mapping, c.duvdx),
+                         mapDerivative(head.mapping, c.duvdy));
     }
     return head.value;
   }
@@ -197,10 +375,15 @@ PT_INLINE vec3 evalTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
     if (node.type == kTextureConstant) {
       v = node.value;
     } else if (PT_TEXTURE_USES(kTextureUsesImages) && node.type == kTextureImage) {
-      v = imageLookup(PT_TEXTURES_ARG node, mapUV(node.mapping, uv));
+      v = imageLookup(PT_TEXTURES_ARG node, mapUV(node.mapping, c.uv),
+                      mapDerivative(node.mapping, c.duvdx), mapDerivative(node.mapping, c.duvdy));
     } else if (node.type == kTextureCheckerboard) {
       top -= 2u;
-      v = checkerboardWeight(mapUV(node.mapping, uv)) == 0.0f ? stack[top] : stack[top + 1u];
+      float w = checkerboardWeight(mapUV(node.mapping, c.uv), mapDerivative(node.mapping, c.duvdx),
+                                   mapDerivative(node.mapping, c.duvdy));
+      v = w == 0.0f   ? stack[top]
+          : w == 1.0f ? stack[top + 1u]
+                      : (1.0f - w) * stack[top] + w * stack[top + 1u];
     } else if (node.type == kTextureScale) {
       top -= 2u;
       float scale = stack[top + 1u].x;
@@ -216,9 +399,17 @@ PT_INLINE vec3 evalTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
   return stack[0];
 }
 
+// At a point (a footprint of zero).
+PT_INLINE vec3 evalTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
+  return evalTextureAt(PT_TEXTURES_ARG first, pointFootprint(uv));
+}
+
 // A float texture's value (its first channel).
+PT_INLINE float evalFloatTextureAt(PT_TEXTURES_PARAM uint first, UVFootprint c) {
+  return evalTextureAt(PT_TEXTURES_ARG first, c).x;
+}
 PT_INLINE float evalFloatTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
-  return evalTexture(PT_TEXTURES_ARG first, uv).x;
+  return evalTextureAt(PT_TEXTURES_ARG first, pointFootprint(uv)).x;
 }
 
 // ---- Materials ----------------------------------------------------------------------------
@@ -236,9 +427,10 @@ PT_INLINE bool anyTexture(MaterialTextures t) {
 // [0, 1] as its albedo spectra are; roughness remapped to alpha where the material asks;
 // diffusetransmission's scale; a conductor given by its reflectance takes eta = 1 and pbrt-v4's
 // k). Parameters without a texture keep the host's values.
-PT_INLINE Material resolveMaterial(PT_TEXTURES_PARAM Material m, MaterialTextures t, vec2 uv) {
+PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextures t,
+                                     UVFootprint uv) {
   if (PT_TEXTURE_USES(kTextureUsesReflectance) && t.reflectance != kNoTexture) {
-    vec3 r = clamp(evalTexture(PT_TEXTURES_ARG t.reflectance, uv), vec3(0.0f), vec3(1.0f));
+    vec3 r = clamp(evalTextureAt(PT_TEXTURES_ARG t.reflectance, uv), vec3(0.0f), vec3(1.0f));
     if (m.type == kMaterialConductor) {
       // pbrt-v4's ConductorMaterial with "reflectance": eta 1, k = 2 sqrt(r) / sqrt(1 - r).
       r = clamp(r, vec3(0.0f), vec3(0.9999f));
@@ -251,31 +443,36 @@ PT_INLINE Material resolveMaterial(PT_TEXTURES_PARAM Material m, MaterialTexture
     }
   }
   if (PT_TEXTURE_USES(kTextureUsesTransmittance) && t.transmittance != kNoTexture) {
-    vec3 r = clamp(evalTexture(PT_TEXTURES_ARG t.transmittance, uv), vec3(0.0f), vec3(1.0f));
+    vec3 r = clamp(evalTextureAt(PT_TEXTURES_ARG t.transmittance, uv), vec3(0.0f), vec3(1.0f));
     m.transmittance =
         m.type == kMaterialDiffuseTransmission ? clamp(t.scale * r, vec3(0.0f), vec3(1.0f)) : r;
   }
   if (PT_TEXTURE_USES(kTextureUsesEtaK) && t.eta != kNoTexture)
-    m.eta = evalTexture(PT_TEXTURES_ARG t.eta, uv);
+    m.eta = evalTextureAt(PT_TEXTURES_ARG t.eta, uv);
   if (PT_TEXTURE_USES(kTextureUsesEtaK) && t.k != kNoTexture)
-    m.k = evalTexture(PT_TEXTURES_ARG t.k, uv);
+    m.k = evalTextureAt(PT_TEXTURES_ARG t.k, uv);
   bool remap = (t.flags & kRemapRoughness) != 0u;
   if (PT_TEXTURE_USES(kTextureUsesRoughness) && t.uRoughness != kNoTexture) {
-    float r = max(evalFloatTexture(PT_TEXTURES_ARG t.uRoughness, uv), 0.0f);
+    float r = max(evalFloatTextureAt(PT_TEXTURES_ARG t.uRoughness, uv), 0.0f);
     m.alphaX = remap ? sqrt(r) : r;
   }
   if (PT_TEXTURE_USES(kTextureUsesRoughness) && t.vRoughness != kNoTexture) {
-    float r = max(evalFloatTexture(PT_TEXTURES_ARG t.vRoughness, uv), 0.0f);
+    float r = max(evalFloatTextureAt(PT_TEXTURES_ARG t.vRoughness, uv), 0.0f);
     m.alphaY = remap ? sqrt(r) : r;
   }
   // coateddiffuse's medium: pbrt-v4 keeps the thickness at least the smallest normal float and
   // clamps g to [-1, 1]; we keep g inside (-1, 1), where Henyey-Greenstein is not a delta.
   if (PT_TEXTURE_USES(kTextureUsesMedium) && t.thickness != kNoTexture) {
-    m.thickness = max(evalFloatTexture(PT_TEXTURES_ARG t.thickness, uv), 1.17549435e-38f);
+    m.thickness = max(evalFloatTextureAt(PT_TEXTURES_ARG t.thickness, uv), 1.17549435e-38f);
   }
   if (PT_TEXTURE_USES(kTextureUsesMedium) && t.g != kNoTexture)
-    m.g = clamp(evalFloatTexture(PT_TEXTURES_ARG t.g, uv), -0.999f, 0.999f);
+    m.g = clamp(evalFloatTextureAt(PT_TEXTURES_ARG t.g, uv), -0.999f, 0.999f);
   return m;
+}
+
+// At a point (a footprint of zero).
+PT_INLINE Material resolveMaterial(PT_TEXTURES_PARAM Material m, MaterialTextures t, vec2 uv) {
+  return resolveMaterialAt(PT_TEXTURES_ARG m, t, pointFootprint(uv));
 }
 
 // ---- Bump maps ---------------------------------------------------------------------------
@@ -289,45 +486,83 @@ PT_INLINE void coordinateSystem(vec3 v, PT_OUT(vec3) a, PT_OUT(vec3) b) {
   b = vec3(c, sign + v.y * v.y * k, -v.y);
 }
 
-// The shading normal that pbrt-v4's BumpMap gives a triangle (vertices of tri, texture
-// coordinates t, the hit's uv) whose displacement is the float texture `displacement`: the
-// surface's partial derivatives dp/du and dp/dv (pbrt-v4's Triangle: from the vertices and
-// their (u, v), a coordinate system about the normal where (u, v) are degenerate) and, with
-// vertex normals (hasNormals, the normals at the vertices and ns interpolated), the shading
-// frame's tangents and dn/du, dn/dv as pbrt-v4 derives them; then the displacement's finite
-// differences along u and v move them, and the normal of the moved pair, turned to the side of
-// ng (pbrt-v4's FaceForward), is the bumped one. pbrt-v4 steps by half the ray footprint's
-// extent in (u, v); we have no ray differentials and step by its fallback, 0.0005. Where both
-// differences are exactly zero (a constant displacement) the surface is left as it is.
-PT_INLINE vec3 bumpedNormal(PT_TEXTURES_PARAM uint displacement, Triangle tri, TriangleUVs t,
-                            vec2 uv, vec3 ng, vec3 ns, bool hasNormals, TriangleNormals normals) {
-  const float kStep = 0.0005f;
-  float displace = evalFloatTexture(PT_TEXTURES_ARG displacement, uv);
-  float uDisplace = evalFloatTexture(PT_TEXTURES_ARG displacement, uv + vec2(kStep, 0.0f));
-  float vDisplace = evalFloatTexture(PT_TEXTURES_ARG displacement, uv + vec2(0.0f, kStep));
-  if (uDisplace == displace && vDisplace == displace) return ns;
-  // dp/du and dp/dv (pbrt-v4's Triangle::InteractionFromIntersection).
+// A triangle's partial derivatives dp/du and dp/dv (pbrt-v4's
+// Triangle::InteractionFromIntersection: from the vertices of tri and their texture coordinates t,
+// a coordinate system about the normal where (u, v) are degenerate) and the determinant of its (u,
+// v) differences.
+struct TriangleDerivatives {
+  vec3 dpdu;
+  vec3 dpdv;
+  float determinant;
+};
+PT_INLINE TriangleDerivatives triangleDerivatives(Triangle tri, TriangleUVs t) {
+  TriangleDerivatives d;
   vec2 duv02 = t.uv0 - t.uv2;
   vec2 duv12 = t.uv1 - t.uv2;
   vec3 dp02 = tri.v0 - tri.v2;
   vec3 dp12 = tri.v1 - tri.v2;
-  float determinant = duv02.x * duv12.y - duv02.y * duv12.x;
-  vec3 dpdu = vec3(0.0f);
-  vec3 dpdv = vec3(0.0f);
-  bool degenerate = abs(determinant) < 1e-9f;
+  d.determinant = duv02.x * duv12.y - duv02.y * duv12.x;
+  d.dpdu = vec3(0.0f);
+  d.dpdv = vec3(0.0f);
+  bool degenerate = abs(d.determinant) < 1e-9f;
   if (!degenerate) {
-    float invDet = 1.0f / determinant;
-    dpdu = (duv12.y * dp02 - duv02.y * dp12) * invDet;
-    dpdv = (duv02.x * dp12 - duv12.x * dp02) * invDet;
+    float invDet = 1.0f / d.determinant;
+    d.dpdu = (duv12.y * dp02 - duv02.y * dp12) * invDet;
+    d.dpdv = (duv02.x * dp12 - duv12.x * dp02) * invDet;
   }
-  vec3 c = cross(dpdu, dpdv);
+  vec3 c = cross(d.dpdu, d.dpdv);
   if (degenerate || dot(c, c) == 0.0f) {
-    coordinateSystem(normalize(cross(tri.v2 - tri.v0, tri.v1 - tri.v0)), dpdu, dpdv);
+    coordinateSystem(normalize(cross(tri.v2 - tri.v0, tri.v1 - tri.v0)), d.dpdu, d.dpdv);
   }
-  // The shading frame: ns with the tangent dp/du made perpendicular, and dn/du, dn/dv.
+  return d;
+}
+
+// The changes of the interpolated vertex normal along u and v, dn/du and dn/dv, as pbrt-v4's
+// Triangle derives them (zero without vertex normals).
+PT_INLINE void normalDerivatives(TriangleUVs t, TriangleNormals normals, float determinant,
+                                 PT_OUT(vec3) dndu, PT_OUT(vec3) dndv) {
+  dndu = vec3(0.0f);
+  dndv = vec3(0.0f);
+  vec2 duv02 = t.uv0 - t.uv2;
+  vec2 duv12 = t.uv1 - t.uv2;
+  vec3 dn1 = normals.n0 - normals.n2;
+  vec3 dn2 = normals.n1 - normals.n2;
+  if (abs(determinant) < 1e-32f) {
+    vec3 dn = cross(normals.n2 - normals.n0, normals.n1 - normals.n0);
+    if (dot(dn, dn) != 0.0f) coordinateSystem(normalize(dn), dndu, dndv);
+  } else {
+    float invDet = 1.0f / determinant;
+    dndu = (duv12.y * dn1 - duv02.y * dn2) * invDet;
+    dndv = (duv02.x * dn2 - duv12.x * dn1) * invDet;
+  }
+}
+
+// The shading normal that pbrt-v4's BumpMap gives a triangle (its derivatives d, the hit's
+// footprint uv) whose displacement is the float texture `displacement`: with vertex normals
+// (hasNormals, ns interpolated, dndu and dndv from normalDerivatives) the shading frame's
+// tangents as pbrt-v4 derives them, otherwise dp/du and dp/dv; the displacement's finite
+// differences along u and v move them, and the normal of the moved pair, turned to the side of
+// ng (pbrt-v4's FaceForward), is the bumped one. The differences step by half the footprint's
+// extent in u and in v (pbrt-v4's), 0.0005 where that is zero. Where both differences are
+// exactly zero (a constant displacement) the surface is left as it is.
+PT_INLINE vec3 bumpedNormal(PT_TEXTURES_PARAM uint displacement, TriangleDerivatives d,
+                            UVFootprint uv, vec3 ng, vec3 ns, bool hasNormals, vec3 dndu,
+                            vec3 dndv) {
+  float du = 0.5f * (abs(uv.duvdx.x) + abs(uv.duvdy.x));
+  if (du == 0.0f) du = 0.0005f;
+  float dv = 0.5f * (abs(uv.duvdx.y) + abs(uv.duvdy.y));
+  if (dv == 0.0f) dv = 0.0005f;
+  float displace = evalFloatTextureAt(PT_TEXTURES_ARG displacement, uv);
+  UVFootprint shifted = uv;
+  shifted.uv = uv.uv + vec2(du, 0.0f);
+  float uDisplace = evalFloatTextureAt(PT_TEXTURES_ARG displacement, shifted);
+  shifted.uv = uv.uv + vec2(0.0f, dv);
+  float vDisplace = evalFloatTextureAt(PT_TEXTURES_ARG displacement, shifted);
+  if (uDisplace == displace && vDisplace == displace) return ns;
+  vec3 dpdu = d.dpdu;
+  vec3 dpdv = d.dpdv;
+  // The shading frame: ns with the tangent dp/du made perpendicular.
   vec3 n = ng;
-  vec3 dndu = vec3(0.0f);
-  vec3 dndv = vec3(0.0f);
   if (hasNormals) {
     n = ns;
     vec3 ss = dpdu;
@@ -339,19 +574,9 @@ PT_INLINE vec3 bumpedNormal(PT_TEXTURES_PARAM uint displacement, Triangle tri, T
     }
     dpdu = ss;
     dpdv = ts;
-    vec3 dn1 = normals.n0 - normals.n2;
-    vec3 dn2 = normals.n1 - normals.n2;
-    if (abs(determinant) < 1e-32f) {
-      vec3 dn = cross(normals.n2 - normals.n0, normals.n1 - normals.n0);
-      if (dot(dn, dn) != 0.0f) coordinateSystem(normalize(dn), dndu, dndv);
-    } else {
-      float invDet = 1.0f / determinant;
-      dndu = (duv12.y * dn1 - duv02.y * dn2) * invDet;
-      dndv = (duv02.x * dn2 - duv12.x * dn1) * invDet;
-    }
   }
-  vec3 bumpedU = dpdu + ((uDisplace - displace) / kStep) * n + displace * dndu;
-  vec3 bumpedV = dpdv + ((vDisplace - displace) / kStep) * n + displace * dndv;
+  vec3 bumpedU = dpdu + ((uDisplace - displace) / du) * n + displace * dndu;
+  vec3 bumpedV = dpdv + ((vDisplace - displace) / dv) * n + displace * dndv;
   vec3 bumped = cross(bumpedU, bumpedV);
   float len2 = dot(bumped, bumped);
   if (!(len2 > 0.0f) || !(len2 < 3.0e38f)) return ns;

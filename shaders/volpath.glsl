@@ -112,7 +112,7 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
         crossInterface(hit.triangle, tri, b, path.direction, path.vol.medium, path.origin);
     return false;
   }
-  SurfacePoint s = surfacePointAt(hit.triangle, tri, b, -path.direction);
+  SurfacePoint s = surfacePointAt(hit.triangle, tri, b, -path.direction, path.vol.path.rd);
 
   // Emitted light found by this ray, weighed against light sampling.
   addVolumeEmissionFound(path.vol, tri, s);

@@ -72,14 +72,16 @@ PT_INLINE RandomStream flightStream(PT_SCENE_PARAM uvec2 pixel, uint sampleIndex
                           PT_PARAMS.seed, kStreamFlight);
 }
 
-// A path at the camera (in the camera's medium), its hero channel drawn.
-PT_INLINE VolumePath startVolumePath(PT_SCENE_PARAM uvec2 pixel, uint sampleIndex, vec3 origin) {
+// A path of camera sample c (in the camera's medium), its hero channel drawn.
+PT_INLINE VolumePath startVolumePath(PT_SCENE_PARAM uvec2 pixel, uint sampleIndex,
+                                     PT_IN(CameraSample) c) {
   RandomStream heroStream =
       makeRandomStream(pixel, sampleIndex, kDimPixel, PT_PARAMS.seed, kStreamHeroChannel);
   uint hero = min(uint(nextRandom(heroStream) * 3.0f), 2u);
-  VolumePath v = VolumePath(startPathState(), vec3(1.0f), vec3(1.0f), hero, PT_PARAMS.cameraMedium,
-                            0u, flightStream(PT_SCENE_ARG pixel, sampleIndex, 0u));
-  v.path.prevP = origin;
+  VolumePath v =
+      VolumePath(cameraPathState(PT_SCENE_ARG c), vec3(1.0f), vec3(1.0f), hero,
+                 PT_PARAMS.cameraMedium, 0u, flightStream(PT_SCENE_ARG pixel, sampleIndex, 0u));
+  v.path.prevP = c.origin;
   return v;
 }
 
@@ -408,6 +410,7 @@ PT_INLINE bool scatterInMedium(PT_INOUT(VolumePath) v, vec3 wo, float g, vec2 u,
   v.rL = v.rU / pdf;
   v.path.prevN = vec3(0.0f);  // a point of a medium: the light BVH weighs no surface
   v.path.specularBounce = false;
+  v.path.rd.present = false;
   return true;
 }
 

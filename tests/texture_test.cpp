@@ -86,7 +86,8 @@ TEST(Textures, WrapModesFoldTexelCoordinates) {
 // mode, the last (repeat), the first again (clamp) or black; the top-left corner the four
 // corners' mean (repeat), the corner texel (clamp) or a quarter of it (black).
 TEST(Textures, BilinearAtCentresEdgesAndCorners) {
-  const int w = 3, h = 2;
+  // Sides that are powers of two: level 0 of the MIP map is the image itself.
+  const int w = 4, h = 2;
   for (uint wrap : {kWrapRepeat, kWrapClamp, kWrapBlack}) {
     SCOPED_TRACE(wrap);
     ImageTextureDesc desc;

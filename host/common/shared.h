@@ -67,7 +67,10 @@ static_assert(offsetof(Camera, filterRootsFar) == 144 && offsetof(Camera, filter
 // RenderParams after its Camera, whatever the Camera's size (a multiple of 16 bytes).
 inline constexpr std::size_t kParamsBase = sizeof(Camera);
 static_assert(kParamsBase % 16 == 0);
-static_assert(sizeof(RenderParams) == kParamsBase + 144);
+static_assert(sizeof(RenderParams) == kParamsBase + 208);
+static_assert(offsetof(RenderParams, minPosDifferentialX) == kParamsBase + 144);
+static_assert(offsetof(RenderParams, footprints) == kParamsBase + 172);
+static_assert(offsetof(RenderParams, minDirDifferentialY) == kParamsBase + 192);
 static_assert(offsetof(RenderParams, cameraMedium) == kParamsBase + 128);
 static_assert(offsetof(RenderParams, maxDepth) == kParamsBase);
 static_assert(offsetof(RenderParams, seed) == kParamsBase + 12);
@@ -85,6 +88,7 @@ static_assert(offsetof(RenderParams, environmentMapping) == kParamsBase + 124);
 static_assert(sizeof(TextureNode) == 16 * kTextureNodeTexels);
 static_assert(offsetof(TextureNode, type) == 12 && offsetof(TextureNode, mapping) == 16);
 static_assert(offsetof(TextureNode, texels) == 32 && offsetof(TextureNode, count) == 52);
+static_assert(offsetof(TextureNode, levels) == 56 && offsetof(TextureNode, maxAnisotropy) == 60);
 static_assert(sizeof(TriangleUVs) == 32 && offsetof(TriangleUVs, uv2) == 16);
 static_assert(sizeof(MaterialTextures) == 16 * kMaterialTextureTexels);
 static_assert(offsetof(MaterialTextures, displacement) == 24 &&

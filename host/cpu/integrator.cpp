@@ -120,7 +120,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
   // The camera ray through a point of the pixel's filter (and of the lens).
   const CameraSample camera = cameraSampleOf(params.camera, sobol, pixel, sampleIndex, seed);
   Ray ray{camera.origin, camera.direction};
-  PathState path = startPathState();  // L, beta, etaScale, bsdfPdf, specularBounce
+  PathState path = cameraPathState(ps, camera);  // L, beta, etaScale, bsdfPdf, specularBounce
 
   for (uint depth = 0;;) {
     // Find the closest surface along the ray.
@@ -135,7 +135,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
     // accurate than origin + t * direction), normals, how it scatters.
     const Triangle& tri = scene.bvh.triangles[hit->triangle];
     const SurfacePoint s =
-        surfacePointAt(ps, hit->triangle, tri, hit->barycentrics, -ray.direction);
+        surfacePointAt(ps, hit->triangle, tri, hit->barycentrics, -ray.direction, path.rd);
     if (debugPrint) {
       std::fprintf(stderr,
                    "cpu depth %u: hit triangle %u (primitive %u) t=%g p=(%g, %g, %g) "

@@ -313,6 +313,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   const Intersection intersection =
       params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
   const bool alpha = scene.effects.alphaCutouts;
+  const bool footprints = footprintsOn(ps);
   const Camera& camera = params.camera;
 
   Paths path;
@@ -397,6 +398,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
                              : vec2(0.0f);
       const CameraSample ray = generateCameraRay(
           camera, filmPixel, random2(sobol, filmPixel, sampleIndex, kDimPixel, seed), uLens);
+      path.state[i] = cameraPathState(ps, ray);
       path.origin.set(i, ray.origin);
       path.direction.set(i, ray.direction);
       path.weight[i] = ray.weight;
@@ -411,10 +413,22 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
           hn::Add(hn::ConvertTo(D(), hn::BitCast(di, hn::Load(du, path.pixelY))), filmY.load());
       Lanes3 direction;
       store(direction, cameraDirection(camera, x, y));
+      Lanes filmPointX, filmPointY;
+      filmPointX.store(x);
+      filmPointY.store(y);
       forEachLane(starting, [&](size_t i) {
         path.origin.set(i, camera.position);
         path.direction.set(i, direction.get(i));
         path.weight[i] = 1.0f;
+        if (footprints) {
+          CameraSample c;
+          c.origin = camera.position;
+          c.direction = direction.get(i);
+          c.weight = 1.0f;
+          c.filmPoint = vec2(filmPointX.v[i], filmPointY.v[i]);
+          c.lensOffset = vec3(0.0f);
+          path.state[i] = cameraPathState(ps, c);
+        }
       });
     }
     active |= starting;
@@ -435,7 +449,8 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
         return;
       }
       const Triangle& tri = scene.bvh.triangles[hit.triangle];
-      surface[i] = surfacePointAt(ps, hit.triangle, tri, hit.barycentrics, -path.direction.get(i));
+      surface[i] = surfacePointAt(ps, hit.triangle, tri, hit.barycentrics, -path.direction.get(i),
+                                  path.state[i].rd);
       addEmissionFound(ps, path.state[i], tri, surface[i], hit.t, path.origin.get(i));
       // Stop after maxDepth scattering events.
       if (path.depth[i] == params.maxDepth) return;

@@ -61,7 +61,7 @@ vec3 sampleRadianceVolume(const SceneData& scene, uvec2 imagePixel, uint32_t sam
   const CameraSample camera = cameraSampleOf(params.camera, sobol, pixel, sampleIndex, seed);
   Ray ray{camera.origin, camera.direction};
   // L, beta, the densities over the channels, the hero channel, the camera's medium.
-  VolumePath v = startVolumePath(ps, pixel, sampleIndex, ray.origin);
+  VolumePath v = startVolumePath(ps, pixel, sampleIndex, camera);
   uint crossings = 0;  // interfaces crossed since the last scattering event
 
   for (;;) {
@@ -127,7 +127,7 @@ vec3 sampleRadianceVolume(const SceneData& scene, uvec2 imagePixel, uint32_t sam
       continue;
     }
     const SurfacePoint s =
-        surfacePointAt(ps, hit->triangle, tri, hit->barycentrics, -ray.direction);
+        surfacePointAt(ps, hit->triangle, tri, hit->barycentrics, -ray.direction, v.path.rd);
     if (debugPrint) {
       std::fprintf(stderr, "cpu depth %u: hit triangle %u (primitive %u) t=%g medium %d\n", v.depth,
                    hit->triangle, tri.primitive, hit->t, int(v.medium));

@@ -2,15 +2,19 @@
 // scene/camera_filter.h's.
 #include "render/camera.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
 #include "common/check.h"
+#include "differentials.h"
 #include "scene/camera_filter.h"
+#include "texture.h"
 
 namespace pt {
 
@@ -67,6 +71,39 @@ Camera makeCamera(const CameraDesc& desc, int width, int height) {
                          camera.aspect + camera.tanHalfFovY),
            "screen window beyond the float range");
   return camera;
+}
+
+void setCameraDifferentials(RenderParams& params, int spp) {
+  const Camera& cam = params.camera;
+  const float infinity = std::numeric_limits<float>::infinity();
+  vec3 minPosX(infinity), minPosY(infinity), minDirX(infinity), minDirY(infinity);
+  constexpr int kPoints = 512;
+  for (int i = 0; i < kPoints; ++i) {
+    const vec2 film(float(i) / float(kPoints - 1) * float(cam.filmWidth),
+                    float(i) / float(kPoints - 1) * float(cam.filmHeight));
+    const vec3 direction = normalize(cameraFilmVector(cam, film));
+    const RayDifferential rd =
+        cameraRayDifferential(cam, film, vec3(0.0f), cam.position, direction, 1.0f);
+    const vec3 dox = worldToCamera(cam, rd.rxOrigin - cam.position);
+    const vec3 doy = worldToCamera(cam, rd.ryOrigin - cam.position);
+    if (glm::length(dox) < glm::length(minPosX)) minPosX = dox;
+    if (glm::length(doy) < glm::length(minPosY)) minPosY = doy;
+    // The offset directions in the frame about the ray's (pbrt-v4's Frame::FromZ).
+    const vec3 d = worldToCamera(cam, direction);
+    vec3 x, y;
+    coordinateSystem(d, x, y);
+    const auto toLocal = [&](vec3 v) { return vec3(dot(v, x), dot(v, y), dot(v, d)); };
+    const vec3 df = toLocal(d);
+    const vec3 dxf = normalize(toLocal(worldToCamera(cam, normalize(rd.rxDirection))));
+    const vec3 dyf = normalize(toLocal(worldToCamera(cam, normalize(rd.ryDirection))));
+    if (glm::length(dxf - df) < glm::length(minDirX)) minDirX = dxf - df;
+    if (glm::length(dyf - df) < glm::length(minDirY)) minDirY = dyf - df;
+  }
+  params.minPosDifferentialX = minPosX;
+  params.minPosDifferentialY = minPosY;
+  params.minDirDifferentialX = minDirX;
+  params.minDirDifferentialY = minDirY;
+  params.differentialScale = std::max(0.125f, 1.0f / std::sqrt(float(std::max(spp, 1))));
 }
 
 }  // namespace pt

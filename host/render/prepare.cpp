@@ -359,12 +359,18 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
 
   // Effects: which material kinds occur on triangles, and whether light sampling can matter.
   EffectSet& fx = data.effects;
-  // What evaluating a texture needs: several nodes, an image lookup.
+  // What evaluating a texture needs: several nodes, an image lookup, EWA filtering, the ray's
+  // footprint (an image or a checkerboard filters over it).
   const auto programFeatures = [&](uint first) {
     const uint count = data.textureNodes[first].count;
     uint bits = count > 1 ? kTextureUsesPrograms : 0u;
     for (uint i = 0; i < count; ++i) {
-      if (data.textureNodes[first + i].type == kTextureImage) bits |= kTextureUsesImages;
+      const TextureNode& node = data.textureNodes[first + i];
+      if (node.type == kTextureImage) {
+        bits |= kTextureUsesImages | kTextureUsesFootprints;
+        if (((node.flags >> 8u) & 0xFu) == kTextureEwa) bits |= kTextureUsesEwa;
+      }
+      if (node.type == kTextureCheckerboard) bits |= kTextureUsesFootprints;
     }
     return bits;
   };
@@ -397,8 +403,11 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
       uses(t->k, kTextureUsesEtaK);
       uses(t->thickness, kTextureUsesMedium);
       uses(t->g, kTextureUsesMedium);
-      uses(t->displacement, 0u);
-      uses(t->alpha, 0u);
+      // A bump map steps by the footprint; alpha is tested in the traversal, at a point.
+      uses(t->displacement, kTextureUsesFootprints);
+      if (t->alpha != kNoTexture) {
+        fx.textureFeatures |= programFeatures(t->alpha) & ~kTextureUsesFootprints;
+      }
       // Roughness that a texture gives may be smooth somewhere and rough elsewhere.
       if (m.type > kMaterialMirror &&
           (t->uRoughness != kNoTexture || t->vRoughness != kNoTexture)) {
@@ -432,6 +441,11 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   }
   fx.bsdfEmission = hittable && p.strategy != kStrategyNee;
   p.texturesPresent = (fx.textures || fx.alphaCutouts || fx.bumpMaps) ? 1u : 0u;
+  // Ray differentials where some texture reads the footprint (differentials.h).
+  if ((fx.textureFeatures & kTextureUsesFootprints) != 0u) {
+    p.footprints = 1u;
+    setCameraDifferentials(p, data.spp);
+  }
   fx.shadingNormals = !data.normals.empty();
   p.normalsPresent = fx.shadingNormals ? 1u : 0u;
   fx.watertight = !settings.fastIntersection;

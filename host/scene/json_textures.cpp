@@ -15,7 +15,8 @@ std::vector<std::string_view> classKeys(std::string_view c) {
   std::vector<std::string_view> keys = {"name", "type"};
   const std::initializer_list<std::string_view> mapping = {"uscale", "vscale", "udelta", "vdelta"};
   if (c == "imagemap") {
-    keys.insert(keys.end(), {"filename", "encoding", "wrap", "filter", "scale", "invert"});
+    keys.insert(keys.end(),
+                {"filename", "encoding", "wrap", "filter", "maxanisotropy", "scale", "invert"});
     keys.insert(keys.end(), mapping);
   } else if (c == "checkerboard") {
     keys.insert(keys.end(), {"tex1", "tex2", "dimension"});
@@ -151,15 +152,14 @@ uint JsonTextures::build(const JsonNode& def, bool isFloat, int depth) {
     }
     if (auto n = def.find("filter")) {
       const std::string f = n->string();
-      // pbrt-v4's MIP-map filters look up the full-resolution image bilinearly here.
-      if (f == "point") {
-        desc.filter = kTexturePoint;
-      } else if (f == "bilinear" || f == "trilinear" || f == "ewa" || f == "EWA") {
-        desc.filter = kTextureBilinear;
-      } else {
+      if (!parseTextureFilter(f, desc.filter)) {
         n->fail("unknown filter " + singleQuoted(f) +
                 " (expected 'bilinear', 'point', 'trilinear' or 'ewa')");
       }
+    }
+    if (auto n = def.find("maxanisotropy")) {
+      desc.maxAnisotropy = finiteFloat(*n);
+      if (!(desc.maxAnisotropy > 0.0f)) n->fail("must be positive");
     }
     if (auto n = def.find("scale")) desc.scale = finiteFloat(*n);
     if (auto n = def.find("invert")) desc.invert = n->boolean();

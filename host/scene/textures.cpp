@@ -6,6 +6,7 @@
 
 #include "common/check.h"
 #include "image/texture_image.h"
+#include "scene/mip_pyramid.h"
 #include "scene/reader_helpers.h"
 #include "texture.h"
 
@@ -19,6 +20,12 @@ uint floatWord(float f) {
   return w;
 }
 
+float uintToFloat(uint w) {
+  float f;
+  std::memcpy(&f, &w, sizeof f);
+  return f;
+}
+
 // The sRGB curve's decoding (IEC 61966-2-1), in double.
 double srgbDecode(double c) {
   return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
@@ -27,6 +34,18 @@ double srgbDecode(double c) {
 // A value of an encoded channel in [0, 1] made linear: sRGB (gamma 0) or the power gamma.
 double decodeEncoded(double c, double gamma) {
   return gamma == 0.0 ? srgbDecode(c) : std::pow(c, gamma);
+}
+
+// A linear value encoded to a byte, as pbrt-v4 stores its 8-bit MIP levels: sRGB (gamma 0)
+// rounded in the encoded domain, 0 and 255 beyond [0, 1]; a power gamma likewise.
+uint encodeByte(float v, double gamma) {
+  if (!(v > 0.0f)) return 0u;
+  if (v >= 1.0f) return 255u;
+  const double x = double(v);
+  const double e = gamma == 0.0
+                       ? (x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055)
+                       : std::pow(x, 1.0 / gamma);
+  return uint(std::clamp(std::round(255.0 * e), 0.0, 255.0));
 }
 
 }  // namespace
@@ -59,6 +78,21 @@ bool parseWrapMode(const std::string& name, uint& wrap) {
     wrap = kWrapClamp;
   } else if (name == "black") {
     wrap = kWrapBlack;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+bool parseTextureFilter(const std::string& name, uint& filter) {
+  if (name == "point") {
+    filter = kTexturePoint;
+  } else if (name == "bilinear") {
+    filter = kTextureBilinear;
+  } else if (name == "trilinear") {
+    filter = kTextureTrilinear;
+  } else if (name == "ewa" || name == "EWA") {
+    filter = kTextureEwa;
   } else {
     return false;
   }
@@ -99,21 +133,23 @@ uint TextureBuilder::decodeTable(double gamma) {
 }
 
 const TextureBuilder::StoredImage& TextureBuilder::storeImage(const std::filesystem::path& path,
-                                                              const std::string& encoding) {
+                                                              const std::string& encoding,
+                                                              uint wrap) {
   double gamma = 0.0;
   if (!parseColorEncoding(encoding, gamma)) {
     throw InputError(path.string() + ": unknown colour encoding '" + encoding +
                      "' (expected \"sRGB\", \"linear\" or \"gamma <g>\" with g > 0)");
   }
-  const auto key = std::make_tuple(path.lexically_normal().string(), encoding);
+  const auto key = std::make_tuple(path.lexically_normal().string(), encoding, wrap);
   const auto found = images_.find(key);
   if (found != images_.end()) return found->second;
-  return images_.emplace(key, storeDecoded(readTextureImage(path), path, encoding)).first->second;
+  return images_.emplace(key, storeDecoded(readTextureImage(path), path, encoding, wrap))
+      .first->second;
 }
 
 TextureBuilder::StoredImage TextureBuilder::storeDecoded(const TextureImage& image,
                                                          const std::filesystem::path& path,
-                                                         const std::string& encoding) {
+                                                         const std::string& encoding, uint wrap) {
   double gamma = 0.0;
   if (!parseColorEncoding(encoding, gamma)) {
     throw InputError(path.string() + ": unknown colour encoding '" + encoding +
@@ -172,15 +208,77 @@ TextureBuilder::StoredImage TextureBuilder::storeDecoded(const TextureImage& ima
       scene_.imageWords.push_back(floatWord(v));
     }
   }
+  storeMipLevels(stored, gamma, wrap);
   return stored;
 }
 
+// The MIP map of the image just stored at stored.texels (mip_pyramid.h), its levels after it
+// in the same format (8-bit levels encoded as the image is, as pbrt-v4 keeps them), then the
+// table of where each level starts. An image whose sides are powers of two keeps its texels
+// as level 0; another's level 0 is its resampled image.
+void TextureBuilder::storeMipLevels(StoredImage& stored, double gamma, uint wrap) {
+  const bool eightBit = stored.format == kTexel8;
+  FloatImage image;
+  image.width = int(stored.width);
+  image.height = int(stored.height);
+  image.channels = eightBit                        ? 4
+                   : stored.format == kTexelFloat1 ? 1
+                   : stored.format == kTexelFloat3 ? 3
+                                                   : 4;
+  const std::size_t texels = std::size_t(stored.width) * std::size_t(stored.height);
+  image.values.resize(texels * std::size_t(image.channels));
+  for (std::size_t i = 0; i < texels; ++i) {
+    if (eightBit) {
+      const uint w = scene_.imageWords[stored.texels + i];
+      for (int c = 0; c < 4; ++c) {
+        image.values[4 * i + std::size_t(c)] =
+            uintToFloat(scene_.imageWords[stored.decode + ((w >> (8 * c)) & 0xFFu)]);
+      }
+    } else {
+      for (int c = 0; c < image.channels; ++c) {
+        const std::size_t at = i * std::size_t(image.channels) + std::size_t(c);
+        image.values[at] = uintToFloat(scene_.imageWords[stored.texels + at]);
+      }
+    }
+  }
+  const bool resized = !isPowerOfTwo(image.width) || !isPowerOfTwo(image.height);
+  std::vector<FloatImage> pyramid = mipPyramid(std::move(image), wrap);
+  std::size_t words = pyramid.size();
+  for (std::size_t level = resized ? 0 : 1; level < pyramid.size(); ++level) {
+    words += pyramid[level].values.size() / (eightBit ? 4 : 1);
+  }
+  if (scene_.imageWords.size() + words > std::size_t(UINT32_MAX)) {
+    throw InputError("the scene's images and their MIP maps exceed 2^32 words (16 GiB)");
+  }
+  reserveGeometric(scene_.imageWords, scene_.imageWords.size() + words);
+  std::vector<uint> starts(pyramid.size(), stored.texels);
+  for (std::size_t level = resized ? 0 : 1; level < pyramid.size(); ++level) {
+    const FloatImage& l = pyramid[level];
+    starts[level] = uint(scene_.imageWords.size());
+    if (eightBit) {
+      for (std::size_t i = 0; i < l.values.size(); i += 4) {
+        scene_.imageWords.push_back(
+            encodeByte(l.values[i], gamma) | encodeByte(l.values[i + 1], gamma) << 8 |
+            encodeByte(l.values[i + 2], gamma) << 16 | encodeByte(l.values[i + 3], gamma) << 24);
+      }
+    } else {
+      for (float v : l.values) scene_.imageWords.push_back(floatWord(v));
+    }
+  }
+  stored.texels = starts[0];
+  stored.width = uint(pyramid[0].width);
+  stored.height = uint(pyramid[0].height);
+  stored.levelCount = uint(pyramid.size());
+  stored.levels = uint(scene_.imageWords.size());
+  scene_.imageWords.insert(scene_.imageWords.end(), starts.begin(), starts.end());
+}
+
 uint TextureBuilder::image(const ImageTextureDesc& desc, bool isFloat) {
-  return imageNode(storeImage(desc.filename, desc.encoding), desc, isFloat);
+  return imageNode(storeImage(desc.filename, desc.encoding, desc.wrap), desc, isFloat);
 }
 
 uint TextureBuilder::image(const TextureImage& image, const ImageTextureDesc& desc, bool isFloat) {
-  return imageNode(storeDecoded(image, desc.filename, desc.encoding), desc, isFloat);
+  return imageNode(storeDecoded(image, desc.filename, desc.encoding, desc.wrap), desc, isFloat);
 }
 
 uint TextureBuilder::imageNode(const StoredImage& stored, const ImageTextureDesc& desc,
@@ -194,7 +292,10 @@ uint TextureBuilder::imageNode(const StoredImage& stored, const ImageTextureDesc
   node.height = stored.height;
   node.decode = stored.decode;
   node.flags = stored.format | desc.wrap << 4 | desc.filter << 8 | stored.floatChannel << 12 |
-               (desc.invert ? kTextureInvert : 0u) | (isFloat ? kTextureFloat : 0u);
+               (desc.invert ? kTextureInvert : 0u) | (isFloat ? kTextureFloat : 0u) |
+               stored.levelCount << kTextureLevelsShift;
+  node.levels = stored.levels;
+  node.maxAnisotropy = desc.maxAnisotropy;
   node.count = 1;
   scene_.textureNodes.push_back(node);
   return uint(scene_.textureNodes.size() - 1);

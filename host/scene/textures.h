@@ -23,6 +23,7 @@ struct ImageTextureDesc {
   std::string encoding = "sRGB";
   uint wrap = kWrapRepeat;
   uint filter = kTextureBilinear;
+  float maxAnisotropy = 8.0f;  // the EWA filter's longest ellipse over its shortest
   float scale = 1.0f;
   bool invert = false;
   vec4 mapping{1.0f, 1.0f, 0.0f, 0.0f};  // uscale, vscale, udelta, vdelta
@@ -34,6 +35,10 @@ bool parseColorEncoding(const std::string& encoding, double& gamma);
 
 // pbrt-v4's wrap mode names ("repeat", "clamp", "black"); false for anything else.
 bool parseWrapMode(const std::string& name, uint& wrap);
+
+// pbrt-v4's image filter names ("point", "bilinear", "trilinear", "ewa" or "EWA"); false for
+// anything else.
+bool parseTextureFilter(const std::string& name, uint& filter);
 
 // A material's textures where it has none: every parameter its own value.
 inline MaterialTextures noMaterialTextures() {
@@ -79,10 +84,15 @@ class TextureBuilder {
     uint format = kTexel8;
     uint decode = 0;
     uint floatChannel = kFloatChannelFirst;
+    uint levels = 0;      // the MIP map's table of level starts
+    uint levelCount = 1;  // its levels
   };
-  const StoredImage& storeImage(const std::filesystem::path& path, const std::string& encoding);
+  // Images are kept per file, encoding and wrap mode (which the MIP map's resampling reads).
+  const StoredImage& storeImage(const std::filesystem::path& path, const std::string& encoding,
+                                uint wrap);
   StoredImage storeDecoded(const TextureImage& image, const std::filesystem::path& path,
-                           const std::string& encoding);
+                           const std::string& encoding, uint wrap);
+  void storeMipLevels(StoredImage& stored, double gamma, uint wrap);
   uint imageNode(const StoredImage& stored, const ImageTextureDesc& desc, bool isFloat);
   uint decodeTable(double gamma);
   uint composite(std::vector<uint> operands, TextureNode node);
@@ -90,7 +100,7 @@ class TextureBuilder {
   uint stackDepth(uint first) const;
 
   Scene& scene_;
-  std::map<std::tuple<std::string, std::string>, StoredImage> images_;
+  std::map<std::tuple<std::string, std::string, uint>, StoredImage> images_;
   std::map<double, uint> decodeTables_;
 };
 

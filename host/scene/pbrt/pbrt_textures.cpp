@@ -1,5 +1,6 @@
 // pbrt-v4's Texture directive and its textures where materials and shapes use them: built as
 // texture programs (scene/textures.h) where simulated, else their mean value.
+#include <cmath>
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -167,17 +168,21 @@ std::optional<uint> Builder::buildTexture(Texture& t, bool isFloat, const Locati
         }
         if (const Param* f = textureParamOf(t, "filter", ParamType::kString)) {
           const std::string name = f->strings.empty() ? "" : f->strings[0];
-          if (name == "point") {
-            desc.filter = kTexturePoint;
-          } else if (name == "bilinear" || name == "trilinear" || name == "ewa" || name == "EWA") {
-            desc.filter = kTextureBilinear;  // MIP maps are not kept: docs/pbrt-format.md
-          } else {
+          if (!parseTextureFilter(name, desc.filter)) {
             fail(f->location, "Texture \"imagemap\": unknown \"filter\" " + singleQuoted(name) +
                                   " (expected \"point\", \"bilinear\", \"trilinear\" or "
                                   "\"ewa\")");
           }
         }
-        textureParamOf(t, "maxanisotropy", ParamType::kFloat);
+        if (const Param* v = textureParamOf(t, "maxanisotropy", ParamType::kFloat)) {
+          if (!v->numbers.empty()) {
+            desc.maxAnisotropy = static_cast<float>(v->numbers[0]);
+            if (!(desc.maxAnisotropy > 0.0f) || !std::isfinite(desc.maxAnisotropy)) {
+              fail(v->location,
+                   "Texture \"imagemap\": \"maxanisotropy\" must be a positive number");
+            }
+          }
+        }
         if (const Param* v = textureParamOf(t, "scale", ParamType::kFloat)) {
           if (!v->numbers.empty()) desc.scale = static_cast<float>(v->numbers[0]);
         }
