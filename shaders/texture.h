@@ -7,12 +7,9 @@
 // defines textureNodeAt(i), imageWordAt(i), materialTexturesAt(i) and uvsAt(i) over its
 // buffers. PT_TEXTURES_PARAM / PT_TEXTURES_ARG pass the tables in C++ and nothing in GLSL.
 //
-// Where we differ from pbrt-v4: it filters image textures over the ray's footprint (MIP maps,
-// trilinear or EWA, from ray differentials) and its checkerboard over the same footprint; we
-// look up the full-resolution image (bilinear or nearest) and the sharp checkerboard at the
-// hit point. Both converge to the same image where the pixel filter averages many samples over
-// the footprint; at low sample counts ours is noisier where a texture has detail below a pixel
-// (docs/textures.md).
+// Images are filtered over the ray's footprint (UVFootprint, from differentials.h) in their MIP
+// maps (host/scene/mip_pyramid.h) as pbrt-v4's MIPMap::Filter filters them, and the
+// checkerboard over the same footprint (docs/textures.md).
 #ifndef PT_TEXTURE_H
 #define PT_TEXTURE_H
 

@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@ struct Case {
   std::string config;
   RenderSettings settings;
   bool latLong = false;  // the environment image read as a lat-long map
+  std::optional<PixelFilterDesc> filter;  // replaces the scene's pixel filter
 };
 
 // lanes-shading-normals.pbrt with its constant environment replaced by a rotated image
@@ -104,6 +106,12 @@ std::vector<Case> cases(const test::TempDir& dir) {
   variant([](RenderSettings& s) { s.maxDepth = 2; });
   variant([](RenderSettings& s) { s.fastIntersection = true; });
   variant([](RenderSettings& s) { s.seed = 12345u; });
+  // The pixel filters whose camera rays the lanes set up together: a wider box, the triangle
+  // and the gaussian (pbrt-v4's default radii).
+  list.push_back({"cornell-box.json", small, false, PixelFilterDesc{kFilterBox, 1.0f, 0.75f}});
+  list.push_back({"cornell-box.json", small, false, PixelFilterDesc{kFilterTriangle, 2.0f, 2.0f}});
+  list.push_back(
+      {"cornell-box.json", small, false, PixelFilterDesc{kFilterGaussian, 1.5f, 1.5f, 0.5f}});
   return list;
 }
 
@@ -116,9 +124,11 @@ uint32_t bitsOf(float x) {
 TEST(CpuLanes, EqualsTheReferenceBitForBit) {
   const test::TempDir dir;
   for (const Case& c : cases(dir)) {
-    SCOPED_TRACE(c.config + (c.latLong ? " (lat-long)" : ""));
+    SCOPED_TRACE(c.config + (c.latLong ? " (lat-long)" : "") +
+                 (c.filter ? " filter " + std::to_string(c.filter->type) : ""));
     Scene scene = loadScene(kConfigs / c.config);
     if (c.latLong) scene.environment->mapping = kEnvironmentLatLong;
+    if (c.filter) scene.camera.filter = *c.filter;
     const SceneData data = prepareScene(std::move(scene), c.settings);
     if (c.config.find("lanes-environment") != std::string::npos) {
       ASSERT_TRUE(data.effects.environmentImage) << data.effects.toString();

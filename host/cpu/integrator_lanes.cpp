@@ -186,6 +186,60 @@ HWY_INLINE V3 cameraDirection(const Camera& cam, V filmX, V filmY) {
   return hn::Div(splat(1.0f), hn::Sqrt(dot(w, w))) * w;
 }
 
+// The pixel filters' film points (filter.h's sampleFilm for the box, the triangle and the
+// gaussian, whose weights are 1) for all lanes at once, operation for operation: the offset
+// from the pixel's corner along one axis of radius r for uniform numbers u.
+HWY_INLINE V sampleBoxLanes(V u, float r) {
+  return hn::Add(splat(0.5f - r), hn::Mul(splat(2.0f * r), u));
+}
+HWY_INLINE V sampleTentLanes(V u, float r) {
+  const V rv = splat(r);
+  const V left = hn::Sub(hn::Mul(rv, hn::Sqrt(hn::Mul(splat(2.0f), u))), rv);
+  const V right =
+      hn::Sub(rv, hn::Mul(rv, hn::Sqrt(hn::Sub(splat(2.0f), hn::Mul(splat(2.0f), u)))));
+  return hn::Add(splat(0.5f), hn::IfThenElse(hn::Lt(u, splat(0.5f)), left, right));
+}
+HWY_INLINE V filterErfLanes(V x) {
+  const V a = glmMin(hn::Abs(x), splat(6.0f));
+  V p = hn::Mul(a, splat(0.0000430638f));
+  p = hn::Mul(a, hn::Add(splat(0.0002765672f), p));
+  p = hn::Mul(a, hn::Add(splat(0.0001520143f), p));
+  p = hn::Mul(a, hn::Add(splat(0.0092705272f), p));
+  p = hn::Mul(a, hn::Add(splat(0.0422820123f), p));
+  p = hn::Add(splat(1.0f), hn::Mul(a, hn::Add(splat(0.0705230784f), p)));
+  p = hn::Mul(p, p);
+  p = hn::Mul(p, p);
+  p = hn::Mul(p, p);
+  p = hn::Mul(p, p);
+  const V e = hn::Sub(splat(1.0f), hn::Div(splat(1.0f), p));
+  return hn::IfThenElse(hn::Lt(x, hn::Zero(D())), hn::Neg(e), e);
+}
+// The gaussian's bisection (filter.h's sampleFilm) on one axis: radius r, the camera's k and
+// e (filterScale, filterExpX or Y).
+HWY_INLINE V sampleGaussianLanes(V u, float r, float k, float e) {
+  const float erfRadius = filterErf(k * r);
+  const auto cdf = [&](V x) {
+    return hn::Sub(hn::Add(filterErfLanes(hn::Mul(splat(k), x)), splat(erfRadius)),
+                   hn::Mul(splat(e), hn::Add(x, splat(r))));
+  };
+  const V target = hn::Mul(u, splat(gaussianFilterCdf(r, r, k, e, erfRadius)));
+  V lo = splat(-r);
+  V hi = splat(r);
+  for (uint i = 0u; i < kFilterBisectionSteps; ++i) {
+    const V mid = hn::Mul(splat(0.5f), hn::Add(lo, hi));
+    const M below = hn::Lt(cdf(mid), target);
+    lo = hn::IfThenElse(below, mid, lo);
+    hi = hn::IfThenElse(below, hi, mid);
+  }
+  return hn::Add(splat(0.5f), hn::Mul(splat(0.5f), hn::Add(lo, hi)));
+}
+// sampleFilm's point for the lanes' camera (a pinhole with one of the three filters).
+HWY_INLINE V sampleFilmAxisLanes(const Camera& cam, V u, float r, float e) {
+  if (cam.filterType == kFilterTriangle) return sampleTentLanes(u, r);
+  if (cam.filterType == kFilterGaussian) return sampleGaussianLanes(u, r, cam.filterScale, e);
+  return sampleBoxLanes(u, r);
+}
+
 // The wide traversal's first steps for the rays of several lanes at once: RayPrecomputed
 // (traverse.cpp; its six divisions become six vector divisions) and intersectBox against the
 // root's box. Returns the lanes whose ray enters it, their `prepared` filled in for
@@ -368,12 +422,13 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
            wide_traversal::anyHitFromRoot(copies.wide, prepared[i], 1.0f, intersection, f);
   };
 
-  // The box filter of one pixel and a pinhole: the film point is the pixel's corner plus the
-  // uniform numbers (sampleBoxFilter with radius 1/2 adds them exactly), the weight 1, so the
-  // camera rays are set up in lanes. Other filters and the thin lens take filter.h's
-  // generateCameraRay lane by lane.
-  const bool cameraInLanes = camera.filterType == kFilterBox && camera.filterRadiusX == 0.5f &&
-                             camera.filterRadiusY == 0.5f && !(camera.lensRadius > 0.0f);
+  // A pinhole with the box, triangle or gaussian filter (whose samples weigh 1): the camera
+  // rays are set up in lanes (sampleFilmAxisLanes). Mitchell's filter and the thin lens take
+  // filter.h's generateCameraRay lane by lane.
+  const bool cameraInLanes = (camera.filterType == kFilterBox ||
+                              camera.filterType == kFilterTriangle ||
+                              camera.filterType == kFilterGaussian) &&
+                             !(camera.lensRadius > 0.0f);
   Lanes filmX, filmY;
 
   for (;;) {
@@ -407,10 +462,12 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
       drawRandom2(sobol, path, sampleIndex, kDimPixel, seed, starting, filmX, filmY);
       const hn::RebindToSigned<D> di;
       const hn::RebindToUnsigned<D> du;
-      const V x =
-          hn::Add(hn::ConvertTo(D(), hn::BitCast(di, hn::Load(du, path.pixelX))), filmX.load());
-      const V y =
-          hn::Add(hn::ConvertTo(D(), hn::BitCast(di, hn::Load(du, path.pixelY))), filmY.load());
+      const V x = hn::Add(
+          hn::ConvertTo(D(), hn::BitCast(di, hn::Load(du, path.pixelX))),
+          sampleFilmAxisLanes(camera, filmX.load(), camera.filterRadiusX, camera.filterExpX));
+      const V y = hn::Add(
+          hn::ConvertTo(D(), hn::BitCast(di, hn::Load(du, path.pixelY))),
+          sampleFilmAxisLanes(camera, filmY.load(), camera.filterRadiusY, camera.filterExpY));
       Lanes3 direction;
       store(direction, cameraDirection(camera, x, y));
       Lanes filmPointX, filmPointY;
