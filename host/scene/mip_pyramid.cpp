@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "common/check.h"
+#include "common/huge_pages.h"
 
 namespace pt {
 
@@ -58,6 +59,13 @@ int wrapIndex(int p, int size, uint wrap) {
 
 }  // namespace
 
+void FloatImage::reserveValues() {
+  const std::size_t n = std::size_t(width) * std::size_t(height) * std::size_t(channels);
+  values.clear();
+  values.reserve(n);
+  adviseHugePages(values.data(), n * sizeof(float));
+}
+
 bool isPowerOfTwo(int n) {
   return n > 0 && (n & (n - 1)) == 0;
 }
@@ -73,19 +81,21 @@ FloatImage resizeUp(const FloatImage& image, int newWidth, int newHeight, uint w
   const std::vector<ResampleWeight> xWeights = resampleWeights(image.width, newWidth);
   const std::vector<ResampleWeight> yWeights = resampleWeights(image.height, newHeight);
   // Along x, every old row.
-  std::vector<float> rows(std::size_t(image.height) * std::size_t(newWidth) * std::size_t(c));
+  FloatImage rows;
+  rows.width = newWidth;
+  rows.height = image.height;
+  rows.channels = c;
+  rows.reserveValues();
   for (int y = 0; y < image.height; ++y) {
     for (int x = 0; x < newWidth; ++x) {
       const ResampleWeight& w = xWeights[std::size_t(x)];
+      int xi[4];
+      for (int j = 0; j < 4; ++j) xi[j] = wrapIndex(w.firstPixel + j, image.width, wrap);
       for (int ch = 0; ch < c; ++ch) {
         float v[4];
-        for (int j = 0; j < 4; ++j) {
-          const int xi = wrapIndex(w.firstPixel + j, image.width, wrap);
-          v[j] = xi < 0 ? 0.0f : image.at(xi, y, ch);
-        }
-        rows[(std::size_t(y) * std::size_t(newWidth) + std::size_t(x)) * std::size_t(c) +
-             std::size_t(ch)] =
-            w.weight[0] * v[0] + w.weight[1] * v[1] + w.weight[2] * v[2] + w.weight[3] * v[3];
+        for (int j = 0; j < 4; ++j) v[j] = xi[j] < 0 ? 0.0f : image.at(xi[j], y, ch);
+        rows.values.push_back(w.weight[0] * v[0] + w.weight[1] * v[1] + w.weight[2] * v[2] +
+                              w.weight[3] * v[3]);
       }
     }
   }
@@ -94,22 +104,17 @@ FloatImage resizeUp(const FloatImage& image, int newWidth, int newHeight, uint w
   out.width = newWidth;
   out.height = newHeight;
   out.channels = c;
-  out.values.resize(std::size_t(newWidth) * std::size_t(newHeight) * std::size_t(c));
+  out.reserveValues();
   for (int y = 0; y < newHeight; ++y) {
     const ResampleWeight& w = yWeights[std::size_t(y)];
+    int yi[4];
+    for (int j = 0; j < 4; ++j) yi[j] = wrapIndex(w.firstPixel + j, image.height, wrap);
     for (int x = 0; x < newWidth; ++x) {
       for (int ch = 0; ch < c; ++ch) {
         float v[4];
-        for (int j = 0; j < 4; ++j) {
-          const int yi = wrapIndex(w.firstPixel + j, image.height, wrap);
-          v[j] = yi < 0 ? 0.0f
-                        : rows[(std::size_t(yi) * std::size_t(newWidth) + std::size_t(x)) *
-                                   std::size_t(c) +
-                               std::size_t(ch)];
-        }
-        out.values[(std::size_t(y) * std::size_t(newWidth) + std::size_t(x)) * std::size_t(c) +
-                   std::size_t(ch)] = std::max(0.0f, w.weight[0] * v[0] + w.weight[1] * v[1] +
-                                                         w.weight[2] * v[2] + w.weight[3] * v[3]);
+        for (int j = 0; j < 4; ++j) v[j] = yi[j] < 0 ? 0.0f : rows.at(x, yi[j], ch);
+        out.values.push_back(std::max(0.0f, w.weight[0] * v[0] + w.weight[1] * v[1] +
+                                                w.weight[2] * v[2] + w.weight[3] * v[3]));
       }
     }
   }
@@ -132,8 +137,7 @@ std::vector<FloatImage> mipPyramid(FloatImage image, uint wrap) {
     next.width = std::max(1, from.width / 2);
     next.height = std::max(1, from.height / 2);
     next.channels = from.channels;
-    next.values.resize(std::size_t(next.width) * std::size_t(next.height) *
-                       std::size_t(next.channels));
+    next.reserveValues();
     for (int y = 0; y < next.height; ++y) {
       // The 2 x 2 texels; a side of 1 repeats its one texel (pbrt-v4's source offsets).
       const int y0 = 2 * y;
@@ -142,11 +146,9 @@ std::vector<FloatImage> mipPyramid(FloatImage image, uint wrap) {
         const int x0 = 2 * x;
         const int x1 = std::min(2 * x + 1, from.width - 1);
         for (int ch = 0; ch < from.channels; ++ch) {
-          next.values[(std::size_t(y) * std::size_t(next.width) + std::size_t(x)) *
-                          std::size_t(next.channels) +
-                      std::size_t(ch)] = (from.at(x0, y0, ch) + from.at(x1, y0, ch) +
-                                          from.at(x0, y1, ch) + from.at(x1, y1, ch)) /
-                                         4.0f;
+          next.values.push_back((from.at(x0, y0, ch) + from.at(x1, y0, ch) + from.at(x0, y1, ch) +
+                                 from.at(x1, y1, ch)) /
+                                4.0f);
         }
       }
     }

@@ -18,6 +18,10 @@ struct FloatImage {
   int channels = 0;
   std::vector<float> values;  // width * height * channels
 
+  // Empties values and reserves room for width * height * channels (advised for huge pages),
+  // for the producer to push them in order.
+  void reserveValues();
+
   float at(int x, int y, int c) const {
     return values[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * std::size_t(channels) +
                   std::size_t(c)];

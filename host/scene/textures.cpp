@@ -1,6 +1,7 @@
 #include "scene/textures.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -36,17 +37,22 @@ double decodeEncoded(double c, double gamma) {
   return gamma == 0.0 ? srgbDecode(c) : std::pow(c, gamma);
 }
 
-// A linear value encoded to a byte, as pbrt-v4 stores its 8-bit MIP levels: sRGB (gamma 0)
-// rounded in the encoded domain, 0 and 255 beyond [0, 1]; a power gamma likewise.
-uint encodeByte(float v, double gamma) {
-  if (!(v > 0.0f)) return 0u;
-  if (v >= 1.0f) return 255u;
-  const double x = double(v);
-  const double e = gamma == 0.0
-                       ? (x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055)
-                       : std::pow(x, 1.0 / gamma);
-  return uint(std::clamp(std::round(255.0 * e), 0.0, 255.0));
-}
+// A linear value encoded to a byte, as pbrt-v4 stores its 8-bit MIP levels: rounded in the
+// encoded domain (sRGB, gamma 0, or the power gamma), 0 and 255 beyond [0, 1]. The byte is the
+// number of thresholds at or below v: thresholds[b - 1] is where round(255 encode(v)) reaches
+// b, the linear value of the encoded (b - 1/2) / 255.
+struct ByteEncoder {
+  std::array<float, 255> thresholds{};
+  explicit ByteEncoder(double gamma) {
+    for (int b = 1; b <= 255; ++b) {
+      thresholds[std::size_t(b - 1)] = float(decodeEncoded((b - 0.5) / 255.0, gamma));
+    }
+  }
+  uint operator()(float v) const {
+    if (!(v > 0.0f)) return 0u;
+    return uint(std::upper_bound(thresholds.begin(), thresholds.end(), v) - thresholds.begin());
+  }
+};
 
 }  // namespace
 
@@ -208,7 +214,7 @@ TextureBuilder::StoredImage TextureBuilder::storeDecoded(const TextureImage& ima
       scene_.imageWords.push_back(floatWord(v));
     }
   }
-  storeMipLevels(stored, gamma, wrap);
+  storeMipLevels(stored, int(c), gamma, wrap);
   return stored;
 }
 
@@ -216,28 +222,27 @@ TextureBuilder::StoredImage TextureBuilder::storeDecoded(const TextureImage& ima
 // in the same format (8-bit levels encoded as the image is, as pbrt-v4 keeps them), then the
 // table of where each level starts. An image whose sides are powers of two keeps its texels
 // as level 0; another's level 0 is its resampled image.
-void TextureBuilder::storeMipLevels(StoredImage& stored, double gamma, uint wrap) {
+void TextureBuilder::storeMipLevels(StoredImage& stored, int channels, double gamma, uint wrap) {
   const bool eightBit = stored.format == kTexel8;
   FloatImage image;
   image.width = int(stored.width);
   image.height = int(stored.height);
-  image.channels = eightBit                        ? 4
-                   : stored.format == kTexelFloat1 ? 1
-                   : stored.format == kTexelFloat3 ? 3
-                                                   : 4;
+  // The channels the image has (an 8-bit grey or RGB image's words repeat grey and hold an
+  // alpha of 255, which its levels repeat likewise).
+  image.channels = channels;
+  image.reserveValues();
   const std::size_t texels = std::size_t(stored.width) * std::size_t(stored.height);
-  image.values.resize(texels * std::size_t(image.channels));
   for (std::size_t i = 0; i < texels; ++i) {
     if (eightBit) {
       const uint w = scene_.imageWords[stored.texels + i];
-      for (int c = 0; c < 4; ++c) {
-        image.values[4 * i + std::size_t(c)] =
-            uintToFloat(scene_.imageWords[stored.decode + ((w >> (8 * c)) & 0xFFu)]);
+      for (int c = 0; c < channels; ++c) {
+        image.values.push_back(
+            uintToFloat(scene_.imageWords[stored.decode + ((w >> (8 * c)) & 0xFFu)]));
       }
     } else {
-      for (int c = 0; c < image.channels; ++c) {
-        const std::size_t at = i * std::size_t(image.channels) + std::size_t(c);
-        image.values[at] = uintToFloat(scene_.imageWords[stored.texels + at]);
+      for (int c = 0; c < channels; ++c) {
+        image.values.push_back(uintToFloat(
+            scene_.imageWords[stored.texels + i * std::size_t(channels) + std::size_t(c)]));
       }
     }
   }
@@ -245,21 +250,25 @@ void TextureBuilder::storeMipLevels(StoredImage& stored, double gamma, uint wrap
   std::vector<FloatImage> pyramid = mipPyramid(std::move(image), wrap);
   std::size_t words = pyramid.size();
   for (std::size_t level = resized ? 0 : 1; level < pyramid.size(); ++level) {
-    words += pyramid[level].values.size() / (eightBit ? 4 : 1);
+    words += pyramid[level].values.size() / (eightBit ? std::size_t(channels) : 1);
   }
   if (scene_.imageWords.size() + words > std::size_t(UINT32_MAX)) {
     throw InputError("the scene's images and their MIP maps exceed 2^32 words (16 GiB)");
   }
   reserveGeometric(scene_.imageWords, scene_.imageWords.size() + words);
   std::vector<uint> starts(pyramid.size(), stored.texels);
+  const ByteEncoder encode(gamma);
   for (std::size_t level = resized ? 0 : 1; level < pyramid.size(); ++level) {
     const FloatImage& l = pyramid[level];
     starts[level] = uint(scene_.imageWords.size());
     if (eightBit) {
-      for (std::size_t i = 0; i < l.values.size(); i += 4) {
-        scene_.imageWords.push_back(
-            encodeByte(l.values[i], gamma) | encodeByte(l.values[i + 1], gamma) << 8 |
-            encodeByte(l.values[i + 2], gamma) << 16 | encodeByte(l.values[i + 3], gamma) << 24);
+      const std::size_t c = std::size_t(channels);
+      for (std::size_t i = 0; i < l.values.size(); i += c) {
+        const uint r = encode(l.values[i]);
+        const uint g = c >= 3 ? encode(l.values[i + 1]) : r;
+        const uint b = c >= 3 ? encode(l.values[i + 2]) : r;
+        const uint a = c == 4 ? encode(l.values[i + 3]) : 255u;
+        scene_.imageWords.push_back(r | g << 8 | b << 16 | a << 24);
       }
     } else {
       for (float v : l.values) scene_.imageWords.push_back(floatWord(v));

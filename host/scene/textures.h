@@ -92,7 +92,8 @@ class TextureBuilder {
                                 uint wrap);
   StoredImage storeDecoded(const TextureImage& image, const std::filesystem::path& path,
                            const std::string& encoding, uint wrap);
-  void storeMipLevels(StoredImage& stored, double gamma, uint wrap);
+  // channels: the image's own (1, 3 or 4).
+  void storeMipLevels(StoredImage& stored, int channels, double gamma, uint wrap);
   uint imageNode(const StoredImage& stored, const ImageTextureDesc& desc, bool isFloat);
   uint decodeTable(double gamma);
   uint composite(std::vector<uint> operands, TextureNode node);
