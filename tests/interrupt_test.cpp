@@ -402,6 +402,28 @@ TEST(ResumeVulkan, ToMoreSamplesContinuesTheSameSequence) {
   checkContinueToMoreSamples("vulkan");
 }
 
+// Where textures read the ray's footprint, its scale follows the samples per pixel (pbrt-v4's
+// max(1/8, 1/sqrt(spp))): a state continued to a target of another scale is refused, naming
+// it; from 64 spp on the scale is 1/8, and such a state continues to more samples.
+TEST(Resume, TexturedStatesKeepTheirDifferentialScale) {
+  test::TempDir dir;
+  const std::string common =
+      "render " + config("textured-sky.json") + " --backend cpu --width 12 --height 8";
+  const std::string low = (dir / "low.ptstate").string();
+  ASSERT_EQ(runPt(common + " --spp 4 --checkpoint " + low).status, 0);
+  const PtResult refused = runPt(common + " --spp 9 --resume " + low);
+  EXPECT_EQ(refused.status, 2) << refused.err;
+  EXPECT_NE(refused.err.find("differential_scale 0.5 vs 0.333333343"), std::string::npos)
+      << refused.err;
+  const std::string high = (dir / "high.ptstate").string();
+  ASSERT_EQ(runPt(common + " --spp 64 --checkpoint " + high).status, 0);
+  ASSERT_EQ(
+      runPt(common + " --spp 72 --resume " + high + " --out " + (dir / "a.pfm").string()).status,
+      0);
+  ASSERT_EQ(runPt(common + " --spp 72 --out " + (dir / "b.pfm").string()).status, 0);
+  expectSameFile(dir / "a.pfm", dir / "b.pfm");
+}
+
 // ---- Slices and merge -----------------------------------------------------------------------
 
 // Four slices by task index (two of them through Slurm's variable), merged in every order (a

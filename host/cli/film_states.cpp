@@ -110,6 +110,13 @@ KeyValues imageSettings(const SceneData& data, const RenderSettings& settings,
   if (!data.lightBvh.empty()) {
     s.emplace_back("light_sampler", std::string(nameOf(kLightSamplerNames, kLightSamplerBvh)));
   }
+  // Ray differentials' scale (pbrt-v4's, from the samples per pixel) where textures read the
+  // footprint: samples of another scale filter textures otherwise.
+  if (p.footprints != 0u) {
+    char scale[32];
+    std::snprintf(scale, sizeof scale, "%.9g", double(p.differentialScale));
+    s.emplace_back("differential_scale", std::string(scale));
+  }
   s.insert(s.end(), backendExtra.begin(), backendExtra.end());
   return s;
 }
