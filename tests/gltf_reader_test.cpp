@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/check.h"
+#include "image/image.h"
 #include "scene/gltf/gltf_scene.h"
 #include "scene/load_scene.h"
 #include "tests/gltf_builder.h"
@@ -59,8 +60,11 @@ TEST(GltfReader, OneTriangleWithDefaultMaterialCameraAndSky) {
   expectNear(s.triangles[0].v2, vec3(0, 1, 0));
   // The specification's default material: metallic 1, roughness 1, base colour 1.
   ASSERT_EQ(s.materials.size(), 1u);
-  EXPECT_EQ(s.materials[0].type, kMaterialConductor);
-  EXPECT_FLOAT_EQ(s.materials[0].alphaX, 1.0f);
+  EXPECT_EQ(s.materials[0].type, kMaterialGltf);
+  EXPECT_EQ(s.materials[0].thickness, 1.0f);
+  EXPECT_EQ(s.materials[0].alphaX, 1.0f);
+  EXPECT_EQ(s.materials[0].reflectance, vec3(1.0f));
+  EXPECT_EQ(s.materials[0].eta.x, 1.5f);
   // No light of its own: the white sky.
   ASSERT_EQ(s.lights.size(), 1u);
   EXPECT_EQ(s.lights[0].type, kLightInfinite);
@@ -309,7 +313,7 @@ TEST(GltfReader, PerspectiveCameraOfTheFirstNodeOrTheOneNamed) {
             "test.gltf: cameras: --camera 7 out of range (the file has 2 cameras)");
 }
 
-TEST(GltfReader, MaterialsMapOntoConductorAndCoatedDiffuse) {
+TEST(GltfReader, MaterialFactorsAndExtensions) {
   GltfBuilder b = oneTriangle();
   b.doc["materials"] = json::array(
       {{{"pbrMetallicRoughness",
@@ -331,14 +335,18 @@ TEST(GltfReader, MaterialsMapOntoConductorAndCoatedDiffuse) {
   const Scene s = read(b.gltf());
   ASSERT_EQ(s.materials.size(), 2u);
   const Material& dielectric = s.materials[0];
-  EXPECT_EQ(dielectric.type, kMaterialCoatedDiffuse);
+  EXPECT_EQ(dielectric.type, kMaterialGltf);
   expectNear(dielectric.reflectance, vec3(0.8f, 0.4f, 0.2f));
   EXPECT_FLOAT_EQ(dielectric.eta.x, 1.4f);
   EXPECT_FLOAT_EQ(dielectric.alphaX, 0.25f);
+  EXPECT_FLOAT_EQ(dielectric.alphaY, 0.25f);
+  EXPECT_EQ(dielectric.thickness, 0.0f);
   expectNear(dielectric.emission, vec3(1, 0.5f, 0));
   EXPECT_EQ(dielectric.twoSided, 1u);
   const Material& metal = s.materials[1];
-  EXPECT_EQ(metal.type, kMaterialConductor);
+  EXPECT_EQ(metal.type, kMaterialGltf);
+  EXPECT_EQ(metal.thickness, 1.0f);
+  expectNear(metal.reflectance, vec3(0.9f));
   EXPECT_FLOAT_EQ(metal.alphaX, 0.04f);
   expectNear(metal.emission, vec3(0, 0, 3));
   EXPECT_EQ(metal.twoSided, 0u);
@@ -461,6 +469,28 @@ TEST(GltfReader, UnparsableFilesGiveOneLineNamingTheFile) {
     EXPECT_EQ(e.rfind("test.gltf: ", 0), 0u) << e;
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
   }
+}
+
+TEST(GltfReader, EnvironmentImageReplacesTheSky) {
+  const test::TempDir dir;
+  Image sky;
+  sky.width = 8;
+  sky.height = 4;
+  sky.pixels.assign(32, vec3(0.5f, 0.25f, 2.0f));
+  sky.pixels[3] = vec3(-1.0f);  // negative radiance is no radiance
+  const auto file = dir / "sky.pfm";
+  writeImage(sky, file);
+  GltfBuilder b = oneTriangle();
+  b.node({{"mesh", 0}});
+  const Scene s = read(b.gltf(), SceneLoadOptions{.environment = file.string()});
+  EXPECT_TRUE(s.lights.empty());
+  ASSERT_TRUE(s.environment.has_value());
+  EXPECT_EQ(s.environment->mapping, kEnvironmentLatLong);
+  EXPECT_EQ(s.environment->image.width, 8);
+  EXPECT_EQ(s.environment->image.pixels[0], vec3(0.5f, 0.25f, 2.0f));
+  EXPECT_EQ(s.environment->image.pixels[3], vec3(0.0f));
+  const std::string missing = (dir / "none.exr").string();
+  EXPECT_EQ(errorOf(b.gltf(), SceneLoadOptions{.environment = missing}).rfind(missing, 0), 0u);
 }
 
 TEST(GltfReader, CommandLineRendersAGltfAndRefusesABadOneWithStatus2) {

@@ -38,8 +38,9 @@ struct RenderArgs {
   std::string device;
   bool validation = false;
   bool noSpecialize = false;
-  bool strict = false;     // pbrt-v4 and glTF files: warnings are errors
-  std::string camera;      // glTF files: the camera, by index or name
+  bool strict = false;      // pbrt-v4 and glTF files: warnings are errors
+  std::string camera;       // glTF files: the camera, by index or name
+  std::string environment;  // glTF files: an environment image
   std::string debugPixel;  // "X,Y"
   SceneOverrides overrides;
   std::optional<int> spp;
@@ -135,8 +136,9 @@ int runRender(const RenderArgs& args) {
   if (!args.resume.empty()) resumed = readFilmState(args.resume);
 
   const auto loadStart = std::chrono::steady_clock::now();
-  Scene scene =
-      loadScene(args.scene, SceneLoadOptions{.strict = args.strict, .camera = args.camera});
+  Scene scene = loadScene(args.scene, SceneLoadOptions{.strict = args.strict,
+                                                       .camera = args.camera,
+                                                       .environment = args.environment});
   const double loadSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
@@ -464,6 +466,9 @@ int main(int argc, char** argv) {
   render->add_option("--camera", r.camera,
                      "glTF files: the camera to render from, by index in the file's cameras or "
                      "by name (default: the first the scene places)");
+  render->add_option("--env", r.environment,
+                     "glTF files: an environment image (.exr, .pfm or .png; latitude-longitude, "
+                     "+y up) to light the model (default: a white sky where it has no light)");
   render->add_option("--spp", r.spp, "Samples per pixel (default: the scene's)")->check(kPositive);
   render->add_option("--threads", r.threads, "CPU threads (default: all)")->check(kPositive);
   render

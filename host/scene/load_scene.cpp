@@ -13,9 +13,10 @@ Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& optio
   if (path.extension() == ".gltf" || path.extension() == ".glb") {
     return loadGltfScene(path, options);  // docs/gltf.md
   }
-  if (!options.camera.empty()) {
+  if (!options.camera.empty() || !options.environment.empty()) {
     scene_detail::throwInputError(path.string(), "",
-                                  "--camera picks a camera of a glTF file; this is not one");
+                                  std::string(options.camera.empty() ? "--env" : "--camera") +
+                                      " is for glTF files; this is not one");
   }
   return loadJsonScene(path);
 }

@@ -101,29 +101,15 @@ Material readMaterial(const tinygltf::Model& model, int index, Context& context)
                          "not simulated (the material renders without it)");
       }
     }
-    if (metallic > 0.0 && metallic < 1.0) {
-      context.warnOnce("metallic", pbrPath + ".metallicFactor",
-                       scene_detail::formatNumber(metallic) +
-                           ": a mix of metal and dielectric is not simulated yet; rendered as "
-                           "the nearer of the two");
-    }
   }
+  // Material's fields for glTF's material: shaders/bsdf.h (kMaterialGltf).
+  Material out{};
+  out.type = kMaterialGltf;
+  out.reflectance = baseColour;
+  out.eta = vec3(float(ior), 0.0f, 0.0f);
   const float alpha = float(roughness * roughness);
-  Material out;
-  if (metallic >= 0.5) {
-    out = defaultMaterial(kMaterialConductor);
-    setConductorReflectance(out, baseColour);
-  } else {
-    out = defaultMaterial(kMaterialCoatedDiffuse);
-    out.reflectance = baseColour;
-    // KHR_materials_ior's 0 is the limit of a very high index (a mirror-like coat); 1 no coat.
-    out.eta = vec3(float(ior == 0.0 ? 1e4 : ior), 0.0f, 0.0f);
-    // Nothing between coat and base: no albedo, and a thickness whose transmittance is 1 to
-    // within float rounding (pbrt-v4 attenuates by exp(-thickness / cos) even without albedo).
-    out.transmittance = vec3(0.0f);
-    out.thickness = 1e-7f;
-  }
   setRoughness(out, alpha, alpha, false);
+  out.thickness = float(metallic);
   out.emission = emission;
   out.twoSided = doubleSided ? 1u : 0u;
   return out;

@@ -1,9 +1,7 @@
-// glTF materials as the renderer's materials. The metallic-roughness model is mapped onto
-// pbrt-v4's materials (docs/gltf.md): metallic >= 0.5 a conductor of the base colour's
-// reflectance, otherwise a coated diffuse surface (the dielectric specular layer of index `ior`
-// over a Lambertian base of the base colour), Trowbridge-Reitz alpha = roughness^2 for both.
-// What this mapping does not simulate (textures, fractional metallic, alpha, extensions) is
-// warned, once per kind.
+// glTF materials as the renderer's kMaterialGltf (shaders/bsdf.h: the specification's
+// metallic-roughness model), from their factors, KHR_materials_ior and
+// KHR_materials_emissive_strength. What is not simulated (textures, alpha modes, other
+// extensions) is warned, once per kind.
 #pragma once
 
 #include <cstddef>

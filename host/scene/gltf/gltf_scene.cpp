@@ -3,10 +3,12 @@
 // (gltf_materials.h), the camera (gltf_camera.h).
 #include "scene/gltf/gltf_scene.h"
 
+#include <cmath>
 #include <map>
 #include <string>
 #include <utility>
 
+#include "image/image.h"
 #include "scene/gltf/gltf_camera.h"
 #include "scene/gltf/gltf_context.h"
 #include "scene/gltf/gltf_document.h"
@@ -42,6 +44,22 @@ void warnUnsimulated(const tinygltf::Model& model, Context& context) {
   }
 }
 
+// --env: a latitude-longitude image, +y up as glTF's world is. Errors name the image's file.
+EnvironmentImage readEnvironment(const std::filesystem::path& path) {
+  EnvironmentImage env;
+  env.file = path.string();
+  env.image = readImage(path);
+  env.mapping = kEnvironmentLatLong;
+  for (vec3& c : env.image.pixels) {
+    if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) {
+      scene_detail::throwInputError(env.file, "",
+                                    "infinite or not-a-number pixels, no use as a light");
+    }
+    c = glm::max(c, vec3(0.0f));
+  }
+  return env;
+}
+
 Scene build(const tinygltf::Model& model, const std::string& file,
             const SceneLoadOptions& options) {
   Scene scene;
@@ -74,8 +92,12 @@ Scene build(const tinygltf::Model& model, const std::string& file,
   }
   if (scene.triangles.empty()) context.fail("scene", "the scene has no triangles to render");
   setCamera(model, nodes, options.camera, scene, context);
-  // glTF has no environment: a scene without a light of its own is lit as viewers light it, by a
-  // uniform white sky (radiance 1).
+  // glTF has no environment: --env gives one, and a scene without a light of its own is lit as
+  // viewers light it, by a uniform white sky (radiance 1).
+  if (!options.environment.empty()) {
+    scene.environment = readEnvironment(options.environment);
+    return scene;
+  }
   bool emits = false;
   for (const Material& m : scene.materials) {
     emits = emits || m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f;
