@@ -471,6 +471,49 @@ TEST(GltfReader, UnparsableFilesGiveOneLineNamingTheFile) {
   }
 }
 
+TEST(GltfReader, PunctualLightsAtTheirNodesShiningAlongMinusZ) {
+  GltfBuilder b = oneTriangle();
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
+      json::array({{{"type", "point"}, {"color", {1.0, 0.5, 0.25}}, {"intensity", 8.0}},
+                   {{"type", "spot"},
+                    {"intensity", 2.0},
+                    {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.5}}}},
+                   {{"type", "directional"}, {"intensity", 3.0}}});
+  const double h = std::sqrt(0.5);
+  b.node({{"mesh", 0}});
+  const int point = b.node(
+      {{"translation", {1, 2, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  // The spot turned 90 degrees about x: its -z to -y (shining down), under a parent's offset.
+  const int spot = b.node({{"translation", {0, 5, 0}},
+                           {"rotation", {-h, 0, 0, h}},
+                           {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
+  const int parent = b.node({{"translation", {10, 0, 0}}, {"children", {spot}}});
+  const int sun = b.node(
+      {{"rotation", {-h, 0, 0, h}}, {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
+  b.scene({0, point, parent, sun});
+  const Scene s = read(b.gltf());
+  EXPECT_TRUE(s.warnings.empty());
+  ASSERT_EQ(s.lights.size(), 3u);  // and no sky
+  EXPECT_EQ(s.lights[0].type, kLightPoint);
+  expectNear(s.lights[0].position, vec3(1, 2, 3));
+  expectNear(s.lights[0].radiance, vec3(8, 4, 2));
+  EXPECT_EQ(s.lights[1].type, kLightSpot);
+  expectNear(s.lights[1].position, vec3(10, 5, 0));
+  expectNear(s.lights[1].direction, vec3(0, -1, 0));
+  expectNear(s.lights[1].radiance, vec3(2));
+  EXPECT_FLOAT_EQ(s.lights[1].cosFalloffStart, std::cos(0.2f));
+  EXPECT_FLOAT_EQ(s.lights[1].cosFalloffEnd, std::cos(0.5f));
+  // A distant light's direction points towards the light: up, for a sun shining down.
+  EXPECT_EQ(s.lights[2].type, kLightDistant);
+  expectNear(s.lights[2].direction, vec3(0, 1, 0));
+  expectNear(s.lights[2].radiance, vec3(3));
+  b.doc["nodes"][point]["extensions"]["KHR_lights_punctual"]["light"] = 7;
+  EXPECT_EQ(errorOf(b.gltf()),
+            "test.gltf: nodes[1].extensions.KHR_lights_punctual.light: light 7 out of range (the "
+            "file has 3)");
+}
+
 TEST(GltfReader, EnvironmentImageReplacesTheSky) {
   const test::TempDir dir;
   Image sky;

@@ -12,6 +12,7 @@
 #include "scene/gltf/gltf_camera.h"
 #include "scene/gltf/gltf_context.h"
 #include "scene/gltf/gltf_document.h"
+#include "scene/gltf/gltf_lights.h"
 #include "scene/gltf/gltf_materials.h"
 #include "scene/gltf/gltf_meshes.h"
 #include "scene/gltf/gltf_nodes.h"
@@ -25,7 +26,8 @@ using namespace gltf;
 
 // Extensions of the file that the reader reads, in part or whole (docs/gltf.md).
 bool isReadExtension(const std::string& name) {
-  return name == "KHR_materials_emissive_strength" || name == "KHR_materials_ior";
+  return name == "KHR_materials_emissive_strength" || name == "KHR_materials_ior" ||
+         name == "KHR_lights_punctual";
 }
 
 void warnUnsimulated(const tinygltf::Model& model, Context& context) {
@@ -92,6 +94,7 @@ Scene build(const tinygltf::Model& model, const std::string& file,
   }
   if (scene.triangles.empty()) context.fail("scene", "the scene has no triangles to render");
   setCamera(model, nodes, options.camera, scene, context);
+  addPunctualLights(model, nodes, scene, context);
   // glTF has no environment: --env gives one, and a scene without a light of its own is lit as
   // viewers light it, by a uniform white sky (radiance 1).
   if (!options.environment.empty()) {
