@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstdint>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,7 @@
 #include "scene/load_scene.h"
 #include "tests/gltf_builder.h"
 #include "tests/test_util.h"
+#include "texture.h"
 
 namespace pt {
 namespace {
@@ -512,6 +515,65 @@ TEST(GltfReader, PunctualLightsAtTheirNodesShiningAlongMinusZ) {
   EXPECT_EQ(errorOf(b.gltf()),
             "test.gltf: nodes[1].extensions.KHR_lights_punctual.light: light 7 out of range (the "
             "file has 3)");
+}
+
+// A 2 x 2 base colour texture: red, green (top row), blue, white; read from a data URI and from
+// a buffer view, times the factor, its v axis flipped to the renderer's, KHR_texture_transform's
+// offset and scale applied.
+TEST(GltfReader, BaseColorTextureTimesFactorFromDataUriAndBufferView) {
+  const test::TempDir dir;
+  Image texels(2, 2);
+  texels.at(0, 0) = vec3(1, 0, 0);
+  texels.at(1, 0) = vec3(0, 1, 0);
+  texels.at(0, 1) = vec3(0, 0, 1);
+  texels.at(1, 1) = vec3(1, 1, 1);
+  writeImage(texels, dir / "t.png");
+  std::ifstream in(dir / "t.png", std::ios::binary);
+  const std::vector<std::uint8_t> png((std::istreambuf_iterator<char>(in)),
+                                      std::istreambuf_iterator<char>());
+  GltfBuilder b = oneTriangle();
+  b.doc["images"] =
+      json::array({{{"uri", "data:image/png;base64," + test::base64(png)}},
+                   {{"bufferView", b.view(png.data(), png.size())}, {"mimeType", "image/png"}}});
+  b.doc["samplers"] = json::array({{{"wrapS", 33071}, {"wrapT", 33071}}});
+  b.doc["textures"] = json::array({{{"source", 0}, {"sampler", 0}}, {{"source", 1}}});
+  const auto material = [](int texture, json extensions) {
+    json info = {{"index", texture}};
+    if (!extensions.is_null()) info["extensions"] = extensions;
+    return json{{"pbrMetallicRoughness",
+                 {{"baseColorFactor", {0.5, 1.0, 0.25, 1.0}}, {"baseColorTexture", info}}}};
+  };
+  b.doc["materials"] =
+      json::array({material(0, nullptr), material(1, nullptr),
+                   material(1, {{"KHR_texture_transform", {{"offset", {0.5, 0.0}}}}}),
+                   material(1, {{"KHR_texture_transform", {{"scale", {2.0, 2.0}}}}})});
+  for (int m = 0; m < 4; ++m) {
+    b.doc["meshes"].push_back(b.doc["meshes"][0]);
+    b.doc["meshes"][m + 1]["primitives"][0]["material"] = m;
+    b.node({{"mesh", m + 1}, {"translation", {0, 0, m}}});
+  }
+  const Scene s = read(b.gltf());
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+  ASSERT_EQ(s.materialTextures.size(), 4u);
+  const TextureTables tables{s.textureNodes.data(), s.imageWords.data(), nullptr, nullptr};
+  // glTF's (u, v) is the renderer's (u, 1 - v).
+  const auto at = [&](int m, float u, float v) {
+    return evalTexture(tables, s.materialTextures[std::size_t(m)].reflectance, vec2(u, 1.0f - v));
+  };
+  const vec3 factor(0.5f, 1.0f, 0.25f);
+  for (int m : {0, 1}) {
+    SCOPED_TRACE(m);
+    expectNear(at(m, 0.25f, 0.25f), factor * vec3(1, 0, 0), 1e-6f);  // top left
+    expectNear(at(m, 0.75f, 0.25f), factor * vec3(0, 1, 0), 1e-6f);
+    expectNear(at(m, 0.25f, 0.75f), factor * vec3(0, 0, 1), 1e-6f);
+  }
+  EXPECT_EQ((s.textureNodes[s.materialTextures[0].reflectance].flags >> 4u) & 15u, kWrapClamp);
+  EXPECT_EQ((s.textureNodes[s.materialTextures[1].reflectance].flags >> 4u) & 15u, kWrapRepeat);
+  // Offset (0.5, 0): u 0.25 reads u 0.75; scale 2: (0.125, 0.125) reads (0.25, 0.25), a texel's
+  // centre (bilinear filtering blends nothing in there).
+  expectNear(at(2, 0.25f, 0.25f), factor * vec3(0, 1, 0), 1e-6f);
+  expectNear(at(3, 0.125f, 0.125f), factor * vec3(1, 0, 0), 1e-6f);
+  expectNear(at(3, 0.125f, 0.375f), factor * vec3(0, 0, 1), 1e-6f);
 }
 
 TEST(GltfReader, EnvironmentImageReplacesTheSky) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "image/image.h"
 #include "render/prepare.h"
 #include "render_compare.h"
 #include "scene/gltf/gltf_scene.h"
@@ -74,16 +75,30 @@ TEST(GltfRender, MetallicRoughnessGridAgreesOnBothBackends) {
           {{"mesh", mesh}, {"translation", {2.2 * double(c) - 3.3, 2.2 * double(r) - 2.2, 0.0}}}));
     }
   }
-  // A grey rough dielectric floor, and a lamp above.
+  // A rough dielectric floor with a base colour texture (a 2 x 2 checkerboard PNG repeated 8
+  // times by KHR_texture_transform), and a lamp above.
   const int quad =
       b.floats({-10, -1.2f, -10, -10, -1.2f, 10, 10, -1.2f, 10, 10, -1.2f, -10}, "VEC3", 3);
   const std::vector<std::uint16_t> quadIndices = {0, 1, 2, 0, 2, 3};
   const int qi = b.accessor(b.view(quadIndices), GltfBuilder::kUShort, 6, "SCALAR");
+  const test::TempDir dir;
+  Image checker(2, 2);
+  checker.at(0, 0) = checker.at(1, 1) = vec3(0.8f, 0.7f, 0.6f);
+  checker.at(1, 0) = checker.at(0, 1) = vec3(0.1f, 0.2f, 0.3f);
+  writeImage(checker, dir / "checker.png");
+  b.doc["images"] = json::array({{{"uri", (dir / "checker.png").string()}}});
+  b.doc["textures"] = json::array({{{"source", 0}}});
   b.doc["materials"].push_back(
-      {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.5}}}});
-  roots.push_back(b.node({{"mesh", b.mesh(json::array({{{"attributes", {{"POSITION", quad}}},
-                                                        {"indices", qi},
-                                                        {"material", 12}}}))}}));
+      {{"pbrMetallicRoughness",
+        {{"metallicFactor", 0.0},
+         {"roughnessFactor", 0.5},
+         {"baseColorTexture",
+          {{"index", 0}, {"extensions", {{"KHR_texture_transform", {{"scale", {8.0, 8.0}}}}}}}}}}});
+  const int quadUvs = b.floats({0, 0, 0, 1, 1, 1, 1, 0}, "VEC2", 2);
+  roots.push_back(b.node(
+      {{"mesh", b.mesh(json::array({{{"attributes", {{"POSITION", quad}, {"TEXCOORD_0", quadUvs}}},
+                                     {"indices", qi},
+                                     {"material", 12}}}))}}));
   b.doc["materials"].push_back(
       {{"emissiveFactor", {1, 1, 1}},
        {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}}}}});
@@ -102,6 +117,7 @@ TEST(GltfRender, MetallicRoughnessGridAgreesOnBothBackends) {
   EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
   const SceneData data = prepareScene(std::move(scene), RenderSettings{.width = 48, .height = 36});
   EXPECT_NE(data.effects.toString().find("gltf"), std::string::npos) << data.effects.toString();
+  EXPECT_NE(data.effects.toString().find("textures"), std::string::npos);
   const Comparison cmp = renderBoth(data, 8);
   expectAgreement(cmp);
 }

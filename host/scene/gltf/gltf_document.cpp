@@ -11,9 +11,15 @@ namespace pt::gltf {
 
 namespace {
 
-// Images stay undecoded: tinygltf is told they were read.
-bool keepImageUndecoded(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                        const unsigned char*, int, void*) {
+// Images stay undecoded: the bytes of a file or data URI are kept as they are (as_is), for the
+// texture reader (gltf_textures.h) to decode. Those of a buffer view are not copied: tinygltf
+// hands them over unchecked against the buffer, and the texture reader reads them itself.
+bool keepImageBytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                    const unsigned char* bytes, int size, void*) {
+  if (image->bufferView < 0 && bytes != nullptr && size > 0) {
+    image->image.assign(bytes, bytes + size);
+    image->as_is = true;
+  }
   return true;
 }
 
@@ -30,7 +36,7 @@ std::string oneLine(std::string text) {
 
 tinygltf::Model parseDocument(const std::string& bytes, const std::filesystem::path& path) {
   tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(keepImageUndecoded, nullptr);
+  loader.SetImageLoader(keepImageBytes, nullptr);
   tinygltf::Model model;
   std::string err, warn;
   const std::string baseDir = path.parent_path().string();

@@ -9,8 +9,8 @@
 namespace pt::gltf {
 
 // Reads and parses `path` and every buffer it references. Throws InputError "<file>: <what
-// tinygltf found>" for a file it cannot parse. Images are left undecoded (their bytes, where
-// tinygltf holds them, are not used: the material reader finds them itself).
+// tinygltf found>" for a file it cannot parse. Images are left undecoded: an image file's or
+// data URI's bytes as they are in Image::image (as_is), a buffer view's where they are.
 tinygltf::Model readDocument(const std::filesystem::path& path);
 
 // The same for `bytes` given as the content of `path` (which need not exist; external buffers

@@ -50,7 +50,8 @@ double extensionNumber(const tinygltf::Value& object, const char* key, double fa
 void warnTexture(int index, const std::string& where, Context& context) {
   if (index < 0) return;
   context.warnOnce("texture", where,
-                   "textures are not simulated yet: the material's factors alone are used");
+                   "textures other than the base colour's are not simulated yet: the "
+                   "material's factors are used");
 }
 
 }  // namespace
@@ -82,7 +83,7 @@ Material readMaterial(const tinygltf::Model& model, int index, Context& context)
       context.warnOnce("alpha", path + ".alphaMode",
                        m.alphaMode + " is not simulated yet: the surface is rendered opaque");
     }
-    warnTexture(pbr.baseColorTexture.index, pbrPath + ".baseColorTexture", context);
+    // baseColorTexture: gltf_textures.h.
     warnTexture(pbr.metallicRoughnessTexture.index, pbrPath + ".metallicRoughnessTexture", context);
     warnTexture(m.normalTexture.index, path + ".normalTexture", context);
     warnTexture(m.emissiveTexture.index, path + ".emissiveTexture", context);

@@ -16,6 +16,7 @@
 #include "scene/gltf/gltf_materials.h"
 #include "scene/gltf/gltf_meshes.h"
 #include "scene/gltf/gltf_nodes.h"
+#include "scene/gltf/gltf_textures.h"
 #include "scene/json_reader.h"
 
 namespace pt {
@@ -70,10 +71,22 @@ Scene build(const tinygltf::Model& model, const std::string& file,
   const std::vector<PlacedNode> nodes = placeNodes(model, context);
   // Scene materials made on first use, one per glTF material (and one for the default).
   std::map<int, uint> slots;
+  TextureReader textures(model, scene, context);
   const MaterialSlot slot = [&](int material, const std::string&) {
     const auto [it, added] = slots.emplace(material, uint(scene.materials.size()));
     if (added) {
       scene.materials.push_back(readMaterial(model, material, context));
+      const tinygltf::TextureInfo* base =
+          material >= 0
+              ? &model.materials[std::size_t(material)].pbrMetallicRoughness.baseColorTexture
+              : nullptr;
+      if (base != nullptr && base->index >= 0) {
+        MaterialTextures t = noMaterialTextures();
+        t.reflectance = textures.baseColor(
+            *base, scene.materials.back().reflectance,
+            indexed("materials", std::size_t(material)) + ".pbrMetallicRoughness.baseColorTexture");
+        if (t.reflectance != kNoTexture) setMaterialTextures(scene, it->second, t);
+      }
       const std::string name = material >= 0 ? model.materials[std::size_t(material)].name : "";
       scene.materialNames.push_back(
           material < 0 ? "default"
@@ -93,6 +106,7 @@ Scene build(const tinygltf::Model& model, const std::string& file,
                              " zero-area triangle" + (meshes.dropped() == 1 ? "" : "s"));
   }
   if (scene.triangles.empty()) context.fail("scene", "the scene has no triangles to render");
+  padMaterialTextures(scene);
   setCamera(model, nodes, options.camera, scene, context);
   addPunctualLights(model, nodes, scene, context);
   // glTF has no environment: --env gives one, and a scene without a light of its own is lit as
