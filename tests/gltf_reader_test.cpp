@@ -552,6 +552,7 @@ TEST(GltfReader, BaseColorTextureTimesFactorFromDataUriAndBufferView) {
     b.doc["meshes"][m + 1]["primitives"][0]["material"] = m;
     b.node({{"mesh", m + 1}, {"translation", {0, 0, m}}});
   }
+  b.doc["extensionsUsed"] = {"KHR_texture_transform"};
   const Scene s = read(b.gltf());
   EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
   ASSERT_EQ(s.materialTextures.size(), 4u);

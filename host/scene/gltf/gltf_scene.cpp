@@ -28,7 +28,7 @@ using namespace gltf;
 // Extensions of the file that the reader reads, in part or whole (docs/gltf.md).
 bool isReadExtension(const std::string& name) {
   return name == "KHR_materials_emissive_strength" || name == "KHR_materials_ior" ||
-         name == "KHR_lights_punctual";
+         name == "KHR_lights_punctual" || name == "KHR_texture_transform";
 }
 
 void warnUnsimulated(const tinygltf::Model& model, Context& context) {
