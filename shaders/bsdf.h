@@ -829,10 +829,10 @@ PT_INLINE float coatedDiffusePdf(CoatedDiffuse c, vec3 wo, vec3 wi, RandomStream
 // with the separable Smith masking-shadowing G = G1(L) G1(V). One difference: appendix B weighs
 // the dielectric's two layers by the Fresnel term of each microfacet (V.H); this takes the
 // term of the macro surface (N.V), so that the base receives what the layer does not reflect
-// and no parameter set reflects more than it receives (with V.H a white base reflects up to
-// 1.19 times the light it receives at 80 degrees: docs/gltf.md). Both are the same for a smooth
-// surface's specular reflection. Two-sided, reflection only. Material fields: reflectance the
-// base colour, eta.x the ior, alphaX = alphaY, thickness the metallic factor.
+// and no parameter set reflects more than it receives (with V.H a white base of roughness 0.3
+// reflects 1.22 times the light it receives at 80 degrees: docs/gltf.md). Both are the same
+// for a smooth surface's specular reflection. Two-sided, reflection only. Material fields:
+// reflectance the base colour, eta.x the ior, alphaX = alphaY, thickness the metallic factor.
 
 struct GltfSurface {
   vec3 baseColor;
