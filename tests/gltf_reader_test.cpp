@@ -102,6 +102,26 @@ TEST(GltfReader, NestedTrsAndMatrixAgainstHandComputedTransform) {
   expectNear(s.triangles[0].v2, vec3(-3, 2, 3), 1e-5f);
 }
 
+// Triangles whose float geometric normal cannot be computed (the cross product's square
+// underflows or overflows) are dropped like zero-area ones, so that no normal is NaN: the
+// fuzzer found one with vertex normals, whose flat stand-in normal came out NaN.
+TEST(GltfReader, TrianglesTooSmallOrLargeForAFloatNormalAreDropped) {
+  for (double scale : {1e-20, 1e20}) {
+    SCOPED_TRACE(scale);
+    GltfBuilder b;
+    const float s = float(scale);
+    const int p = b.floats({0, 0, 0, s, 0, 0, 0, s, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3", 3);
+    const int n = b.floats({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3", 3);
+    b.mesh(json::array({{{"attributes", {{"POSITION", p}, {"NORMAL", n}}}}}));
+    b.node({{"mesh", 0}});
+    const Scene sc = read(b.gltf());
+    ASSERT_EQ(sc.triangles.size(), 1u);
+    expectNear(sc.triangles[0].v1, vec3(1, 0, 0));
+    ASSERT_EQ(sc.warnings.size(), 1u);
+    EXPECT_EQ(sc.warnings[0], "test.gltf: dropped 1 zero-area triangle");
+  }
+}
+
 TEST(GltfReader, EveryInstanceOfAMeshIsEmitted) {
   GltfBuilder b = oneTriangle();
   const int a = b.node({{"mesh", 0}});

@@ -2,6 +2,7 @@
 #include "scene/gltf/gltf_meshes.h"
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include <glm/matrix.hpp>
@@ -189,6 +190,15 @@ void MeshReader::emit(int mesh, const std::string& where, const glm::dmat4& worl
         std::swap(uv[1], uv[2]);
       }
       t.material = material;
+      // The renderer's geometric normal is the float cross product normalized: a triangle too
+      // small or too large for it (its square length below float's normal range, or beyond
+      // it) has none, and is dropped as a zero-area triangle is.
+      const vec3 ng = glm::cross(t.v1 - t.v0, t.v2 - t.v0);
+      const float length2 = glm::dot(ng, ng);
+      if (!(length2 >= std::numeric_limits<float>::min() && std::isfinite(length2))) {
+        ++dropped_;
+        continue;
+      }
       const Appended a =
           appendTriangle(scene, t, p.normals.empty() ? nullptr : &n, p.uvs.empty() ? nullptr : &uv);
       if (a == Appended::kZeroArea) ++dropped_;
