@@ -100,6 +100,29 @@ void checkNormals(const Mesh& mesh) {
   }
 }
 
+// What the readers promise of an accepted scene's triangles: finite vertices, materials in
+// range, unit finite normals and finite texture coordinates parallel to them (or none).
+void checkTriangles(const Scene& scene) {
+  const auto finite = [](vec3 v) { return std::isfinite(v.x + v.y + v.z); };
+  PT_CHECK(scene.normals.empty() || scene.normals.size() == scene.triangles.size(),
+           "scene normals not parallel to its triangles");
+  PT_CHECK(scene.uvs.empty() || scene.uvs.size() == scene.triangles.size(),
+           "scene texture coordinates not parallel to its triangles");
+  for (const Triangle& t : scene.triangles) {
+    PT_CHECK(finite(t.v0) && finite(t.v1) && finite(t.v2), "non-finite vertex accepted");
+    PT_CHECK(t.material < scene.materials.size(), "material index out of range");
+  }
+  for (const TriangleNormals& n : scene.normals) {
+    for (const vec3& v : {n.n0, n.n1, n.n2}) {
+      PT_CHECK(finite(v) && std::abs(glm::length(v) - 1.0f) < 1e-3f, "bad normal accepted");
+    }
+  }
+  for (const TriangleUVs& uv : scene.uvs) {
+    PT_CHECK(std::isfinite(uv.uv0.x + uv.uv0.y + uv.uv1.x + uv.uv1.y + uv.uv2.x + uv.uv2.y),
+             "non-finite texture coordinate accepted");
+  }
+}
+
 // What the readers promise of an accepted scene's media (the renderer relies on them): no
 // media fields without media, one interface per triangle with valid indices, grids inside the
 // grid buffer, the majorants left to prepareScene, g in [-1, 1], finite non-negative values.
@@ -158,6 +181,12 @@ Outcome fuzzScene(const std::uint8_t* data, std::size_t size) {
   const fs::path path = workDir() / "scene.json";
   writeFile(path, data, size);
   return guarded([&] { checkMedia(loadScene(path)); });
+}
+
+Outcome fuzzGltf(const std::uint8_t* data, std::size_t size) {
+  const fs::path path = workDir() / "scene.gltf";  // a .glb too: the reader goes by its magic
+  writeFile(path, data, size);
+  return guarded([&] { checkTriangles(loadScene(path)); });
 }
 
 Outcome fuzzObj(const std::uint8_t* data, std::size_t size) {
@@ -274,8 +303,9 @@ Outcome fuzzNanoVdb(const std::uint8_t* data, std::size_t size) {
 
 const std::vector<Target>& targets() {
   static const std::vector<Target> all = {
-      {"scene", fuzzScene}, {"obj", fuzzObj},   {"mtl", fuzzMtl},         {"ply", fuzzPly},
-      {"image", fuzzImage}, {"pbrt", fuzzPbrt}, {"texture", fuzzTexture}, {"nvdb", fuzzNanoVdb}};
+      {"scene", fuzzScene},     {"obj", fuzzObj},      {"mtl", fuzzMtl},
+      {"ply", fuzzPly},         {"image", fuzzImage},  {"pbrt", fuzzPbrt},
+      {"texture", fuzzTexture}, {"nvdb", fuzzNanoVdb}, {"gltf", fuzzGltf}};
   return all;
 }
 

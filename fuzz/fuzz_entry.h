@@ -19,6 +19,7 @@ Outcome fuzzMtl(const std::uint8_t* data, std::size_t size);    // loadMtlMateri
 Outcome fuzzPly(const std::uint8_t* data, std::size_t size);    // loadPlyMesh, its normals checked
 Outcome fuzzImage(const std::uint8_t* data, std::size_t size);  // readImage: EXR, PFM, PNG
 Outcome fuzzPbrt(const std::uint8_t* data, std::size_t size);   // a .pbrt scene beside fixed meshes
+Outcome fuzzGltf(const std::uint8_t* data, std::size_t size);   // a .gltf or .glb scene
 Outcome fuzzNanoVdb(const std::uint8_t* data, std::size_t size);  // readNanoVdbMedium, packed
 // readTextureImage: the first byte picks the extension (textureExtension), the rest is the file.
 Outcome fuzzTexture(const std::uint8_t* data, std::size_t size);

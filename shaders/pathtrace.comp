@@ -35,6 +35,7 @@ const bool kDielectric = false;
 const bool kThinDielectric = false;
 const bool kDiffuseTransmission = false;
 const bool kCoatedDiffuse = false;
+const bool kGltf = false;
 const bool kShadingNormals = false;
 const bool kDeltaLights = false;
 const bool kEnvironment = false;
@@ -50,6 +51,7 @@ layout(constant_id = PT_SPEC_DIELECTRIC) const bool kDielectric = true;
 layout(constant_id = PT_SPEC_THIN_DIELECTRIC) const bool kThinDielectric = true;
 layout(constant_id = PT_SPEC_DIFFUSE_TRANSMISSION) const bool kDiffuseTransmission = true;
 layout(constant_id = PT_SPEC_COATED_DIFFUSE) const bool kCoatedDiffuse = true;
+layout(constant_id = PT_SPEC_GLTF) const bool kGltf = true;
 layout(constant_id = PT_SPEC_SHADING_NORMALS) const bool kShadingNormals = true;
 layout(constant_id = PT_SPEC_DELTA_LIGHTS) const bool kDeltaLights = true;
 layout(constant_id = PT_SPEC_ENVIRONMENT) const bool kEnvironment = true;
@@ -66,7 +68,7 @@ layout(constant_id = PT_SPEC_ENVIRONMENT_IMAGE) const bool kEnvironmentImage = t
 const bool kAnalyticLights = kDeltaLights || kEnvironment || kSphereLights;
 // Some surface has one of bsdf.h's materials; bsdf.h's switch sees only the types in use.
 const bool kBsdfMaterials =
-    kConductor || kDielectric || kThinDielectric || kDiffuseTransmission || kCoatedDiffuse;
+    kConductor || kDielectric || kThinDielectric || kDiffuseTransmission || kCoatedDiffuse || kGltf;
 
 layout(std430, set = 0, binding = PT_BINDING_PARAMS) readonly buffer ParamsBuffer {
   RenderParams paramsBuffer;
@@ -125,6 +127,7 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 #define PT_HAS_THIN_DIELECTRIC kThinDielectric
 #define PT_HAS_DIFFUSE_TRANSMISSION kDiffuseTransmission
 #define PT_HAS_COATED_DIFFUSE kCoatedDiffuse
+#define PT_HAS_GLTF kGltf
 #define PT_LOOP_TICK() gLoopIterations++
 #include "bsdf.h"
 #include "lights.h"

@@ -110,26 +110,31 @@ PT_CONST uint kMaterialCoatedDiffuse = 6u;  // dielectric coat over a Lambertian
 // No surface: pbrt-v4's "interface" material. Its triangles only bound media (a ray passes
 // through, into the medium on the side it goes to); scenes without media have none.
 PT_CONST uint kMaterialInterface = 7u;
-PT_CONST uint kMaterialTypeCount = 8u;
+// glTF 2.0's metallic-roughness material (its appendix B; shaders/bsdf.h says how it is read).
+PT_CONST uint kMaterialGltf = 8u;
+PT_CONST uint kMaterialTypeCount = 9u;
 
 // One material. The first two rows are all that diffuse and mirror surfaces read; the others
 // hold the parameters of the other types (zero where a type has no use for them). Roughness is
 // stored as the Trowbridge-Reitz alpha, pbrt-v4's remapping already applied by the host.
 struct Material {
   vec3 reflectance;    // 12 bytes: diffuse albedo, mirror reflectance, diffusetransmission's
-                       //           reflectance, coateddiffuse's base albedo; linear RGB
+                       //           reflectance, coateddiffuse's base albedo, gltf's base
+                       //           colour; linear RGB
   uint type;           //  4 bytes: kMaterial*
   vec3 emission;       // 12 bytes: radiance emitted on the front side (geometric normal side)
   uint twoSided;       //  4 bytes: 1: emission leaves both sides (pbrt-v4's "twosided")
   vec3 eta;            // 12 bytes: conductor: real part of the index of refraction per channel;
-                       //           dielectric, thindielectric, coateddiffuse: the index in .x
+                       //           dielectric, thindielectric, coateddiffuse, gltf: the index
+                       //           in .x
   float alphaX;        //  4 bytes: Trowbridge-Reitz alpha along the tangent (conductor,
                        //           dielectric, coateddiffuse's coat)
   vec3 k;              // 12 bytes: conductor: imaginary part of the index (absorption)
   float alphaY;        //  4 bytes: alpha along the bitangent
   vec3 transmittance;  // 12 bytes: diffusetransmission: transmittance; coateddiffuse: the
                        //           albedo of the medium between coat and base
-  float thickness;     //  4 bytes: coateddiffuse: the medium's optical thickness
+  float thickness;     //  4 bytes: coateddiffuse: the medium's optical thickness; gltf: the
+                       //           metallic factor
   float g;             //  4 bytes: coateddiffuse: Henyey-Greenstein asymmetry of the medium
   uint maxDepth;       //  4 bytes: coateddiffuse: random-walk length
   uint nSamples;       //  4 bytes: coateddiffuse: random walks per evaluation
@@ -598,7 +603,8 @@ PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v =
 #define PT_SPEC_TEXTURE_FEATURES 23    // uint: kTextureUses* bits of what the textures need
 #define PT_SPEC_MEDIUM_KINDS 24        // uint: bit 1 << kMedium* for each type of medium present
 #define PT_SPEC_LIGHT_BVH 25           // bool: emitters are chosen by the light BVH
-#define PT_SPEC_COUNT 26
+#define PT_SPEC_GLTF 26                // bool: some surface has glTF's material
+#define PT_SPEC_COUNT 27
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever

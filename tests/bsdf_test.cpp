@@ -26,6 +26,7 @@ namespace {
 using test::conductor;
 using test::dielectric;
 using test::diffuseTransmission;
+using test::gltfMaterial;
 using test::LobeFocus;
 using test::SphereGrid;
 using test::thinDielectric;
@@ -134,13 +135,17 @@ std::string describe(const Material& m) {
   std::ostringstream s;
   static const char* const kNames[] = {"diffuse",       "mirror",         "conductor",
                                        "dielectric",    "thindielectric", "diffusetransmission",
-                                       "coateddiffuse", "interface"};
+                                       "coateddiffuse", "interface",      "gltf"};
   s << (m.type < kMaterialTypeCount ? kNames[m.type] : "?") << " alpha " << m.alphaX << "/"
     << m.alphaY << " eta " << m.eta.x;
   if (m.type == kMaterialConductor) s << "," << m.eta.y << "," << m.eta.z << " k " << m.k.x;
   if (m.type == kMaterialDiffuseTransmission || m.type == kMaterialCoatedDiffuse) {
     s << " r " << m.reflectance.x << "," << m.reflectance.y << "," << m.reflectance.z << " t "
       << m.transmittance.x << "," << m.transmittance.y << "," << m.transmittance.z;
+  }
+  if (m.type == kMaterialGltf) {
+    s << " base " << m.reflectance.x << "," << m.reflectance.y << "," << m.reflectance.z
+      << " metallic " << m.thickness;
   }
   if (m.type == kMaterialCoatedDiffuse) {
     s << " thickness " << m.thickness << " g " << m.g << " maxdepth " << m.maxDepth << " nsamples "
@@ -380,6 +385,26 @@ std::vector<Chi2Case> nearSmoothCases() {
 }
 
 // The machinery itself: p-values, quadrature, cells.
+// glTF's material over its parameters: metallic, roughness (alpha = roughness^2), ior, base
+// colour, wo above and below (it is two-sided).
+std::vector<Chi2Case> gltfCases() {
+  std::vector<Chi2Case> cases;
+  const vec3 base(0.8f, 0.4f, 0.1f);
+  for (float metallic : {0.0f, 0.5f, 1.0f}) {
+    for (float roughness : {0.3f, 0.6f, 1.0f}) {
+      for (vec3 wo : {direction(0.6, 0.4), direction(0.15, 2.0), direction(-0.5, 1.0)}) {
+        cases.push_back({gltfMaterial(base, metallic, roughness), wo, kFewerSamples});
+      }
+    }
+  }
+  // A narrow lobe, a smooth surface (its delta lobe counted apart), indices far from 1.5.
+  cases.push_back({gltfMaterial(base, 0.5f, 0.1f), direction(0.6, 0.4), kManySamples});
+  cases.push_back({gltfMaterial(base, 0.5f, 0.0f), direction(0.6, 0.4), kFewerSamples});
+  cases.push_back({gltfMaterial(base, 0.0f, 0.4f, 1.1f), direction(0.3, 1.0), kFewerSamples});
+  cases.push_back({gltfMaterial(vec3(1.0f), 0.2f, 0.4f, 3.0f), direction(0.9, 1.0), kFewerSamples});
+  return cases;
+}
+
 TEST(BsdfChi2, Machinery) {
   EXPECT_NEAR(test::gammaQ(1.0, 2.5), std::exp(-2.5), 1e-12);
   // The 95 % quantiles of chi-square with 1 and 1000 degrees of freedom.
@@ -421,6 +446,10 @@ TEST(BsdfChi2, DiffuseTransmission) {
   for (const Chi2Case& c : diffuseTransmissionCases()) chi2Test(c);
 }
 
+TEST(BsdfChi2, Gltf) {
+  for (const Chi2Case& c : gltfCases()) chi2Test(c);
+}
+
 // The samplers at alpha 0.0015 against the double-precision reference pdf: the sampling is
 // right there, and this machinery resolves lobes that narrow.
 TEST(BsdfChi2, NearSmoothSamplersMatchTheExactPdf) {
@@ -457,6 +486,10 @@ TEST(BsdfChi2, RejectsAWrongPdf) {
        dielectric(0.002f, 0.002f, 1.5f)},
       {"diffuse transmission 0.5/0.5 against the pdf of 0.6/0.4",
        diffuseTransmission(vec3(0.5f), vec3(0.5f)), diffuseTransmission(vec3(0.6f), vec3(0.4f))},
+      {"gltf metallic 0.5 against the pdf of metallic 0.6", gltfMaterial(vec3(0.5f), 0.5f, 0.5f),
+       gltfMaterial(vec3(0.5f), 0.6f, 0.5f)},
+      {"gltf roughness 0.5 against the pdf of roughness 0.55", gltfMaterial(vec3(0.5f), 0.5f, 0.5f),
+       gltfMaterial(vec3(0.5f), 0.5f, 0.55f)},
   };
   for (const Wrong& w : wrongs) {
     const test::Chi2Result r = chi2Test(
@@ -741,6 +774,11 @@ std::vector<Material> roughMaterials() {
   }
   materials.push_back(diffuseTransmission(vec3(0.5f), vec3(0.5f)));
   materials.push_back(diffuseTransmission(vec3(0.8f, 0.6f, 0.1f), vec3(0.1f, 0.2f, 0.3f)));
+  for (float metallic : {0.0f, 0.5f, 1.0f}) {
+    for (float roughness : {0.04f, 0.5f, 1.0f}) {
+      materials.push_back(gltfMaterial(vec3(0.8f, 0.4f, 0.1f), metallic, roughness));
+    }
+  }
   return materials;
 }
 const std::vector<vec3> kConsistencyIncoming = {vec3(0.0f, 0.0f, 1.0f), direction(0.6, 0.4),
@@ -823,6 +861,9 @@ TEST(BsdfConsistency, PdfIntegratesToTheProbabilityOfNonDeltaSamples) {
       {dielectric(0.3f, 0.3f, 1.0f / 1.33f), direction(0.5, 0.3), 0.0},
       {diffuseTransmission(vec3(0.3f), vec3(0.6f)), direction(0.4, 0.3), 1.0 - 1e-4},
       {diffuseTransmission(vec3(0.3f), vec3(0.0f)), direction(-1e-3, 0.3), 1.0 - 1e-4},
+      // glTF's smooth surface: the diffuse lobe alone has a density.
+      {gltfMaterial(vec3(0.8f, 0.4f, 0.1f), 0.5f, 0.0f), direction(0.6, 0.4), 0.0},
+      {gltfMaterial(vec3(0.8f, 0.4f, 0.1f), 0.3f, 0.7f), direction(-0.3, 0.4), 0.0},
   };
   constexpr int kSamples = 200000 / kSampleDivisor;
   for (const Case& c : cases) {
@@ -1224,6 +1265,96 @@ TEST(BsdfEnergy, WhiteFurnaceNeverExceedsOne) {
   }
 }
 
+// glTF's material in the white furnace: metallic 1 with a white base colour is lossless where
+// smooth (every sample's weight 1) and so is a smooth dielectric over a white base (the base
+// receives what the specular layer does not reflect); no parameter set, drawn at random over
+// the whole range (ior from 1 to 3 and 0, KHR_materials_ior's limit of f0 = 1), reflects more
+// than it receives.
+TEST(BsdfEnergy, GltfWhiteFurnace) {
+  const std::vector<vec3> incoming = {vec3(0.0f, 0.0f, 1.0f), direction(0.5, 0.3),
+                                      direction(0.1, 1.3), direction(1e-3, 2.0),
+                                      direction(-0.5, 0.3)};
+  const auto albedo = [](const Material& m, vec3 wo, int n) {
+    return sampledAlbedo(
+        [&](float uc, vec2 u, uint) { return bsdfSample(m, wo, uc, u, RandomStream{}); }, n,
+        seedOf(caseName(m, wo)));
+  };
+  for (vec3 wo : incoming) {
+    const Material metal = gltfMaterial(vec3(1.0f), 1.0f, 0.0f);
+    EXPECT_NEAR(albedo(metal, wo, kFurnaceSamples / 4).mean, 1.0, 1e-5) << describe(wo);
+    EXPECT_LT(albedo(metal, wo, kFurnaceSamples / 4).sigma, 1e-6) << describe(wo);
+    const Material smooth = gltfMaterial(vec3(1.0f), 0.0f, 0.0f);
+    const Albedo a = albedo(smooth, wo, kFurnaceSamples / 4);
+    EXPECT_NEAR(a.mean, 1.0, 4.0 * a.sigma + 1e-6) << describe(smooth) << " " << describe(wo);
+  }
+  Rng rng(4141);
+  double highest = 0.0;
+  for (int i = 0; i < 40; ++i) {
+    const float metallic = i % 4 == 0 ? 0.0f : rng.uniform();
+    const float roughness = i % 5 == 0 ? 0.0f : rng.uniform();
+    const float ior = i % 7 == 0 ? 0.0f : 1.0f + 2.0f * rng.uniform();
+    const Material m = gltfMaterial(vec3(1.0f), metallic, roughness, ior);
+    for (vec3 wo : incoming) {
+      const Albedo a = albedo(m, wo, kFurnaceSamples / 8);
+      EXPECT_LE(a.mean, 1.0 + 3.0 * a.sigma + 1e-6)
+          << describe(m) << " wo " << describe(wo) << ": albedo " << a.mean << " +- " << a.sigma;
+      highest = std::max(highest, a.mean);
+    }
+  }
+  std::printf("glTF white furnace: the highest albedo of 40 random parameter sets: %.5f\n",
+              highest);
+}
+
+// glTF's f against appendix B's formulas written out in double: the Lambertian base weighed by
+// (1 - metallic)(1 - F(N.V)), the specular lobe D G1(V) G1(L) / (4 |N.L| |N.V|) weighed by
+// (1 - metallic) F(N.V) + metallic Schlick(baseColor, V.H), F Schlick's of f0 from the ior.
+TEST(BsdfFresnel, GltfClosedForms) {
+  Rng rng(77);
+  for (int i = 0; i < 2000; ++i) {
+    const vec3 base(rng.uniform(), rng.uniform(), rng.uniform());
+    const float metallic = rng.uniform();
+    const float roughness = 0.05f + 0.95f * rng.uniform();
+    const float ior = 1.0f + 2.0f * rng.uniform();
+    const Material m = gltfMaterial(base, metallic, roughness, ior);
+    vec3 wo = rng.direction(), wi = rng.direction();
+    wo.z = std::abs(wo.z);
+    wi.z = std::abs(wi.z);
+    if (wo.z < 1e-3f || wi.z < 1e-3f) continue;
+    const dvec3 o = dvec3(wo), l = dvec3(wi), h = normalize(o + l);
+    const double alpha = double(m.alphaX);
+    const ExactTrowbridgeReitz d{alpha, alpha};
+    const double f0 = sqr((double(ior) - 1.0) / (double(ior) + 1.0));
+    const double fd = f0 + (1.0 - f0) * std::pow(1.0 - o.z, 5.0);
+    const double specular = d.d(h) * d.g1(o) * d.g1(l) / (4.0 * o.z * l.z);
+    const vec3 f = bsdfF(m, wo, wi, RandomStream{});
+    for (int c = 0; c < 3; ++c) {
+      const double b = double(base[c]);
+      const double metal = b + (1.0 - b) * std::pow(1.0 - dot(o, h), 5.0);
+      const double expected = (1.0 - metallic) * (1.0 - fd) * b / kPiD +
+                              ((1.0 - metallic) * fd + metallic * metal) * specular;
+      ASSERT_NEAR(f[c], expected, 1e-4 * expected + 1e-7)
+          << describe(m) << " wo " << describe(wo) << " wi " << describe(wi) << " channel " << c;
+    }
+  }
+  // Smooth: the delta lobe reflects F(N.V) of the dielectric and Schlick's term of the base
+  // colour for the metal; at normal incidence f0 = 0.04 for ior 1.5.
+  for (double cosTheta : {1.0, 0.3}) {
+    const vec3 wo = direction(cosTheta, 0.5);
+    const double x = std::pow(1.0 - cosTheta, 5.0);
+    const vec3 base(0.9f, 0.6f, 0.3f);
+    for (float metallic : {0.0f, 1.0f}) {
+      const Material m = gltfMaterial(base, metallic, 0.0f);
+      const BsdfSample s = bsdfSample(m, wo, 0.99999f, vec2(0.5f), RandomStream{});
+      ASSERT_NE(s.flags & kBsdfSpecular, 0u) << describe(m);
+      for (int c = 0; c < 3; ++c) {
+        const double b = double(base[c]);
+        const double reflected = metallic > 0.0f ? b + (1.0 - b) * x : 0.04 + 0.96 * x;
+        EXPECT_NEAR(s.f[c] * absCosTheta(s.wi), reflected, 1e-6) << describe(m) << " " << c;
+      }
+    }
+  }
+}
+
 // For the rough microfacet models the sampled albedo equals f |cos| integrated by quadrature,
 // within the sampling noise. What they lack of 1 is the energy single scattering loses (the
 // light that would scatter between microfacets more than once), largest at alpha 1; the test
@@ -1441,7 +1572,8 @@ TEST(BsdfHardCases, NoInvalidValues) {
 // The significance of each statistical test assumed at most kMaxTests of them.
 TEST(BsdfChi2, TestCount) {
   const size_t chi2 = conductorCases().size() + dielectricCases().size() +
-                      diffuseTransmissionCases().size() + 2 * nearSmoothCases().size();
+                      diffuseTransmissionCases().size() + 2 * nearSmoothCases().size() +
+                      gltfCases().size();
   const size_t coated = coatedCases().size();
   EXPECT_LE(chi2 + coated, size_t(kMaxTests));
   std::printf("%zu chi-square tests, %zu coated-diffuse tests, each at significance %.3g\n", chi2,

@@ -113,7 +113,11 @@ INSTANTIATE_TEST_SUITE_P(
              }(),
              "conductor+dielectric"},
         Case{"coatedExtremes", coatedDiffuse(1.0f, vec3(1.0f)), coatedDiffuse(1e-4f, vec3(0.0f)),
-             "coateddiffuse"}),
+             "coateddiffuse"},
+        Case{"gltfSmooth", test::gltfMaterial(vec3(0.9f, 0.6f, 0.3f), 1.0f, 0.0f),
+             test::gltfMaterial(vec3(0.2f, 0.5f, 0.8f), 0.0f, 0.0f), "gltf"},
+        Case{"gltfRough", test::gltfMaterial(vec3(0.9f, 0.6f, 0.3f), 0.5f, 0.4f),
+             test::gltfMaterial(vec3(0.2f, 0.5f, 0.8f), 0.0f, 1.0f, 1.1f), "gltf"}),
     [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
 
 // A sphere of 2 * 24 * 48 triangles at the origin, radius 1, with vertex normals: the

@@ -49,4 +49,14 @@ inline Material diffuseTransmission(vec3 r, vec3 t) {
   m.transmittance = t;
   return m;
 }
+// glTF's metallic-roughness material as the glTF reader fills it (alpha = roughness^2).
+inline Material gltfMaterial(vec3 baseColor, float metallic, float roughness, float ior = 1.5f) {
+  Material m{};
+  m.type = kMaterialGltf;
+  m.reflectance = baseColor;
+  m.thickness = metallic;
+  m.eta = vec3(ior, 0.0f, 0.0f);
+  m.alphaX = m.alphaY = roughness * roughness;
+  return m;
+}
 }  // namespace pt::test

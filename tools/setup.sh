@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  libglm-dev libstb-dev nlohmann-json3-dev libtinyobjloader-dev libtinyexr-dev libcli11-dev
+  libglm-dev libstb-dev nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libtinyexr-dev libcli11-dev
   libnanovdb-dev zlib1g-dev
   libgtest-dev clang libfuzzer-14-dev
   libembree-dev embree-tools libbenchmark-dev libhwy-dev

@@ -38,7 +38,9 @@ struct RenderArgs {
   std::string device;
   bool validation = false;
   bool noSpecialize = false;
-  bool strict = false;     // pbrt-v4 files: warnings are errors
+  bool strict = false;      // pbrt-v4 and glTF files: warnings are errors
+  std::string camera;       // glTF files: the camera, by index or name
+  std::string environment;  // glTF files: an environment image
   std::string debugPixel;  // "X,Y"
   SceneOverrides overrides;
   std::optional<int> spp;
@@ -134,7 +136,9 @@ int runRender(const RenderArgs& args) {
   if (!args.resume.empty()) resumed = readFilmState(args.resume);
 
   const auto loadStart = std::chrono::steady_clock::now();
-  Scene scene = loadScene(args.scene, SceneLoadOptions{.strict = args.strict});
+  Scene scene = loadScene(args.scene, SceneLoadOptions{.strict = args.strict,
+                                                       .camera = args.camera,
+                                                       .environment = args.environment});
   const double loadSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
@@ -447,7 +451,7 @@ int main(int argc, char** argv) {
 
   RenderArgs r;
   CLI::App* render = app.add_subcommand("render", "Render a scene to one or more images");
-  render->add_option("scene", r.scene, "Scene file (JSON)")->required();
+  render->add_option("scene", r.scene, "Scene file (JSON, pbrt-v4 or glTF)")->required();
   render->add_option("--backend", r.backend, "vulkan (GPU, or lavapipe without one) or cpu")
       ->check(CLI::IsMember({"vulkan", "cpu"}))
       ->capture_default_str();
@@ -457,8 +461,14 @@ int main(int argc, char** argv) {
   render->add_flag("--no-specialize", r.noSpecialize,
                    "Compile every effect into the shader (to measure what specialization saves)");
   render->add_flag("--strict", r.strict,
-                   "pbrt-v4 files: what the reader would warn about (ignored or rendered "
-                   "otherwise than pbrt-v4) is an error, exit status 2");
+                   "pbrt-v4 and glTF files: what the reader would warn about (ignored or "
+                   "rendered otherwise than the format says) is an error, exit status 2");
+  render->add_option("--camera", r.camera,
+                     "glTF files: the camera to render from, by index in the file's cameras or "
+                     "by name (default: the first the scene places)");
+  render->add_option("--env", r.environment,
+                     "glTF files: an environment image (.exr, .pfm or .png; latitude-longitude, "
+                     "+y up) to light the model (default: a white sky where it has no light)");
   render->add_option("--spp", r.spp, "Samples per pixel (default: the scene's)")->check(kPositive);
   render->add_option("--threads", r.threads, "CPU threads (default: all)")->check(kPositive);
   render

@@ -814,7 +814,10 @@ TextureImage decode(const Bytes& data, const fs::path& path, FileFormat format,
 
 }  // namespace image_detail
 
-TextureImage readTextureImage(const std::filesystem::path& path) {
+namespace {
+
+// The format the extension of `path` names; InputError naming the file where none.
+image_detail::FileFormat textureFormatOrFail(const std::filesystem::path& path) {
   using namespace image_detail;
   const std::optional<FileFormat> format = textureFormatOf(path);
   constexpr const char* kExpected = "(expected .png, .jpg, .jpeg, .tga, .bmp, .hdr, .exr or .pfm)";
@@ -822,7 +825,21 @@ TextureImage readTextureImage(const std::filesystem::path& path) {
     if (path.extension().empty()) fail(path, std::string("no image file extension ") + kExpected);
     fail(path, "unknown image file extension '" + path.extension().string() + "' " + kExpected);
   }
-  return decode(readWholeFile(path, "an image file"), path, *format, DecodeOptions{});
+  return *format;
+}
+
+}  // namespace
+
+TextureImage readTextureImage(const std::filesystem::path& path) {
+  const image_detail::FileFormat format = textureFormatOrFail(path);
+  return image_detail::decode(readWholeFile(path, "an image file"), path, format,
+                              image_detail::DecodeOptions{});
+}
+
+TextureImage decodeTextureImage(const std::vector<unsigned char>& bytes,
+                                const std::filesystem::path& name) {
+  const image_detail::FileFormat format = textureFormatOrFail(name);
+  return image_detail::decode(bytes, name, format, image_detail::DecodeOptions{});
 }
 
 }  // namespace pt

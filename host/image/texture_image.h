@@ -25,6 +25,11 @@ struct TextureImage {
 // "<path>: <reason>" (one line) for an unknown extension, a missing, truncated or malformed
 // file, or one larger than kMaxTextureTexels texels (checked from the header before decoding).
 TextureImage readTextureImage(const std::filesystem::path& path);
+
+// The same for a file's bytes already in memory (an image inside a glTF buffer or data URI):
+// `name` stands for the file in messages, and its extension picks the format.
+TextureImage decodeTextureImage(const std::vector<unsigned char>& bytes,
+                                const std::filesystem::path& name);
 inline constexpr int64_t kMaxTextureTexels = int64_t(1) << 28;
 
 }  // namespace pt

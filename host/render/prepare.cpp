@@ -43,6 +43,7 @@ std::string EffectSet::toString() const {
   add(thinDielectric, "thindielectric");
   add(diffuseTransmission, "diffusetransmission");
   add(coatedDiffuse, "coateddiffuse");
+  add(gltf, "gltf");
   add(shadingNormals, "shading-normals");
   add(deltaLights, "delta-lights");
   add(environment, "environment");
@@ -421,6 +422,7 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     if (m.type == kMaterialThinDielectric) fx.thinDielectric = true;
     if (m.type == kMaterialDiffuseTransmission) fx.diffuseTransmission = true;
     if (m.type == kMaterialCoatedDiffuse) fx.coatedDiffuse = true;
+    if (m.type == kMaterialGltf) fx.gltf = true;
     if (m.type > kMaterialMirror && bsdfHasNonSpecular(m)) lightSampled = true;
   }
   // Light is sampled from the points where a medium scatters.

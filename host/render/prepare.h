@@ -65,6 +65,7 @@ struct EffectSet {
   bool thinDielectric = false;
   bool diffuseTransmission = false;
   bool coatedDiffuse = false;
+  bool gltf = false;
   bool shadingNormals = false;    // some mesh has vertex normals: shading normals interpolated
   bool deltaLights = false;       // point, spot or distant lights (sampled, never hit)
   bool environment = false;       // an infinite light: rays that leave the scene see it
@@ -85,7 +86,8 @@ struct EffectSet {
   bool watertight = true;  // false: the faster, leaky Moller-Trumbore test
   bool sobol = false;      // Owen-scrambled Sobol numbers instead of independent ones
   bool hasBsdfMaterials() const {
-    return conductor || dielectric || thinDielectric || diffuseTransmission || coatedDiffuse;
+    return conductor || dielectric || thinDielectric || diffuseTransmission || coatedDiffuse ||
+           gltf;
   }
   std::string toString() const;  // e.g. "diffuse+mirror+nee+mis+rr" (+"fast-isect", "sobol")
 };

@@ -1,6 +1,8 @@
-// The format dispatch (load_scene.h): pbrt-v4 files by their extension, JSON otherwise.
+// The format dispatch (load_scene.h): pbrt-v4 and glTF files by their extension, JSON otherwise.
 #include "scene/load_scene.h"
 
+#include "scene/gltf/gltf_scene.h"
+#include "scene/json_reader.h"
 #include "scene/json_scene.h"
 #include "scene/pbrt/pbrt_scene.h"
 
@@ -8,6 +10,14 @@ namespace pt {
 
 Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& options) {
   if (path.extension() == ".pbrt") return loadPbrtScene(path, options);  // docs/pbrt-format.md
+  if (path.extension() == ".gltf" || path.extension() == ".glb") {
+    return loadGltfScene(path, options);  // docs/gltf.md
+  }
+  if (!options.camera.empty() || !options.environment.empty()) {
+    scene_detail::throwInputError(path.string(), "",
+                                  std::string(options.camera.empty() ? "--env" : "--camera") +
+                                      " is for glTF files; this is not one");
+  }
   return loadJsonScene(path);
 }
 

@@ -120,6 +120,12 @@ struct SceneLoadOptions {
   // otherwise than pbrt-v4, is an InputError instead ("file:line:column: ..."), so that an
   // image is pbrt-v4's scene or nothing (pt render --strict). JSON scenes have no such warnings.
   bool strict = false;
+  // glTF files: the camera to render from, an index into the file's "cameras" or a camera's
+  // name (pt render --camera); empty: the first camera a node of the scene places.
+  std::string camera;
+  // glTF files: an environment image (.exr, .pfm or .png; latitude-longitude, +y up) that lights
+  // the model instead of the white sky a file without lights gets (pt render --env).
+  std::string environment;
 };
 
 // pbrt-v4's texture coordinates for the triangles of a mesh without any: (0,0), (1,0), (1,1).

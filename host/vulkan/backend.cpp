@@ -174,18 +174,19 @@ ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& s
                        all || fx.bumpMaps,
                        all ? kTextureUsesAll : fx.textureFeatures,
                        all ? 0xFFFFFFFFu : fx.mediumKinds,
-                       all || fx.lightBvh}};
-  static_assert(PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
-                PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
-                PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
-                PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 &&
-                PT_SPEC_THIN_DIELECTRIC == 11 && PT_SPEC_DIFFUSE_TRANSMISSION == 12 &&
-                PT_SPEC_COATED_DIFFUSE == 13 && PT_SPEC_SHADING_NORMALS == 14 &&
-                PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
-                PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_SPHERE_LIGHTS == 18 &&
-                PT_SPEC_ENVIRONMENT_IMAGE == 19 && PT_SPEC_TEXTURES == 20 && PT_SPEC_ALPHA == 21 &&
-                PT_SPEC_BUMP == 22 && PT_SPEC_TEXTURE_FEATURES == 23 &&
-                PT_SPEC_MEDIUM_KINDS == 24 && PT_SPEC_LIGHT_BVH == 25 && PT_SPEC_COUNT == 26);
+                       all || fx.lightBvh,
+                       all || fx.gltf}};
+  static_assert(
+      PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
+      PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
+      PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
+      PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 && PT_SPEC_THIN_DIELECTRIC == 11 &&
+      PT_SPEC_DIFFUSE_TRANSMISSION == 12 && PT_SPEC_COATED_DIFFUSE == 13 &&
+      PT_SPEC_SHADING_NORMALS == 14 && PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
+      PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_SPHERE_LIGHTS == 18 &&
+      PT_SPEC_ENVIRONMENT_IMAGE == 19 && PT_SPEC_TEXTURES == 20 && PT_SPEC_ALPHA == 21 &&
+      PT_SPEC_BUMP == 22 && PT_SPEC_TEXTURE_FEATURES == 23 && PT_SPEC_MEDIUM_KINDS == 24 &&
+      PT_SPEC_LIGHT_BVH == 25 && PT_SPEC_GLTF == 26 && PT_SPEC_COUNT == 27);
   std::vector<vk::SpecializationMapEntry> entries;
   for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
     entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));
