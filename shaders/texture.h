@@ -138,11 +138,6 @@ PT_INLINE vec4 levelTexel(PT_TEXTURES_PARAM TextureNode node, ImageLevel level, 
               stride == 4u ? uintBitsToFloat(imageWordAt(PT_TEXTURES_ARG at + 3u)) : 1.0f);
 }
 
-// Texel (x, y) of the image itself (level 0).
-PT_INLINE vec4 imageTexel(PT_TEXTURES_PARAM TextureNode node, int x, int y) {
-  return levelTexel(PT_TEXTURES_ARG node, imageLevel(PT_TEXTURES_ARG node, 0), x, y);
-}
-
 // A coordinate in texels made safe to convert to int: NaN to 0, the rest within +-2^24 (beyond
 // that a float has no fraction left to filter).
 PT_INLINE float safeTexelCoordinate(float x) {

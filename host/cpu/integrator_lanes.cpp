@@ -195,8 +195,7 @@ HWY_INLINE V sampleBoxLanes(V u, float r) {
 HWY_INLINE V sampleTentLanes(V u, float r) {
   const V rv = splat(r);
   const V left = hn::Sub(hn::Mul(rv, hn::Sqrt(hn::Mul(splat(2.0f), u))), rv);
-  const V right =
-      hn::Sub(rv, hn::Mul(rv, hn::Sqrt(hn::Sub(splat(2.0f), hn::Mul(splat(2.0f), u)))));
+  const V right = hn::Sub(rv, hn::Mul(rv, hn::Sqrt(hn::Sub(splat(2.0f), hn::Mul(splat(2.0f), u)))));
   return hn::Add(splat(0.5f), hn::IfThenElse(hn::Lt(u, splat(0.5f)), left, right));
 }
 HWY_INLINE V filterErfLanes(V x) {
@@ -425,10 +424,10 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   // A pinhole with the box, triangle or gaussian filter (whose samples weigh 1): the camera
   // rays are set up in lanes (sampleFilmAxisLanes). Mitchell's filter and the thin lens take
   // filter.h's generateCameraRay lane by lane.
-  const bool cameraInLanes = (camera.filterType == kFilterBox ||
-                              camera.filterType == kFilterTriangle ||
-                              camera.filterType == kFilterGaussian) &&
-                             !(camera.lensRadius > 0.0f);
+  const bool cameraInLanes =
+      (camera.filterType == kFilterBox || camera.filterType == kFilterTriangle ||
+       camera.filterType == kFilterGaussian) &&
+      !(camera.lensRadius > 0.0f);
   Lanes filmX, filmY;
 
   for (;;) {

@@ -21,12 +21,6 @@ uint floatWord(float f) {
   return w;
 }
 
-float uintToFloat(uint w) {
-  float f;
-  std::memcpy(&f, &w, sizeof f);
-  return f;
-}
-
 // The sRGB curve's decoding (IEC 61966-2-1), in double.
 double srgbDecode(double c) {
   return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
@@ -237,11 +231,11 @@ void TextureBuilder::storeMipLevels(StoredImage& stored, int channels, double ga
       const uint w = scene_.imageWords[stored.texels + i];
       for (int c = 0; c < channels; ++c) {
         image.values.push_back(
-            uintToFloat(scene_.imageWords[stored.decode + ((w >> (8 * c)) & 0xFFu)]));
+            uintBitsToFloat(scene_.imageWords[stored.decode + ((w >> (8 * c)) & 0xFFu)]));
       }
     } else {
       for (int c = 0; c < channels; ++c) {
-        image.values.push_back(uintToFloat(
+        image.values.push_back(uintBitsToFloat(
             scene_.imageWords[stored.texels + i * std::size_t(channels) + std::size_t(c)]));
       }
     }
