@@ -261,26 +261,35 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
   TriangleUVs uvs;
   TriangleDerivatives derivatives;
   bool textured = (PT_HAS_TEXTURES || PT_HAS_BUMP_MAPS) && PT_PARAMS.texturesPresent != 0u;
-  bool footprints = false;
+  bool footprints = textured && footprintsOn(PT_SCENE_ONLY);
+  bool shadingNormals = PT_HAS_SHADING_NORMALS && PT_PARAMS.normalsPresent != 0u;
+  bool footprintUVs = false;  // uv.duvdx, uv.duvdy and derivatives hold the hit's
   if (textured) {
     textures = materialTexturesAt(PT_SCENE_TEXTURES tri.material);
-    // The texture coordinates only where the material reads them: on a large mesh without
-    // textures their load is a cache miss at every hit.
-    if (anyTexture(textures)) {
+    // The footprint at every hit, as pbrt-v4's ComputeDifferentials (about the geometric
+    // normal): a specular bounce carries it on to what textures the path reaches next.
+    if (footprints) {
+      surfaceDpdxy(PT_PARAMS, rd, b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2, ng, s.dpdx, s.dpdy);
+    }
+    // The texture coordinates only where the material reads them, or where vertex normals
+    // turn the differentials of a specular bounce: on a large mesh without textures their load
+    // is a cache miss at every hit.
+    bool reads = anyTexture(textures);
+    if (reads || (footprints && shadingNormals)) {
       uvs = uvsAt(PT_SCENE_TEXTURES tri.primitive);
       uv.uv = interpolatedUV(uvs, b);
-      footprints = footprintsOn(PT_SCENE_ONLY);
+      footprintUVs = footprints;
       if (footprints || (PT_HAS_BUMP_MAPS && textures.displacement != kNoTexture)) {
         derivatives = triangleDerivatives(tri, uvs);
       }
       if (footprints) {
-        // pbrt-v4's ComputeDifferentials, about the geometric normal.
-        surfaceDpdxy(PT_PARAMS, rd, b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2, ng, s.dpdx, s.dpdy);
         footprintUV(derivatives.dpdu, derivatives.dpdv, s.dpdx, s.dpdy, uv.duvdx, uv.duvdy);
       }
     }
     if (PT_HAS_TEXTURES) s.material = resolveMaterialAt(PT_SCENE_TEXTURES s.material, textures, uv);
   }
+#else
+  bool shadingNormals = PT_HAS_SHADING_NORMALS && PT_PARAMS.normalsPresent != 0u;
 #endif
   float cosOut = dot(ng, wo);
   // Lambertian and mirror surfaces are two-sided: shaded with the normal facing the ray. With
@@ -289,7 +298,6 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
   // side of the geometric surface wi is on; rays leave on the side of ng they go to.)
   vec3 n = cosOut >= 0.0f ? ng : -ng;
   vec3 ns = ng;
-  bool shadingNormals = PT_HAS_SHADING_NORMALS && PT_PARAMS.normalsPresent != 0u;
 #ifndef PT_NO_BSDF_MATERIALS
   TriangleNormals normals;
   if (shadingNormals) {
@@ -302,10 +310,10 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
   // specular bounces.
   vec3 dndu = vec3(0.0f);
   vec3 dndv = vec3(0.0f);
-  if (shadingNormals && (bumped || footprints)) {
+  if (shadingNormals && (bumped || footprintUVs)) {
     normalDerivatives(uvs, normals, derivatives.determinant, dndu, dndv);
   }
-  if (footprints) {
+  if (footprintUVs) {
     s.dndx = dndu * uv.duvdx.x + dndv * uv.duvdx.y;
     s.dndy = dndu * uv.duvdy.x + dndv * uv.duvdy.y;
   }

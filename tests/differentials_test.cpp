@@ -1,8 +1,9 @@
 // Ray differentials (shaders/differentials.h): the footprint of a pixel on a surface against
 // finite differences of the camera mapping (pinhole and thin lens), carried through a curved
 // mirror and a refraction against the derivative of the exact mapping (central differences in
-// double precision), the camera's smallest differentials standing in for a ray's own, and the
-// changes of (u, v) solved from a surface's partial derivatives.
+// double precision), the camera's smallest differentials standing in for a ray's own, the
+// changes of (u, v) solved from a surface's partial derivatives, and the footprint at an
+// untextured hit of a textured scene.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +13,10 @@
 #include "differentials.h"
 #include "filter.h"
 #include "render/camera.h"
+#include "render/prepare.h"
+#include "scene/load_scene.h"
 #include "scene/scene.h"
+#include "test_util.h"
 
 namespace pt {
 namespace {
@@ -284,6 +288,76 @@ TEST(Differentials, TextureCoordinateChangesFromPartialDerivatives) {
   footprintUV(vec3(1.0f, 0.0f, 0.0f), vec3(2.0f, 0.0f, 0.0f), vec3(1.0f, 0.0f, 0.0f), vec3(0.0f),
               duvdx, duvdy);
   EXPECT_EQ(duvdx, vec2(0.0f));
+}
+
+// pbrt-v4 takes the footprint at every hit, not only where a texture reads it: in a textured
+// scene, an untextured mirror with vertex normals gets dp/dx and dp/dy where the ray's offset
+// rays meet its tangent plane, and the interpolated normal's change across them, which its
+// specular bounce carries on to the textures it reflects. The normal's change is checked
+// against the (unnormalized) interpolation of the vertex normals at p + dp/dx, which is linear.
+constexpr char kCurvedMirror[] =
+    "v -1 -1 0\nv 1 -1 0\nv 0 1 0\n"
+    "vn -0.3 -0.2 1\nvn 0.4 -0.1 1\nvn 0 0.3 1\n"
+    "f 1//1 2//2 3//3\n";
+
+TEST(Differentials, EveryHitOfATexturedSceneGetsItsFootprint) {
+  const test::TempDir dir;
+  dir.write("mirror.obj", kCurvedMirror);
+  const Scene scene = loadScene(dir.write("scene.json", R"({
+    "camera": {"position": [0.2, 0.1, 5], "target": [0, 0, 0], "vfov": 30,
+               "width": 64, "height": 64},
+    "textures": [{"name": "board", "type": "checkerboard", "uscale": 8, "vscale": 8,
+                  "tex1": 0.1, "tex2": 0.9}],
+    "materials": [{"name": "floor", "type": "diffuse", "reflectance": "board"},
+                  {"name": "mirror", "type": "mirror", "reflectance": [1, 1, 1]}],
+    "shapes": [
+      {"type": "quad", "material": "floor",
+       "vertices": [[-5, -5, -2], [5, -5, -2], [5, 5, -2], [-5, 5, -2]]},
+      {"type": "obj", "material": "mirror", "file": "mirror.obj"}
+    ],
+    "lights": [{"type": "distant", "direction": [0, 0, 1], "radiance": [1, 1, 1]}]})"));
+  const SceneData data = prepareScene(scene, RenderSettings{});
+  ASSERT_EQ(data.params.footprints, 1u);
+  ASSERT_EQ(data.params.normalsPresent, 1u);
+  const PathScene ps = data.pathScene();
+  uint index = 0;
+  while (data.materials[data.bvh.triangles[index].material].type != kMaterialMirror) ++index;
+  const Triangle& tri = data.bvh.triangles[index];
+  const vec3 b(0.3f, 0.3f, 0.4f);
+  const vec3 p = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
+  const Camera& cam = data.params.camera;
+  const vec3 d = normalize(p - cam.position);
+  const vec2 film(0.5f * float(cam.filmWidth), 0.5f * float(cam.filmHeight));
+  const RayDifferential rd =
+      cameraRayDifferential(cam, film, vec3(0.0f), cam.position, d, data.params.differentialScale);
+  ASSERT_TRUE(rd.present);
+  const SurfacePoint s = surfacePointAt(ps, index, tri, b, -d, rd);
+  EXPECT_EQ(s.scatter, kScatterMirror);
+  vec3 dpdx, dpdy;
+  surfaceDpdxy(data.params, rd, p, s.ng, dpdx, dpdy);
+  EXPECT_GT(length(dpdx), 0.0f);
+  EXPECT_EQ(s.dpdx, dpdx);
+  EXPECT_EQ(s.dpdy, dpdy);
+
+  // The barycentrics of a point q of the triangle's plane, in double precision.
+  const glm::dvec3 v0 = toDouble(tri.v0), v1 = toDouble(tri.v1), v2 = toDouble(tri.v2);
+  const auto barycentrics = [&](glm::dvec3 q) {
+    const glm::dvec3 n = glm::cross(v1 - v0, v2 - v0);
+    const double area = glm::dot(n, n);
+    const double w1 = glm::dot(glm::cross(q - v0, v2 - v0), n) / area;
+    const double w2 = glm::dot(glm::cross(v1 - v0, q - v0), n) / area;
+    return glm::dvec3(1.0 - w1 - w2, w1, w2);
+  };
+  const TriangleNormals& normals = ps.normals[tri.primitive];
+  const auto interpolated = [&](glm::dvec3 w) {
+    return w.x * toDouble(normals.n0) + w.y * toDouble(normals.n1) + w.z * toDouble(normals.n2);
+  };
+  const glm::dvec3 here = interpolated(barycentrics(toDouble(p)));
+  const glm::dvec3 wantX = interpolated(barycentrics(toDouble(p + dpdx))) - here;
+  const glm::dvec3 wantY = interpolated(barycentrics(toDouble(p + dpdy))) - here;
+  EXPECT_GT(glm::length(wantX), 1e-4);
+  expectVectorNear(toDouble(s.dndx), wantX, 1e-3, "dn/dx");
+  expectVectorNear(toDouble(s.dndy), wantY, 1e-3, "dn/dy");
 }
 
 }  // namespace
