@@ -948,6 +948,22 @@ PT_INLINE bool bsdfHasNonSpecular(Material m) {
   return true;  // diffuse transmission, coated diffuse
 }
 
+// Whether sampling the BSDF can return a delta lobe: a bounce that carries the ray's
+// differentials on (pbrt-v4's SpawnRay after a specular sample).
+PT_INLINE bool bsdfHasSpecular(Material m) {
+  if (PT_HAS_CONDUCTOR && m.type == kMaterialConductor) {
+    return effectivelySmooth(distributionOf(m));
+  }
+  if ((PT_HAS_DIELECTRIC && m.type == kMaterialDielectric) ||
+      (PT_HAS_COATED_DIFFUSE && m.type == kMaterialCoatedDiffuse)) {
+    // A coated surface's delta lobe is its coat's reflection.
+    return dielectricIsSmooth(distributionOf(m), m.eta.x);
+  }
+  if (PT_HAS_THIN_DIELECTRIC && m.type == kMaterialThinDielectric) return true;
+  if (PT_HAS_GLTF && m.type == kMaterialGltf) return effectivelySmooth(distributionOf(m));
+  return false;  // diffuse transmission
+}
+
 // f(wo, wi) without delta lobes; `rng` feeds the coated material's estimate.
 PT_INLINE vec3 bsdfF(Material m, vec3 wo, vec3 wi, RandomStream rng) {
   if (wo.z == 0.0f) return vec3(0.0f);

@@ -266,15 +266,19 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
   bool footprintUVs = false;  // uv.duvdx, uv.duvdy and derivatives hold the hit's
   if (textured) {
     textures = materialTexturesAt(PT_SCENE_TEXTURES tri.material);
-    // The footprint at every hit, as pbrt-v4's ComputeDifferentials (about the geometric
-    // normal): a specular bounce carries it on to what textures the path reaches next.
+    bool reads = anyTexture(textures);
+    // The footprint (pbrt-v4's ComputeDifferentials, about the geometric normal) where it is
+    // read: by a texture, or by a specular bounce, which carries it on to the textures the
+    // path reaches next. (pbrt-v4 takes it at every hit; elsewhere it goes unused.)
+    footprints =
+        footprints && (reads || s.material.type == kMaterialMirror ||
+                       (s.material.type != kMaterialDiffuse && bsdfHasSpecular(s.material)));
     if (footprints) {
       surfaceDpdxy(PT_PARAMS, rd, b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2, ng, s.dpdx, s.dpdy);
     }
     // The texture coordinates only where the material reads them, or where vertex normals
     // turn the differentials of a specular bounce: on a large mesh without textures their load
     // is a cache miss at every hit.
-    bool reads = anyTexture(textures);
     if (reads || (footprints && shadingNormals)) {
       uvs = uvsAt(PT_SCENE_TEXTURES tri.primitive);
       uv.uv = interpolatedUV(uvs, b);

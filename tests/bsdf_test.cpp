@@ -1446,6 +1446,39 @@ TEST(BsdfPrecision, TrowbridgeReitzNearTheSmoothThreshold) {
   }
 }
 
+// bsdfHasSpecular (which hits take the footprint for a specular bounce) says whether sampling
+// can return a delta lobe: 4096 samples from three directions find one exactly when it says so.
+TEST(BsdfFlags, HasSpecularIsWhatSamplingReturns) {
+  CoatParams roughCoat;
+  roughCoat.alpha = 0.3f;
+  const std::vector<std::pair<const char*, Material>> materials = {
+      {"smooth conductor", conductor(0.0f, 0.0f)},
+      {"rough conductor", conductor(0.2f, 0.3f)},
+      {"smooth glass", dielectric(0.0f, 0.0f, 1.5f)},
+      {"rough glass", dielectric(0.3f, 0.3f, 1.5f)},
+      {"rough index-matched interface", dielectric(0.3f, 0.3f, 1.0f)},
+      {"thin glass", thinDielectric(1.5f)},
+      {"diffuse transmission", diffuseTransmission(vec3(0.5f), vec3(0.4f))},
+      {"smooth coat", coatedDiffuse(CoatParams{})},
+      {"rough coat", coatedDiffuse(roughCoat)},
+      {"smooth glTF metal", gltfMaterial(vec3(0.8f), 1.0f, 0.0f)},
+      {"rough glTF plastic", gltfMaterial(vec3(0.8f), 0.0f, 0.5f)}};
+  for (const auto& [name, m] : materials) {
+    bool specular = false;
+    for (const vec3 wo : {normalize(vec3(0.3f, -0.2f, 0.9f)), normalize(vec3(0.9f, 0.1f, 0.2f)),
+                          normalize(vec3(-0.2f, 0.4f, -0.8f))}) {
+      for (uint i = 0; i < 4096u && !specular; ++i) {
+        const float uc = (float(i) + 0.5f) / 4096.0f;
+        const vec2 u(std::fmod(float(i) * 0.6180339887f, 1.0f),
+                     std::fmod(float(i) * 0.7548776662f, 1.0f));
+        const BsdfSample bs = bsdfSample(m, wo, uc, u, streamFor(i, 0u));
+        specular = (bs.flags & kBsdfSpecular) != 0u;
+      }
+    }
+    EXPECT_EQ(bsdfHasSpecular(m), specular) << name;
+  }
+}
+
 // ---- Hard cases: no NaN, Inf or negative value -------------------------------------------
 
 TEST(BsdfHardCases, NoInvalidValues) {
