@@ -15,7 +15,9 @@
 //   texel y W + x (x < W, y < H): the radiance of pixel (x, y) in rgb, and in w the end of its
 //       bin in row y's conditional CDF (the sum of the row's weights up to and including x over
 //       the row's sum; 1 at x = W - 1);
-//   texel W H + y / 4, component y % 4: the end of row y's bin in the marginal CDF over rows.
+//   texel W H + y / 4, component y % 4: the end of row y's bin in the marginal CDF over rows;
+//   then, four to a texel from float W H * 4 + ceil(H / 4) * 4 on: the marginal's guide table,
+//       then row 0's, row 1's, ... (environmentGuideEntry below).
 // A bin's probability is its CDF end minus its start (the previous end, 0 for the first): the
 // sampler draws each bin with exactly that probability, and the density of a direction is read
 // from the same two numbers, so that the sampled pdf and the pdf of a direction agree bit for
@@ -164,11 +166,35 @@ PT_INLINE float environmentBinProbability(EnvironmentMap env, int row, uint i) {
   return environmentCdfEnd(env, row, i) - start;
 }
 
+// Guide tables (Chen and Asau's cutpoint method) start the searches below near their answer:
+// a CDF of n bins has G + 1 entries, G = environmentGuideSize(n) a power of two about n / 8;
+// entry k is the first bin whose end exceeds k / G (n - 1 where none does). A u in
+// [k / G, (k + 1) / G) has its bin between entries k and k + 1, and the search there finds the
+// bin that searching all n finds, in about three steps instead of log2 n (each a cache miss
+// on a large image). The entries are stored as floats (exact: below 2^24).
+PT_INLINE uint environmentGuideSize(uint count) {
+  uint n = (count + 7u) / 8u;
+  return n <= 1u ? 1u : (2u << uint(findMSB(n - 1u)));
+}
+
+// Entry k of the guide table of `row` (-1: the marginal's).
+PT_INLINE uint environmentGuideEntry(EnvironmentMap env, int row, uint k) {
+  uint marginalEntries = environmentGuideSize(env.height) + 1u;
+  uint i = 4u * (env.width * env.height + (env.height + 3u) / 4u) + k;
+  if (row >= 0) i += marginalEntries + uint(row) * (environmentGuideSize(env.width) + 1u);
+  vec4 t = PT_ENVIRONMENT_TEXEL(env, i / 4u);
+  uint c = i & 3u;
+  return uint(c == 0u ? t.x : c == 1u ? t.y : c == 2u ? t.z : t.w);
+}
+
 // The first of `count` bins whose CDF end exceeds u: the bin the inversion method gives for u in
 // [0, 1). A bin of probability 0 is never the answer (its end equals the previous one).
 PT_INLINE uint environmentFindBin(EnvironmentMap env, int row, uint count, float u) {
-  uint lo = 0u;
-  uint hi = count - 1u;
+  // u G is exact (G a power of two), so u lies in [k / G, (k + 1) / G).
+  uint guideSize = environmentGuideSize(count);
+  uint k = min(uint(u * float(guideSize)), guideSize - 1u);
+  uint lo = environmentGuideEntry(env, row, k);
+  uint hi = environmentGuideEntry(env, row, k + 1u);
   while (lo < hi) {
     PT_ENVIRONMENT_LOOP_TICK();
     uint mid = (lo + hi) / 2u;

@@ -164,6 +164,52 @@ TEST(EnvironmentSampling, SamplesFollowTheirDensity) {
   }
 }
 
+// The guide tables start each search near its answer; the bin found must be the one the whole
+// CDF gives: the first whose end exceeds u (the last where none does). Checked against a linear
+// scan, for the marginal and every row of an image whose sides are not powers of two, with
+// rows and columns of weight 0 (empty bins), at random u and at both sides of every guide
+// threshold k / G.
+TEST(EnvironmentSampling, GuideTablesFindTheBinOfTheWholeSearch) {
+  Image sky = makeSky(77, 21);
+  for (int x = 0; x < sky.width; ++x) sky.at(x, 5) = vec3(0.0f);
+  for (int y = 0; y < sky.height; ++y) {
+    for (int x = 30; x < 45; ++x) sky.at(x, y) = vec3(0.0f);
+  }
+  const std::vector<vec4> texels = buildEnvironmentTexels(sky, kEnvironmentLatLong, false);
+  const EnvironmentMap env = mapOf(sky, kEnvironmentLatLong, texels, rotatedFrame());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  int checked = 0;
+  for (int row = -1; row < sky.height; ++row) {
+    const uint count = row < 0 ? env.height : env.width;
+    const auto scan = [&](float u) {
+      for (uint i = 0; i < count; ++i) {
+        if (environmentCdfEnd(env, row, i) > u) return i;
+      }
+      return count - 1;
+    };
+    std::vector<float> us;
+    for (int i = 0; i < 200; ++i) us.push_back(uniform(rng));
+    const uint g = environmentGuideSize(count);
+    for (uint k = 0; k <= g; ++k) {
+      const float t = float(k) / float(g);
+      us.push_back(t);
+      us.push_back(std::nextafter(t, 0.0f));
+    }
+    for (uint i = 0; i < count; ++i) us.push_back(environmentCdfEnd(env, row, i));
+    for (float u : us) {
+      if (!(u >= 0.0f && u < 1.0f)) continue;
+      ASSERT_EQ(environmentFindBin(env, row, count, u), scan(u)) << "row " << row << " u " << u;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 20 * 200);
+  // 77 bins: guides of 16 entries (77 / 8 rounded up, to a power of two); 21 rows: 4.
+  EXPECT_EQ(environmentGuideSize(77), 16u);
+  EXPECT_EQ(environmentGuideSize(21), 4u);
+  EXPECT_EQ(environmentGuideSize(8), 1u);
+}
+
 TEST(EnvironmentSampling, SampledPdfIsTheDirectionsPdfAndRadiance) {
   for (const MappingCase& m : kMappings) {
     SCOPED_TRACE(m.mapping);
@@ -337,11 +383,13 @@ TEST(EnvironmentRender, BothBackendsAgreeUnderMis) {
 }
 
 TEST(EnvironmentRender, TooManyTexelsForTheDeviceIsOneLine) {
-  // 1024 x 1024 texels and 256 of the marginal's, against a limit one short.
-  EXPECT_EQ(environmentTexelCount(1024, 1024), 1024u * 1024u + 256u);
-  EXPECT_NO_THROW(checkEnvironmentTexels("dev", 1024 * 1024 + 256, "sky.exr", 1024 * 1024 + 256));
+  // 1024 x 1024 texels, 256 of the marginal's, and the guide tables' (1024 + 1) x 129 floats
+  // (129 entries each: 1024 / 8 + 1) in 33057 texels, against a limit one short.
+  const size_t count = 1024u * 1024u + 256u + 33057u;
+  EXPECT_EQ(environmentTexelCount(1024, 1024), count);
+  EXPECT_NO_THROW(checkEnvironmentTexels("dev", count, "sky.exr", count));
   try {
-    checkEnvironmentTexels("dev", 1024 * 1024 + 255, "sky.exr", 1024 * 1024 + 256);
+    checkEnvironmentTexels("dev", count - 1, "sky.exr", count);
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     const std::string what = e.what();

@@ -31,6 +31,20 @@ double cdfEnds(const double* weights, size_t n, float* ends) {
   return sum;
 }
 
+// The guide table of the CDF with these `ends` (environment.h's environmentGuideSize + 1
+// entries), written from float `at` of `out` on.
+void writeGuide(const float* ends, uint n, std::vector<vec4>& out, size_t at) {
+  const uint g = environmentGuideSize(n);
+  uint bin = 0;
+  for (uint k = 0; k <= g; ++k) {
+    // k / G is exact in float: the comparison is the shader's.
+    const float threshold = float(k) / float(g);
+    while (bin + 1 < n && !(ends[bin] > threshold)) ++bin;
+    const size_t i = at + k;
+    out[i / 4][int(i % 4)] = float(bin);
+  }
+}
+
 }  // namespace
 
 std::vector<vec4> buildEnvironmentTexels(const Image& radiance, uint mapping, bool compensated) {
@@ -57,6 +71,10 @@ std::vector<vec4> buildEnvironmentTexels(const Image& radiance, uint mapping, bo
     if (!any) std::fill(weights.begin(), weights.end(), 1.0);
   }
   std::vector<vec4> texels(environmentTexelCount(w, h), vec4(0.0f));
+  const size_t marginalBase = size_t(w) * size_t(h);
+  const size_t marginalGuide = 4 * (marginalBase + (size_t(h) + 3) / 4);
+  const size_t rowGuides = marginalGuide + environmentGuideSize(uint(h)) + 1;
+  const size_t rowGuideEntries = environmentGuideSize(uint(w)) + 1;
   std::vector<double> rowSums(size_t(h), 0.0);
   std::vector<float> ends(static_cast<size_t>(w));
   for (int y = 0; y < h; ++y) {
@@ -65,11 +83,12 @@ std::vector<vec4> buildEnvironmentTexels(const Image& radiance, uint mapping, bo
     for (int x = 0; x < w; ++x) {
       texels[base + size_t(x)] = vec4(max(radiance.at(x, y), vec3(0.0f)), ends[size_t(x)]);
     }
+    writeGuide(ends.data(), uint(w), texels, rowGuides + size_t(y) * rowGuideEntries);
   }
   std::vector<float> marginal(static_cast<size_t>(h));
   cdfEnds(rowSums.data(), size_t(h), marginal.data());
-  const size_t marginalBase = size_t(w) * size_t(h);
   for (int y = 0; y < h; ++y) texels[marginalBase + size_t(y) / 4][y % 4] = marginal[size_t(y)];
+  writeGuide(marginal.data(), uint(h), texels, marginalGuide);
   return texels;
 }
 

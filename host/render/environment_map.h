@@ -22,7 +22,8 @@ inline constexpr bool kEnvironmentCompensationDefault = true;
 
 // The texels of PT_BINDING_ENVIRONMENT for `radiance` (W x H, row 0 at the top) mapped by
 // `mapping` (kEnvironment*): each pixel's radiance and its conditional CDF end, then the
-// marginal CDF over the rows, four to a texel (environment.h describes the layout). The weight
+// marginal CDF over the rows and the CDFs' guide tables, four to a texel (environment.h
+// describes the layout). The weight
 // of a pixel is the mean of its channels (pbrt-v4's GetSamplingDistribution), times sin theta
 // of its row's centre for a lat-long map (the solid angle its texels cover); `compensated`
 // subtracts the weights' mean and clamps at 0 (pbrt-v4's compensatedDistribution; all ones if
@@ -32,7 +33,9 @@ std::vector<vec4> buildEnvironmentTexels(const Image& radiance, uint mapping, bo
 
 // The number of texels buildEnvironmentTexels gives for a W x H image.
 inline size_t environmentTexelCount(int width, int height) {
-  return size_t(width) * size_t(height) + (size_t(height) + 3) / 4;
+  const size_t guideFloats = size_t(environmentGuideSize(uint(height))) + 1 +
+                             size_t(height) * (size_t(environmentGuideSize(uint(width))) + 1);
+  return size_t(width) * size_t(height) + (size_t(height) + 3) / 4 + (guideFloats + 3) / 4;
 }
 
 // The mean radiance over the sphere of directions (each texel weighed by its solid angle).
