@@ -66,16 +66,20 @@ std::optional<Hit> closestShadowHit(const SceneData& scene, const Ray& ray, Inte
 
 AlphaCutouts AlphaCutouts::ofPathRay(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex,
                                      uint depth) {
-  return AlphaCutouts{&scene, scene.textureTables(),
+  return AlphaCutouts{&scene, scene.cpuCopies().cutouts.data(), scene.textureTables(),
                       pathAlphaRandom(pixel, sampleIndex, depth, scene.params.seed)};
 }
 
 AlphaCutouts AlphaCutouts::ofShadowRay(const SceneData& scene, vec2 uLight) {
-  return AlphaCutouts{&scene, scene.textureTables(), shadowAlphaRandom(uLight)};
+  return AlphaCutouts{&scene, scene.cpuCopies().cutouts.data(), scene.textureTables(),
+                      shadowAlphaRandom(uLight)};
 }
 
 bool AlphaCutouts::accept(const void* context, uint32_t triangle, const Hit& hit) {
   const AlphaCutouts& a = *static_cast<const AlphaCutouts*>(context);
+  if (a.cutouts == nullptr || ((a.cutouts[triangle / 64] >> (triangle % 64)) & 1u) == 0u) {
+    return true;
+  }
   const Triangle& tri = a.scene->bvh.triangles[triangle];
   return alphaKeepsHit(a.tables, tri.material, tri.primitive, hit.barycentrics, a.u);
 }

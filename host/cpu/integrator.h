@@ -51,6 +51,7 @@ std::optional<Hit> closestShadowHit(const SceneData& scene, const Ray& ray, Inte
 // the ray's number (texture.h's pathAlphaRandom, shadowAlphaRandom).
 struct AlphaCutouts {
   const SceneData* scene;
+  const uint64_t* cutouts;  // CpuSceneCopies::cutouts
   TextureTables tables;
   float u;
   // The cut-outs of a path's ray after `depth` scattering events, and of the shadow ray of a

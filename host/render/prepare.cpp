@@ -21,10 +21,22 @@ std::vector<TriangleShading> computeTriangleShading(const std::vector<Triangle>&
   return shading;
 }
 
-void LazyCpuSceneCopies::build(const Bvh& bvh) const {
+void LazyCpuSceneCopies::build(const Bvh& bvh,
+                               const std::vector<MaterialTextures>& materialTextures) const {
   std::call_once(state_->once, [&] {
-    state_->copies.wide = buildWideBvh(bvh);
-    state_->copies.shading = computeTriangleShading(bvh.triangles);
+    CpuSceneCopies& c = state_->copies;
+    c.wide = buildWideBvh(bvh);
+    c.shading = computeTriangleShading(bvh.triangles);
+    const auto cutAway = [&](uint material) {
+      return material < materialTextures.size() && materialTextures[material].alpha != kNoTexture;
+    };
+    if (std::any_of(bvh.triangles.begin(), bvh.triangles.end(),
+                    [&](const Triangle& t) { return cutAway(t.material); })) {
+      c.cutouts.assign((bvh.triangles.size() + 63) / 64, 0);
+      for (size_t t = 0; t < bvh.triangles.size(); ++t) {
+        if (cutAway(bvh.triangles[t].material)) c.cutouts[t / 64] |= uint64_t(1) << (t % 64);
+      }
+    }
     state_->built.store(true, std::memory_order_release);
   });
 }

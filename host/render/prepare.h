@@ -96,11 +96,15 @@ struct EffectSet {
 // (Bvh::triangles): what the CPU reads at every hit and light sample, computed once.
 std::vector<TriangleShading> computeTriangleShading(const std::vector<Triangle>& triangles);
 
-// What only the CPU reference reads: the wide copy of the BVH (wide_bvh.h) and the
-// triangles' shading constants.
+// What only the CPU reference reads: the wide copy of the BVH (wide_bvh.h), the
+// triangles' shading constants, and which triangles alpha tests may cut away.
 struct CpuSceneCopies {
   WideBvh wide;
   std::vector<TriangleShading> shading;  // in Bvh::triangles order
+  // Bit t (word t / 64, bit t % 64): Bvh::triangles[t]'s material has an alpha texture. The
+  // traversal's candidate hits read it instead of the triangle (a cache miss at every
+  // candidate); empty where no material has one.
+  std::vector<uint64_t> cutouts;
 };
 
 // CpuSceneCopies, built on first use, once, by whichever thread asks first: the Vulkan
@@ -118,8 +122,9 @@ class LazyCpuSceneCopies {
   LazyCpuSceneCopies& operator=(LazyCpuSceneCopies&&) noexcept = default;
 
   // Once per ray in the CPU reference: inline, one load and a branch once it is built.
-  const CpuSceneCopies& get(const Bvh& bvh) const {
-    if (!state_->built.load(std::memory_order_acquire)) build(bvh);
+  const CpuSceneCopies& get(const Bvh& bvh,
+                            const std::vector<MaterialTextures>& materialTextures) const {
+    if (!state_->built.load(std::memory_order_acquire)) build(bvh, materialTextures);
     return state_->copies;
   }
 
@@ -129,7 +134,7 @@ class LazyCpuSceneCopies {
     std::atomic<bool> built{false};
     CpuSceneCopies copies;
   };
-  void build(const Bvh& bvh) const;
+  void build(const Bvh& bvh, const std::vector<MaterialTextures>& materialTextures) const;
   std::unique_ptr<State> state_;
 };
 
@@ -169,7 +174,7 @@ struct SceneData {
   LazyCpuSceneCopies cpu;  // of bvh; through cpuCopies() and wideBvh()
 
   // What only the CPU reference reads, built from bvh on the first call.
-  const CpuSceneCopies& cpuCopies() const { return cpu.get(bvh); }
+  const CpuSceneCopies& cpuCopies() const { return cpu.get(bvh, materialTextures); }
   // The BVH the CPU reference traverses: bvh collapsed to eight-wide nodes, with the same
   // answers to every query (wide_bvh.h).
   const WideBvh& wideBvh() const { return cpuCopies().wide; }
