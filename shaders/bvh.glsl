@@ -214,6 +214,20 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
     ref = 0u;
   }
   uint bestPrimitive = kNoPrimitive;  // kNoPrimitive until a hit is found
+#ifdef PT_HIT_FILTER
+  // A closer hit that the includer's filter judges (PT_HIT_FILTERED: an alpha cut-out) is
+  // judged outside the traversal loop: lavapipe runs both sides of a branch, so a filter in the
+  // loop would cost every step of every ray its texture lookups. The loop stops after the step
+  // that meets such a hit, without taking it; the filter judges it below, and the loop goes on
+  // from where it stopped. (The step's remainder, the next leaf or a pop, reads nothing of the
+  // best hit: taking the hit after it is taking it in the step.)
+  bool pending = false;
+  Triangle pendingTri;
+  TriangleHit pendingHit;
+  uint pendingIndex = 0u;
+  for (;;) {
+    gLoopIterations++;
+#endif
   for (;;) {
     gLoopIterations++;
     // searchRange of the closest hit so far (recomputed rather than kept: lavapipe keeps fewer
@@ -237,8 +251,13 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
       if (inexact) break;
       bool closer = hitTriangle && isCloserHit(hit.t, tri.primitive, best.t, bestPrimitive);
 #ifdef PT_HIT_FILTER
-      // A hit the includer's filter drops (an alpha cut-out) is passed by, as if missed.
-      if (closer) closer = PT_HIT_FILTER(tri, hit, r);
+      if (closer && PT_HIT_FILTERED(tri)) {
+        pending = true;
+        pendingTri = tri;
+        pendingHit = hit;
+        pendingIndex = first;
+        closer = false;
+      }
 #endif
       best.t = closer ? hit.t : best.t;
       best.triangle = closer ? first : best.triangle;
@@ -327,7 +346,23 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
         ref = 0u;
       }
     }
+#ifdef PT_HIT_FILTER
+    if (pending) break;
+#endif
   }
+#ifdef PT_HIT_FILTER
+    if (!pending) break;
+    pending = false;
+    // A hit the filter drops (an alpha cut-out) is passed by, as if missed.
+    if (PT_HIT_FILTER(pendingTri, pendingHit, r)) {
+      best.t = pendingHit.t;
+      best.triangle = pendingIndex;
+      bestPrimitive = pendingTri.primitive;
+      if (anyHit) break;
+    }
+    if (first == end && ref == 0u && stackSize == 0u) break;
+  }
+#endif
   bool found = bestPrimitive != kNoPrimitive;
   // Ended by a break: a hit found for any-hit, a test to redo exactly, or nothing left. (A
   // flag set at each break would not do: the compiler folds it to true, having seen no other

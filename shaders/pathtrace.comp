@@ -170,6 +170,14 @@ float gAlphaU = 0.0;
 #define PT_HIT_FILTER(tri, hit, r)                   \
   (!kAlphaCutouts || params.texturesPresent == 0u || \
    alphaKeepsHit(tri.material, tri.primitive, hit.barycentrics, gAlphaU))
+// Whether PT_HIT_FILTER has anything to judge at a hit on tri: its material has an alpha
+// texture (MaterialTextures::alpha, the second texel's w).
+bool materialHasAlpha(uint material) {
+  return texelFetch(materialTextureTexels, int(kMaterialTextureTexels * material) + 1).w !=
+         kNoTexture;
+}
+#define PT_HIT_FILTERED(tri) \
+  (kAlphaCutouts && params.texturesPresent != 0u && materialHasAlpha(tri.material))
 // The environment image (environment.h reads its texels through environmentTexel).
 vec4 environmentTexel(uint i) {
   return uintBitsToFloat(texelFetch(environmentTexels, int(i)));
