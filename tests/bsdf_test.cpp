@@ -18,6 +18,7 @@
 
 #include "bsdf.h"
 #include "chi2.h"
+#include "common/numbers.h"
 #include "test_materials.h"
 
 namespace pt {
@@ -54,8 +55,6 @@ constexpr int kThetaCells = 16;
 constexpr int kPhiCells = 32;
 // Directions drawn first to find where the lobes are (test::focusedGrid).
 constexpr int kPilotSamples = 4096;
-
-constexpr double kPiD = std::numbers::pi;
 
 // ---- Helpers ---------------------------------------------------------------------------------
 

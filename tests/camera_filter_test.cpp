@@ -169,7 +169,7 @@ constexpr int kSamples = 200000;
 constexpr int kCells = 20;
 // Every chi-square test below must pass at a significance that keeps the chance of a correct
 // sampler failing any of them below 1e-3 (they are deterministic: a fixed seed each).
-const double kSignificance = test::sidakSignificance(1e-3, 10);
+const double kFilterSignificance = test::sidakSignificance(1e-3, 10);
 
 struct FilterCase {
   const char* name;
@@ -186,7 +186,7 @@ TEST_P(FilterSampling, OffsetsFollowTheFilter) {
   const Histogram h = histogram(cam, c.fx, c.fy, kSamples, kCells, 7);
   const test::Chi2Result r = test::pearsonChi2(h.observed, h.expected);
   EXPECT_EQ(r.zeroDensityHits, 0.0);
-  EXPECT_GT(r.pValue, kSignificance) << "chi2 " << r.statistic << " dof " << r.dof;
+  EXPECT_GT(r.pValue, kFilterSignificance) << "chi2 " << r.statistic << " dof " << r.dof;
 }
 
 // Every weight is 1 but mitchell's: sign(f(x) f(y)) times (integral |f| / integral f), the
@@ -414,7 +414,7 @@ TEST(CameraThinLens, ConcentricDiskIsUniform) {
         std::min(kSectors - 1, int(angle / (2.0 * 3.14159265358979323846) * kSectors));
     observed[size_t(ring * kSectors + sector)] += 1.0;
   }
-  EXPECT_GT(test::pearsonChi2(observed, expected).pValue, kSignificance);
+  EXPECT_GT(test::pearsonChi2(observed, expected).pValue, kFilterSignificance);
   EXPECT_EQ(sampleConcentricDisk(vec2(0.5f)), vec2(0.0f));
 }
 
@@ -494,7 +494,7 @@ TEST(CameraCrop, PixelsAsPbrtV4ComputesThem) {
 
 // ---- whole renders ------------------------------------------------------------------------
 
-SceneData cornell(int size, const std::function<void(CameraDesc&)>& camera) {
+SceneData cornellWithCamera(int size, const std::function<void(CameraDesc&)>& camera) {
   Scene scene = loadScene(test::kConfigs / "cornell-box.json");
   camera(scene.camera);
   return prepareScene(std::move(scene), RenderSettings{.width = size, .height = size});
@@ -524,8 +524,8 @@ Image renderCpuImage(const SceneData& data, int spp) {
 // lane by lane).
 TEST(CameraCrop, RendersTheWholeImagesPixelsBitForBit) {
   for (auto* setUp : {+[](CameraDesc&) {}, +[](CameraDesc& c) { thinLensAndGaussian(c); }}) {
-    const SceneData whole = cornell(16, setUp);
-    const SceneData crop = cornell(16, [&](CameraDesc& c) {
+    const SceneData whole = cornellWithCamera(16, setUp);
+    const SceneData crop = cornellWithCamera(16, [&](CameraDesc& c) {
       setUp(c);
       c.pixelBounds = std::array<int, 4>{3, 14, 6, 11};
     });
@@ -547,7 +547,7 @@ TEST(CameraCrop, RendersTheWholeImagesPixelsBitForBit) {
 
 // The lanes (renderCpu) and the reference give the same bits with filters, lenses and crops.
 TEST(CameraCrop, LanesEqualTheReference) {
-  const SceneData data = cornell(12, mitchellWindowCrop);
+  const SceneData data = cornellWithCamera(12, mitchellWindowCrop);
   const Image image = renderCpuImage(data, 1);
   for (int y = 0; y < image.height; ++y) {
     for (int x = 0; x < image.width; ++x) {
@@ -559,20 +559,20 @@ TEST(CameraCrop, LanesEqualTheReference) {
 }
 
 TEST(CameraAgree, GaussianThinLensOnBothBackends) {
-  const SceneData data = cornell(24, thinLensAndGaussian);
+  const SceneData data = cornellWithCamera(24, thinLensAndGaussian);
   expectAgreement(renderBoth(data, 8));
 }
 
 TEST(CameraAgree, MitchellScreenWindowCropOnBothBackends) {
-  const SceneData data = cornell(24, mitchellWindowCrop);
+  const SceneData data = cornellWithCamera(24, mitchellWindowCrop);
   ASSERT_EQ(data.params.camera.width, 18u);
   expectAgreement(renderBoth(data, 8));
 }
 
 // On lavapipe too, a crop is its pixels of the whole image, bit for bit.
 TEST(CameraAgree, VulkanCropIsTheWholeImagesPixels) {
-  const SceneData whole = cornell(16, thinLensAndGaussian);
-  const SceneData crop = cornell(16, [](CameraDesc& c) {
+  const SceneData whole = cornellWithCamera(16, thinLensAndGaussian);
+  const SceneData crop = cornellWithCamera(16, [](CameraDesc& c) {
     thinLensAndGaussian(c);
     c.cropWindow = std::array<float, 4>{0.25f, 0.75f, 0.5f, 1.0f};
   });

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "chi2.h"
+#include "common/numbers.h"
 #include "cpu/integrator.h"
 #include "environment.h"
 #include "furnace_scene.h"
@@ -26,8 +27,6 @@
 
 namespace pt {
 namespace {
-
-constexpr double kPiD = 3.14159265358979323846;
 
 // A sky that is nothing like uniform: a gradient down the rows, a tint across, and a bright
 // patch, so that the distribution's rows and columns all differ.

@@ -26,7 +26,7 @@ namespace {
 
 using test::kConfigs;
 
-SceneData prepare(const std::string& config, int size) {
+SceneData prepareConfig(const std::string& config, int size) {
   return prepareScene(loadScene(kConfigs / config), RenderSettings{.width = size, .height = size});
 }
 
@@ -367,7 +367,7 @@ TEST(MergeFilmStates, RefusesOtherSettingsSizesAndOverlaps) {
 // ---- The CPU renderer's passes --------------------------------------------------------------
 
 TEST(CpuPasses, TheImageDoesNotDependOnTheThreadCount) {
-  const SceneData data = prepare("cornell-box.json", 24);
+  const SceneData data = prepareConfig("cornell-box.json", 24);
   Film one(24, 24);
   renderCpu(data, test::cpuOptions(1, 6), one);
   for (int threads : {2, 3, 5}) {
@@ -379,7 +379,7 @@ TEST(CpuPasses, TheImageDoesNotDependOnTheThreadCount) {
 }
 
 TEST(CpuPasses, RunsSplitAnyWaySumToTheBitsOfOneRun) {
-  const SceneData data = prepare("cornell-mirror.json", 20);
+  const SceneData data = prepareConfig("cornell-mirror.json", 20);
   Film whole(20, 20);
   renderCpu(data, test::cpuOptions(2, 12), whole);
   // Continued in three calls into one film, as a resumed render does.
@@ -403,7 +403,7 @@ TEST(CpuPasses, RunsSplitAnyWaySumToTheBitsOfOneRun) {
 }
 
 TEST(CpuPasses, AStopLeavesWholePassesAndCheckpointsSeeThem) {
-  const SceneData data = prepare("cornell-box.json", 32);
+  const SceneData data = prepareConfig("cornell-box.json", 32);
   std::atomic<bool> stop{false};
   Film film(32, 32);
   CpuRenderOptions options = test::cpuOptions(2, 1000);
@@ -459,7 +459,7 @@ VulkanRenderOptions vulkanOptions(uint32_t first, int spp) {
 }
 
 TEST(VulkanBatches, StoppedMidBatchAndContinuedGiveTheBitsOfOneRun) {
-  const SceneData data = prepare("cornell-box.json", 16);
+  const SceneData data = prepareConfig("cornell-box.json", 16);
   Film whole(16, 16);
   const VulkanRenderStats ref = renderVulkan(data, vulkanOptions(0, 21), whole);
   EXPECT_EQ(ref.validationErrors, 0u);
@@ -503,7 +503,7 @@ TEST(VulkanBatches, StoppedMidBatchAndContinuedGiveTheBitsOfOneRun) {
 }
 
 TEST(VulkanBatches, AlignedSlicesMergeToTheBitsOfOneRun) {
-  const SceneData data = prepare("cornell-mirror.json", 16);
+  const SceneData data = prepareConfig("cornell-mirror.json", 16);
   Film whole(16, 16);
   renderVulkan(data, vulkanOptions(0, 30), whole);
   // Slices at batch boundaries (multiples of 8), the last one kept open and folded on merge.

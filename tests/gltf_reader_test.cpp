@@ -37,7 +37,7 @@ Scene read(const std::string& text, const SceneLoadOptions& options = {}) {
 }
 
 // The InputError's message, or "" where the file is accepted.
-std::string errorOf(const std::string& text, const SceneLoadOptions& options = {}) {
+std::string gltfErrorOf(const std::string& text, const SceneLoadOptions& options = {}) {
   try {
     read(text, options);
   } catch (const InputError& e) {
@@ -330,9 +330,9 @@ TEST(GltfReader, PerspectiveCameraOfTheFirstNodeOrTheOneNamed) {
     expectNear(c.camera.target, vec3(2, 0, 0), 1e-6f);
     EXPECT_EQ(c.camera.width, 512);
   }
-  EXPECT_EQ(errorOf(b.gltf(), SceneLoadOptions{.camera = "clsoe"}),
+  EXPECT_EQ(gltfErrorOf(b.gltf(), SceneLoadOptions{.camera = "clsoe"}),
             "test.gltf: cameras: no camera named 'clsoe' (did you mean 'close'?)");
-  EXPECT_EQ(errorOf(b.gltf(), SceneLoadOptions{.camera = "7"}),
+  EXPECT_EQ(gltfErrorOf(b.gltf(), SceneLoadOptions{.camera = "7"}),
             "test.gltf: cameras: --camera 7 out of range (the file has 2 cameras)");
 }
 
@@ -395,7 +395,7 @@ TEST(GltfReader, UnsimulatedFeaturesWarnOnceAndAreErrorsWithStrict) {
   EXPECT_EQ(s.warnings[2],
             "test.gltf: meshes[0].primitives[1].mode: points and lines have no "
             "area and are not rendered");
-  EXPECT_EQ(errorOf(b.gltf(), SceneLoadOptions{.strict = true}),
+  EXPECT_EQ(gltfErrorOf(b.gltf(), SceneLoadOptions{.strict = true}),
             "test.gltf: extensionsUsed[0]: KHR_materials_clearcoat is not simulated (rendered "
             "without it) (an error with --strict)");
 }
@@ -481,14 +481,14 @@ TEST(GltfReader, ErrorsNameTheJsonPath) {
     GltfBuilder b = oneTriangle();
     b.node({{"mesh", 0}});
     c.edit(b);
-    EXPECT_EQ(errorOf(b.gltf()), c.expected);
+    EXPECT_EQ(gltfErrorOf(b.gltf()), c.expected);
   }
 }
 
 TEST(GltfReader, UnparsableFilesGiveOneLineNamingTheFile) {
   for (const std::string text : {std::string("{"), std::string("{\"asset\": {}}"),
                                  std::string("glTF\x02\0\0\0\x08\0\0\0", 12)}) {
-    const std::string e = errorOf(text);
+    const std::string e = gltfErrorOf(text);
     EXPECT_EQ(e.rfind("test.gltf: ", 0), 0u) << e;
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
   }
@@ -532,7 +532,7 @@ TEST(GltfReader, PunctualLightsAtTheirNodesShiningAlongMinusZ) {
   expectNear(s.lights[2].direction, vec3(0, 1, 0));
   expectNear(s.lights[2].radiance, vec3(3));
   b.doc["nodes"][point]["extensions"]["KHR_lights_punctual"]["light"] = 7;
-  EXPECT_EQ(errorOf(b.gltf()),
+  EXPECT_EQ(gltfErrorOf(b.gltf()),
             "test.gltf: nodes[1].extensions.KHR_lights_punctual.light: light 7 out of range (the "
             "file has 3)");
 }
@@ -616,7 +616,7 @@ TEST(GltfReader, EnvironmentImageReplacesTheSky) {
   EXPECT_EQ(s.environment->image.pixels[0], vec3(0.5f, 0.25f, 2.0f));
   EXPECT_EQ(s.environment->image.pixels[3], vec3(0.0f));
   const std::string missing = (dir / "none.exr").string();
-  EXPECT_EQ(errorOf(b.gltf(), SceneLoadOptions{.environment = missing}).rfind(missing, 0), 0u);
+  EXPECT_EQ(gltfErrorOf(b.gltf(), SceneLoadOptions{.environment = missing}).rfind(missing, 0), 0u);
 }
 
 TEST(GltfReader, CommandLineRendersAGltfAndRefusesABadOneWithStatus2) {

@@ -49,10 +49,7 @@ using ImageWrite = ImageTempDir;
 
 using test::readFile;
 
-void writeBytes(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), std::streamsize(bytes.size()));
-}
+using test::writeBytes;
 
 // An image of awkward float values: denormals, the extremes, signed zero, and distinct values
 // per channel and pixel so that swapped channels, rows or columns show.
@@ -96,17 +93,7 @@ void expectBitIdentical(const Image& actual, const Image& expected) {
   }
 }
 
-// Runs `read` and returns the InputError's message ("" and a test failure if none).
-template <typename F>
-std::string inputErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError";
-  return "";
-}
+using test::inputErrorOf;
 
 void expectMessageStartsWithPath(const std::string& message, const fs::path& path) {
   EXPECT_EQ(message.rfind(path.string() + ": ", 0), 0u) << message;

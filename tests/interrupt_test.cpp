@@ -32,7 +32,7 @@ using Clock = std::chrono::steady_clock;
 using test::PtResult;
 using test::runPt;
 
-std::string config(const std::string& name) {
+std::string configFile(const std::string& name) {
   return (test::kConfigs / name).string();
 }
 
@@ -174,7 +174,7 @@ void checkInterruptAtRandomMoment(const std::string& backend, const std::string&
   test::TempDir dir;
   const std::string common = " --backend " + backend + " --width " + size + " --height " + size;
   std::vector<std::string> args{"render",
-                                config("cornell-box.json"),
+                                configFile("cornell-box.json"),
                                 "--backend",
                                 backend,
                                 "--width",
@@ -223,7 +223,7 @@ void checkInterruptAtRandomMoment(const std::string& backend, const std::string&
   }
   // The images are those of a render of k samples.
   const PtResult again =
-      runPt("render " + config("cornell-box.json") + common + " --spp " + spp + " --out " +
+      runPt("render " + configFile("cornell-box.json") + common + " --spp " + spp + " --out " +
             (dir / "b.pfm").string() + " --out " + (dir / "b.png").string());
   ASSERT_EQ(again.status, 0) << again.err;
   expectSameFile(dir / "a.pfm", dir / "b.pfm");
@@ -241,7 +241,7 @@ TEST(InterruptVulkan, SigintAtARandomMomentWritesWholePasses) {
 
 TEST(Interrupt, SigtermStopsTheSameWay) {
   test::TempDir dir;
-  PtProcess pt({"render", config("cornell-box.json"), "--backend", "cpu", "--width", "32",
+  PtProcess pt({"render", configFile("cornell-box.json"), "--backend", "cpu", "--width", "32",
                 "--height", "32", "--spp", "1000000", "--out", (dir / "a.pfm").string()});
   // Late enough that a pass is complete (else nothing is written, by design); a sanitizer
   // build starts several times slower.
@@ -258,12 +258,12 @@ TEST(Interrupt, ASecondSigintStopsAtOnceLeavingNothingHalfWritten) {
   test::TempDir dir;
   // Outputs from an earlier render: they must survive whole, replaced or not.
   const std::string common = " --backend cpu --width 256 --height 256";
-  ASSERT_EQ(runPt("render " + config("cornell-box.json") + common + " --spp 1 --out " +
+  ASSERT_EQ(runPt("render " + configFile("cornell-box.json") + common + " --spp 1 --out " +
                   (dir / "a.exr").string() + " --out " + (dir / "a.png").string())
                 .status,
             0);
   const std::string oldExr = test::readFile(dir / "a.exr");
-  PtProcess pt({"render", config("cornell-box.json"), "--backend", "cpu", "--width", "256",
+  PtProcess pt({"render", configFile("cornell-box.json"), "--backend", "cpu", "--width", "256",
                 "--height", "256", "--spp", "1000000", "--checkpoint", (dir / "s.ptstate").string(),
                 "--out", (dir / "a.exr").string(), "--out", (dir / "a.png").string()});
   sleepFor(0.5);
@@ -292,7 +292,7 @@ TEST(Interrupt, ASecondSigintStopsAtOnceLeavingNothingHalfWritten) {
 // machine and backend (so that interrupts land in it on a fast GPU as on lavapipe).
 std::string sppForSeconds(const std::string& backend, const std::string& size, double seconds) {
   const PtResult r =
-      runPt("render " + config("cornell-mirror.json") + " --backend " + backend + " --width " +
+      runPt("render " + configFile("cornell-mirror.json") + " --backend " + backend + " --width " +
             size + " --height " + size + " --spp 64 --out " + (test::TempDir() / "x.pfm").string());
   EXPECT_EQ(r.status, 0) << r.err;
   const double perSample = std::max(1e-6, std::stod("0" + statValue(r.out, "seconds")) / 64.0);
@@ -304,7 +304,7 @@ std::string sppForSeconds(const std::string& backend, const std::string& size, d
 void checkResume(const std::string& backend, const std::string& size, int interrupts) {
   test::TempDir dir;
   const std::string spp = sppForSeconds(backend, size, 0.6);
-  const std::vector<std::string> base{"render",    config("cornell-mirror.json"),
+  const std::vector<std::string> base{"render",    configFile("cornell-mirror.json"),
                                       "--backend", backend,
                                       "--width",   size,
                                       "--height",  size,
@@ -313,7 +313,7 @@ void checkResume(const std::string& backend, const std::string& size, int interr
                                       "--out",     (dir / "a.exr").string()};
   const std::string common =
       " --backend " + backend + " --width " + size + " --height " + size + " --spp " + spp;
-  const PtResult ref = runPt("render " + config("cornell-mirror.json") + common + " --out " +
+  const PtResult ref = runPt("render " + configFile("cornell-mirror.json") + common + " --out " +
                              (dir / "ref.pfm").string() + " --out " + (dir / "ref.exr").string());
   ASSERT_EQ(ref.status, 0) << ref.err;
 
@@ -382,8 +382,8 @@ TEST(ResumeVulkan, AfterThreeInterruptionsIsBitIdentical) {
 // state keeps the last, partial batch open for this).
 void checkContinueToMoreSamples(const std::string& backend) {
   test::TempDir dir;
-  const std::string common =
-      "render " + config("cornell-box.json") + " --backend " + backend + " --width 16 --height 16";
+  const std::string common = "render " + configFile("cornell-box.json") + " --backend " + backend +
+                             " --width 16 --height 16";
   const fs::path state = dir / "s.ptstate";
   ASSERT_EQ(runPt(common + " --spp 20 --checkpoint " + state.string()).status, 0);
   ASSERT_EQ(
@@ -408,7 +408,7 @@ TEST(ResumeVulkan, ToMoreSamplesContinuesTheSameSequence) {
 TEST(Resume, TexturedStatesKeepTheirDifferentialScale) {
   test::TempDir dir;
   const std::string common =
-      "render " + config("textured-sky.json") + " --backend cpu --width 12 --height 8";
+      "render " + configFile("textured-sky.json") + " --backend cpu --width 12 --height 8";
   const std::string low = (dir / "low.ptstate").string();
   ASSERT_EQ(runPt(common + " --spp 4 --checkpoint " + low).status, 0);
   const PtResult refused = runPt(common + " --spp 9 --resume " + low);
@@ -430,8 +430,8 @@ TEST(Resume, TexturedStatesKeepTheirDifferentialScale) {
 // few on Vulkan), give the one-run image; the merged state continues like a one-run state.
 void checkMerge(const std::string& backend, const std::string& spp, bool everyOrder) {
   test::TempDir dir;
-  const std::string common =
-      "render " + config("cornell-box.json") + " --backend " + backend + " --width 16 --height 16";
+  const std::string common = "render " + configFile("cornell-box.json") + " --backend " + backend +
+                             " --width 16 --height 16";
   ASSERT_EQ(runPt(common + " --spp " + spp + " --out " + (dir / "ref.pfm").string()).status, 0);
   std::vector<std::string> states;
   for (int task = 0; task < 4; ++task) {
@@ -480,7 +480,7 @@ TEST(MergeVulkan, FourSlicesGiveTheOneRunImage) {
 
 TEST(Merge, NamesMissingSamplesAndMergesAPartialSetWhenAsked) {
   test::TempDir dir;
-  const std::string common = "render " + config("cornell-box.json") +
+  const std::string common = "render " + configFile("cornell-box.json") +
                              " --backend cpu --width 16 --height 16 --spp 40 --task-count 4";
   for (int task : {0, 1, 3}) {
     ASSERT_EQ(runPt(common + " --task-index " + std::to_string(task) + " --checkpoint " +
@@ -504,7 +504,7 @@ TEST(Merge, NamesMissingSamplesAndMergesAPartialSetWhenAsked) {
   EXPECT_NE(r.err.find("the image has 30 of 40 samples per pixel"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(dir / "m.exr"));
   // With the missing slice rendered, the merge is whole.
-  ASSERT_EQ(runPt("render " + config("cornell-box.json") +
+  ASSERT_EQ(runPt("render " + configFile("cornell-box.json") +
                   " --backend cpu --width 16 --height 16 --samples 20:10 --checkpoint " +
                   (dir / "s2.ptstate").string())
                 .status,
@@ -518,7 +518,7 @@ TEST(Merge, NamesMissingSamplesAndMergesAPartialSetWhenAsked) {
 
 TEST(Refusals, BadStatesAndSettingsGiveOneLineAndStatus2) {
   test::TempDir dir;
-  const std::string box = "render " + config("cornell-box.json") + " --backend cpu";
+  const std::string box = "render " + configFile("cornell-box.json") + " --backend cpu";
   const std::string small = box + " --width 16 --height 16";
   const std::string s = (dir / "s.ptstate").string();
   const std::string slice = (dir / "slice.ptstate").string();
@@ -545,15 +545,15 @@ TEST(Refusals, BadStatesAndSettingsGiveOneLineAndStatus2) {
        small + " --spp 16 --seed 3 --resume " + s + out,
        {s + ": rendered with other settings (there vs here): seed 0 vs 3"}},
       {"other scene",
-       "render " + config("cornell-mirror.json") +
+       "render " + configFile("cornell-mirror.json") +
            " --backend cpu --width 16 --height 16 --spp 16 --resume " + s + out,
        {"scene "}},
       {"other resolution",
        box + " --width 16 --height 12 --spp 16 --resume " + s + out,
        {"resolution 16x16 vs 16x12"}},
       {"other backend",
-       "render " + config("cornell-box.json") + " --width 16 --height 16 --spp 16 --resume " + s +
-           out,
+       "render " + configFile("cornell-box.json") + " --width 16 --height 16 --spp 16 --resume " +
+           s + out,
        {"backend cpu vs vulkan"}},
       {"other depth", small + " --max-depth 3 --spp 16 --resume " + s + out, {"max_depth"}},
       {"other builder",
@@ -605,7 +605,7 @@ TEST(Refusals, BadStatesAndSettingsGiveOneLineAndStatus2) {
        small + " --spp 2 --task-index 0 --task-count 3 --checkpoint " + slice,
        {"task 0 gets no samples of 0:2"}},
       {"unaligned Vulkan slice",
-       "render " + config("cornell-box.json") +
+       "render " + configFile("cornell-box.json") +
            " --width 16 --height 16 --samples 5:11 --checkpoint " + slice,
        {"multiple of 16"}},
       {"checkpoint into a directory",

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "chi2.h"
+#include "common/numbers.h"
 #include "cpu/integrator.h"
 #include "furnace_scene.h"
 #include "lights.h"
@@ -24,8 +25,6 @@
 
 namespace pt {
 namespace {
-
-constexpr double kPiD = 3.14159265358979323846;
 
 // A camera 10 above the plane z = 0 looking down, whose image is the world unmirrored
 // (Scale -1 1 1 before LookAt, as Bitterli's files start), a box filter, and `spp` samples.
@@ -44,7 +43,7 @@ constexpr char kPlane[] =
     "Shape \"trianglemesh\" \"point3 P\" [-10 -10 0  10 -10 0  10 10 0  -10 10 0]\n"
     "  \"integer indices\" [0 1 2 0 2 3]\n";
 
-SceneData prepare(const std::string& text) {
+SceneData prepareText(const std::string& text) {
   return prepareScene(loadPbrtSceneText(text, "lights.pbrt"), RenderSettings{});
 }
 
@@ -63,7 +62,7 @@ Image expectedImage(const SceneData& data, const Radiance& radiance) {
 template <typename Radiance>
 void expectClosedForm(const std::string& text, const Radiance& radiance, double tolerance,
                       double absolute) {
-  const SceneData data = prepare(text);
+  const SceneData data = prepareText(text);
   const Image expected = expectedImage(data, radiance);
   const Comparison cmp = renderBoth(data, data.spp);
   expectAgreement(cmp);
@@ -128,7 +127,7 @@ TEST(AnalyticLights, DistantLightCosineOnBothBackends) {
 }
 
 // A cube of albedo 0.5 under a constant environment of radiance 1 (furnace_scene.h), 24 x 24.
-std::string furnace(int spp, const char* light) {
+std::string furnaceText(int spp, const char* light) {
   return test::furnaceScene(24, spp, light);
 }
 using test::objectPixels;
@@ -137,7 +136,7 @@ TEST(AnalyticLights, FurnaceUnderAConstantEnvironmentOnBothBackends) {
   for (uint strategy : {kStrategyMis, kStrategyNee, kStrategyBsdf}) {
     SCOPED_TRACE(strategy);
     Scene scene =
-        loadPbrtSceneText(furnace(64, "LightSource \"infinite\" \"rgb L\" [1 1 1]\n"), "f.pbrt");
+        loadPbrtSceneText(furnaceText(64, "LightSource \"infinite\" \"rgb L\" [1 1 1]\n"), "f.pbrt");
     RenderSettings settings;
     settings.strategy = strategy;
     const SceneData data = prepareScene(std::move(scene), settings);
@@ -163,7 +162,7 @@ TEST(AnalyticLights, MaxDepthCountsScatteringEventsAsPbrtDoesOnBothBackends) {
     RenderSettings settings;
     settings.maxDepth = depth;
     const SceneData data = prepareScene(
-        loadPbrtSceneText(furnace(16, "LightSource \"infinite\" \"rgb L\" [1 1 1]\n"), "f.pbrt"),
+        loadPbrtSceneText(furnaceText(16, "LightSource \"infinite\" \"rgb L\" [1 1 1]\n"), "f.pbrt"),
         settings);
     const Comparison cmp = renderBoth(data, data.spp);
     for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
@@ -185,10 +184,10 @@ TEST(AnalyticLights, TwoSidedAreaLightsEmitFromTheirBackOnBothBackends) {
   // lights the plane as the same square one-sided and facing down does (pbrt-v4's
   // "twosided"); one-sided and facing up, not at all.
   const auto scene = [&](const char* light, const char* indices) {
-    return prepare(header(16, 64, 1) + "AttributeBegin\nAreaLightSource \"diffuse\" " + light +
-                   "\nShape \"trianglemesh\" \"point3 P\" [3.5 -0.5 2  4.5 -0.5 2  4.5 0.5 2"
-                   "  3.5 0.5 2] \"integer indices\" [" +
-                   indices + "]\nAttributeEnd\n" + kPlane);
+    return prepareText(header(16, 64, 1) + "AttributeBegin\nAreaLightSource \"diffuse\" " + light +
+                       "\nShape \"trianglemesh\" \"point3 P\" [3.5 -0.5 2  4.5 -0.5 2  4.5 0.5 2"
+                       "  3.5 0.5 2] \"integer indices\" [" +
+                       indices + "]\nAttributeEnd\n" + kPlane);
   };
   const SceneData twoSided = scene("\"rgb L\" [5 5 5] \"bool twosided\" true", "0 1 2 0 2 3");
   const SceneData down = scene("\"rgb L\" [5 5 5]", "0 2 1 0 3 2");
@@ -226,7 +225,7 @@ TEST(AnalyticLights, EveryKindTogetherAgreesOnBothBackends) {
       "Shape \"trianglemesh\" \"point3 P\" [-2 -2 0.5  0 -2 0.5  0 0 1.5  -2 0 1.5]\n"
       "  \"integer indices\" [0 1 2 0 2 3]\nAttributeEnd\n" +
       std::string(kPlane);
-  const SceneData data = prepare(text);
+  const SceneData data = prepareText(text);
   EXPECT_EQ(data.lights.size(), 4u);
   EXPECT_EQ(data.emitters.size(), 5u);
   EXPECT_NE(data.effects.toString().find("delta-lights+environment"), std::string::npos)
@@ -564,7 +563,7 @@ TEST(AnalyticLights, SphereLightIrradianceOnAPlaneOnBothBackends) {
                            "Translate 4.5 0.5 1.2\nShape \"sphere\" \"float radius\" 0.5\n"
                            "AttributeEnd\n" +
                            kPlane;
-  const SceneData data = prepare(text);
+  const SceneData data = prepareText(text);
   ASSERT_EQ(data.lights.size(), 1u);
   EXPECT_EQ(data.lights[0].type, kLightSphere);
   EXPECT_EQ(data.emitters.size(), 1u);  // the sphere, not its triangles

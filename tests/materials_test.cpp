@@ -32,7 +32,7 @@ Material dielectric(float eta, float alpha) {
 Material diffuseTransmission() {
   return diffuseTransmission(vec3(0.5f, 0.4f, 0.3f), vec3(0.3f, 0.4f, 0.5f));
 }
-Material coatedDiffuse(float alpha, vec3 albedo) {
+Material coatedDiffuseMaterial(float alpha, vec3 albedo) {
   Material m{};
   m.type = kMaterialCoatedDiffuse;
   m.reflectance = vec3(0.6f, 0.3f, 0.2f);
@@ -59,16 +59,16 @@ SceneData cornellWith(const Material& a, const Material& b, int size) {
   return prepareScene(std::move(scene), RenderSettings{.width = size, .height = size});
 }
 
-struct Case {
+struct MaterialCase {
   const char* name;
   Material a, b;
   const char* effects;  // the material types the effect string must list
 };
 
-class MaterialsAgree : public ::testing::TestWithParam<Case> {};
+class MaterialsAgree : public ::testing::TestWithParam<MaterialCase> {};
 
 TEST_P(MaterialsAgree, OnBothBackends) {
-  const Case& c = GetParam();
+  const MaterialCase& c = GetParam();
   const SceneData data = cornellWith(c.a, c.b, 32);
   EXPECT_NE(data.effects.toString().find(c.effects), std::string::npos) << data.effects.toString();
   EXPECT_TRUE(data.effects.hasBsdfMaterials());
@@ -80,50 +80,54 @@ TEST_P(MaterialsAgree, OnBothBackends) {
 INSTANTIATE_TEST_SUITE_P(
     Types, MaterialsAgree,
     ::testing::Values(
-        Case{"conductors", conductor(0.0f), conductor(0.3f), "conductor"},
-        Case{"anisotropicConductor", conductor(0.05f),
-             [] {
-               Material m = conductor(0.05f);
-               m.alphaY = 0.5f;
-               return m;
-             }(),
-             "conductor"},
-        Case{"glass", dielectric(1.5f, 0.0f), dielectric(1.5f, 0.3f), "dielectric"},
-        Case{"glassBelowOne", dielectric(1.0f / 1.33f, 0.2f), dielectric(1.0f, 0.0f), "dielectric"},
-        Case{"thinAndTranslucent", thinDielectric(1.5f), diffuseTransmission(),
-             "thindielectric+diffusetransmission"},
-        Case{"coated", coatedDiffuse(0.0f, vec3(0.0f)), coatedDiffuse(0.3f, vec3(0.5f)),
-             "coateddiffuse"},
+        MaterialCase{"conductors", conductor(0.0f), conductor(0.3f), "conductor"},
+        MaterialCase{"anisotropicConductor", conductor(0.05f),
+                     [] {
+                       Material m = conductor(0.05f);
+                       m.alphaY = 0.5f;
+                       return m;
+                     }(),
+                     "conductor"},
+        MaterialCase{"glass", dielectric(1.5f, 0.0f), dielectric(1.5f, 0.3f), "dielectric"},
+        MaterialCase{"glassBelowOne", dielectric(1.0f / 1.33f, 0.2f), dielectric(1.0f, 0.0f),
+                     "dielectric"},
+        MaterialCase{"thinAndTranslucent", thinDielectric(1.5f), diffuseTransmission(),
+                     "thindielectric+diffusetransmission"},
+        MaterialCase{"coated", coatedDiffuseMaterial(0.0f, vec3(0.0f)),
+                     coatedDiffuseMaterial(0.3f, vec3(0.5f)), "coateddiffuse"},
         // The hard cases: nearly smooth and fully rough, indices next to 1 and far from it
         // (glass blocks: total internal reflection inside), extreme anisotropy.
-        Case{"conductorRoughnessExtremes", conductor(1e-4f), conductor(1.0f), "conductor"},
-        Case{"glassIndexExtremes", dielectric(1.0001f, 0.0f), dielectric(4.0f, 0.0f), "dielectric"},
-        Case{"roughGlassExtremes", dielectric(1.0001f, 0.05f), dielectric(4.0f, 1.0f),
-             "dielectric"},
-        Case{"anisotropyExtremes",
-             [] {
-               Material m = conductor(0.001f);
-               m.alphaY = 1.0f;
-               return m;
-             }(),
-             [] {
-               Material m = dielectric(1.5f, 1.0f);
-               m.alphaY = 0.001f;
-               return m;
-             }(),
-             "conductor+dielectric"},
-        Case{"coatedExtremes", coatedDiffuse(1.0f, vec3(1.0f)), coatedDiffuse(1e-4f, vec3(0.0f)),
-             "coateddiffuse"},
-        Case{"gltfSmooth", test::gltfMaterial(vec3(0.9f, 0.6f, 0.3f), 1.0f, 0.0f),
-             test::gltfMaterial(vec3(0.2f, 0.5f, 0.8f), 0.0f, 0.0f), "gltf"},
-        Case{"gltfRough", test::gltfMaterial(vec3(0.9f, 0.6f, 0.3f), 0.5f, 0.4f),
-             test::gltfMaterial(vec3(0.2f, 0.5f, 0.8f), 0.0f, 1.0f, 1.1f), "gltf"}),
-    [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
+        MaterialCase{"conductorRoughnessExtremes", conductor(1e-4f), conductor(1.0f), "conductor"},
+        MaterialCase{"glassIndexExtremes", dielectric(1.0001f, 0.0f), dielectric(4.0f, 0.0f),
+                     "dielectric"},
+        MaterialCase{"roughGlassExtremes", dielectric(1.0001f, 0.05f), dielectric(4.0f, 1.0f),
+                     "dielectric"},
+        MaterialCase{"anisotropyExtremes",
+                     [] {
+                       Material m = conductor(0.001f);
+                       m.alphaY = 1.0f;
+                       return m;
+                     }(),
+                     [] {
+                       Material m = dielectric(1.5f, 1.0f);
+                       m.alphaY = 0.001f;
+                       return m;
+                     }(),
+                     "conductor+dielectric"},
+        MaterialCase{"coatedExtremes", coatedDiffuseMaterial(1.0f, vec3(1.0f)),
+                     coatedDiffuseMaterial(1e-4f, vec3(0.0f)), "coateddiffuse"},
+        MaterialCase{"gltfSmooth", test::gltfMaterial(vec3(0.9f, 0.6f, 0.3f), 1.0f, 0.0f),
+                     test::gltfMaterial(vec3(0.2f, 0.5f, 0.8f), 0.0f, 0.0f), "gltf"},
+        MaterialCase{"gltfRough", test::gltfMaterial(vec3(0.9f, 0.6f, 0.3f), 0.5f, 0.4f),
+                     test::gltfMaterial(vec3(0.2f, 0.5f, 0.8f), 0.0f, 1.0f, 1.1f), "gltf"}),
+    [](const ::testing::TestParamInfo<MaterialCase>& info) {
+      return std::string(info.param.name);
+    });
 
 // A sphere of 2 * 24 * 48 triangles at the origin, radius 1, with vertex normals: the
 // sphere's own (smooth shading), or twisted by `twist` radians about the vertical axis's
 // cross product with the normal (so that many shading normals point below their triangles).
-void addSphere(Scene& scene, uint material, float twist) {
+void addTwistedSphere(Scene& scene, uint material, float twist) {
   const std::vector<Triangle> sphere = test::makeSphere(vec3(0.0f), 1.0f, 24, 48);
   if (scene.normals.empty()) {
     for (const Triangle& t : scene.triangles) {
@@ -163,7 +167,7 @@ Scene furnaceWith(const Material& m, float twist) {
     t.v2 *= 3.0f;
   }
   for (uint i = 0; i < scene.triangles.size(); ++i) scene.triangles[i].primitive = i;
-  addSphere(scene, 1, twist);
+  addTwistedSphere(scene, 1, twist);
   scene.camera = CameraDesc{vec3(0.0f, 0.0f, -2.9f), vec3(0.0f), vec3(0, 1, 0), 40.0f, 16, 16};
   scene.integrator.maxDepth = 1000;
   return scene;
@@ -190,7 +194,7 @@ TEST(MaterialsFurnace, NeverAboveOneAndOneWhenLosslessOnBothBackends) {
   Material transmissive = diffuseTransmission();
   transmissive.reflectance = vec3(0.5f);
   transmissive.transmittance = vec3(0.5f);
-  Material coated = coatedDiffuse(0.2f, vec3(0.0f));
+  Material coated = coatedDiffuseMaterial(0.2f, vec3(0.0f));
   coated.reflectance = vec3(1.0f);
   Material metal = conductor(0.3f);
   metal.eta = vec3(1.0f);
@@ -230,9 +234,9 @@ TEST(MaterialsFurnace, NeverAboveOneAndOneWhenLosslessOnBothBackends) {
 // BSDF. CPU, every non-delta type, smooth-shaded sphere.
 TEST(MaterialsFurnace, LightSamplingAgreesWithBsdfSampling) {
   Material transmissive = diffuseTransmission();
-  Material roughCoat = coatedDiffuse(0.5f, vec3(0.0f));
+  Material roughCoat = coatedDiffuseMaterial(0.5f, vec3(0.0f));
   roughCoat.reflectance = vec3(0.8f);
-  Material mediumCoat = coatedDiffuse(0.3f, vec3(0.8f));
+  Material mediumCoat = coatedDiffuseMaterial(0.3f, vec3(0.8f));
   mediumCoat.thickness = 0.3f;
   for (const Material& m :
        {conductor(0.3f), dielectric(1.5f, 0.3f), transmissive, roughCoat, mediumCoat}) {
@@ -273,7 +277,7 @@ TEST(MaterialsFurnace, LightSamplingAgreesWithBsdfSampling) {
 // material still gives finite samples, and the backends still agree.
 TEST(MaterialsShadingNormals, TwistedNormalsStayFiniteOnBothBackends) {
   for (const Material& m :
-       {dielectric(1.5f, 0.0f), conductor(0.2f), coatedDiffuse(0.1f, vec3(0.0f)),
+       {dielectric(1.5f, 0.0f), conductor(0.2f), coatedDiffuseMaterial(0.1f, vec3(0.0f)),
         Material{vec3(0.7f), kMaterialDiffuse, vec3(0.0f), 0}}) {
     SCOPED_TRACE("type " + std::to_string(m.type));
     Scene scene = furnaceWith(m, 100.0f * kPi / 180.0f);
@@ -297,7 +301,7 @@ TEST(MaterialsShadingNormals, SmoothSphereAgreesAndDiffersFromFlatOnBothBackends
   scene.triangles.push_back(loadScene(test::kConfigs / "cornell-box.json").triangles[31]);
   for (uint i = 0; i < scene.triangles.size(); ++i) scene.triangles[i].primitive = i;
   const size_t before = scene.triangles.size();
-  addSphere(scene, uint(scene.materials.size() - 1), 0.0f);
+  addTwistedSphere(scene, uint(scene.materials.size() - 1), 0.0f);
   for (size_t i = before; i < scene.triangles.size(); ++i) {
     Triangle& t = scene.triangles[i];
     for (vec3* v : {&t.v0, &t.v1, &t.v2}) *v = *v * 120.0f + vec3(278.0f, 150.0f, 280.0f);

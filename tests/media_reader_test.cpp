@@ -29,11 +29,11 @@ namespace fs = std::filesystem;
 
 // A camera that needs no mirroring (Scale -1 1 1, as Bitterli's files start), so that world
 // coordinates come through unchanged.
-constexpr char kUnmirrored[] =
+constexpr char kMediaUnmirrored[] =
     "Scale -1 1 1\nLookAt 0 0 -10  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n";
 
 // A triangle at the origin, its normal +z: (0,0,0), (1,0,0), (0,1,0).
-constexpr char kTriangle[] =
+constexpr char kMediaTriangle[] =
     "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0 ] \"integer indices\" [ 0 1 2 ]\n";
 
 Scene pbrtScene(const std::string& text, bool strict = false) {
@@ -56,7 +56,7 @@ glm::dvec3 toMedium(const Medium& m, glm::dvec3 p) {
           glm::dot(glm::dvec4(m.toMedium2), h)};
 }
 
-void expectNear(glm::dvec3 a, glm::dvec3 b, const std::string& what) {
+void expectNearMedia(glm::dvec3 a, glm::dvec3 b, const std::string& what) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 1e-5) << what << " [" << c << "]";
 }
 
@@ -77,10 +77,10 @@ void expectNoMedia(const Scene& s) {
 // ---- pbrt-v4: homogeneous -----------------------------------------------------------------
 
 TEST(MediaPbrt, HomogeneousTakesPbrtV4sDefaults) {
-  const Scene s = pbrtScene(std::string(kUnmirrored) +
+  const Scene s = pbrtScene(std::string(kMediaUnmirrored) +
                             "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
                             "MediumInterface \"fog\" \"\"\n" +
-                            kTriangle);
+                            kMediaTriangle);
   ASSERT_EQ(s.media.size(), 1u);
   EXPECT_EQ(s.mediumNames, std::vector<std::string>{"fog"});
   const Medium& m = s.media[0];
@@ -98,12 +98,12 @@ TEST(MediaPbrt, HomogeneousTakesPbrtV4sDefaults) {
 }
 
 TEST(MediaPbrt, HomogeneousScalesCoefficientsAndEmission) {
-  const Scene s = pbrtScene(std::string(kUnmirrored) +
+  const Scene s = pbrtScene(std::string(kMediaUnmirrored) +
                             "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
                             "  \"rgb sigma_a\" [1 2 3] \"rgb sigma_s\" [4 5 6] \"float scale\" 2\n"
                             "  \"float g\" 0.5 \"rgb Le\" [1 2 3] \"float Lescale\" 3\n"
                             "MediumInterface \"fog\"\n" +
-                            kTriangle);
+                            kMediaTriangle);
   ASSERT_EQ(s.media.size(), 1u);
   const Medium& m = s.media[0];
   EXPECT_EQ(m.sigmaA, vec3(2.0f, 4.0f, 6.0f));
@@ -118,35 +118,35 @@ TEST(MediaPbrt, HomogeneousScalesCoefficientsAndEmission) {
 }
 
 TEST(MediaPbrt, PresetsArePbrtV4sMeasuredMediaWithSigmaPrimeSAsSigmaS) {
-  const Scene s = pbrtScene(std::string(kUnmirrored) +
+  const Scene s = pbrtScene(std::string(kMediaUnmirrored) +
                             "MakeNamedMedium \"k\" \"string type\" \"homogeneous\"\n"
                             "  \"string preset\" \"Ketchup\" \"float scale\" 10\n"
                             "MediumInterface \"k\" \"\"\n" +
-                            kTriangle);
+                            kMediaTriangle);
   ASSERT_EQ(s.media.size(), 1u);
   // Jensen et al. 2001: Ketchup's sigma'_s (0.18, 0.07, 0.03), sigma_a (0.061, 0.97, 1.45).
-  expectNear(s.media[0].sigmaS, glm::dvec3(1.8, 0.7, 0.3), "sigma_s");
-  expectNear(s.media[0].sigmaA, glm::dvec3(0.61, 9.7, 14.5), "sigma_a");
+  expectNearMedia(s.media[0].sigmaS, glm::dvec3(1.8, 0.7, 0.3), "sigma_s");
+  expectNearMedia(s.media[0].sigmaA, glm::dvec3(0.61, 9.7, 14.5), "sigma_a");
   ASSERT_NE(findMediumPreset("Regular Milk"), nullptr);
   EXPECT_EQ(findMediumPreset("Regular Milk")->sigmaPrimeS, vec3(4.5513f, 5.8294f, 7.136f));
   EXPECT_EQ(mediumPresetNames().size(), 47u);
 
   // With a preset pbrt-v4 reads neither sigma_a nor sigma_s: they are reported unused.
-  const Scene both = pbrtScene(std::string(kUnmirrored) +
+  const Scene both = pbrtScene(std::string(kMediaUnmirrored) +
                                "MakeNamedMedium \"k\" \"string type\" \"homogeneous\"\n"
                                "  \"string preset\" \"Apple\" \"rgb sigma_a\" [9 9 9]\n"
                                "MediumInterface \"k\" \"\"\n" +
-                               kTriangle);
+                               kMediaTriangle);
   EXPECT_EQ(both.media[0].sigmaA, vec3(0.0030f, 0.0034f, 0.046f));
   ASSERT_EQ(both.warnings.size(), 1u);
   EXPECT_NE(both.warnings[0].find("sigma_a"), std::string::npos) << both.warnings[0];
 
   // An unknown preset: warned as pbrt-v4 does, sigma_a and sigma_s used.
-  const Scene unknown = pbrtScene(std::string(kUnmirrored) +
+  const Scene unknown = pbrtScene(std::string(kMediaUnmirrored) +
                                   "MakeNamedMedium \"k\" \"string type\" \"homogeneous\"\n"
                                   "  \"string preset\" \"Ketchp\" \"rgb sigma_a\" [2 2 2]\n"
                                   "MediumInterface \"k\" \"\"\n" +
-                                  kTriangle);
+                                  kMediaTriangle);
   EXPECT_EQ(unknown.media[0].sigmaA, vec3(2.0f));
   ASSERT_EQ(unknown.warnings.size(), 1u);
   EXPECT_EQ(unknown.warnings[0],
@@ -158,14 +158,14 @@ TEST(MediaPbrt, PresetsArePbrtV4sMeasuredMediaWithSigmaPrimeSAsSigmaS) {
 
 TEST(MediaPbrt, UniformGridStoresDensityXFastestAndItsEmissionGrid) {
   const Scene s =
-      pbrtScene(std::string(kUnmirrored) +
+      pbrtScene(std::string(kMediaUnmirrored) +
                 "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\"\n"
                 "  \"integer nx\" 3 \"integer ny\" 2 \"integer nz\" 1\n"
                 "  \"float density\" [0 1 2 3 4 5] \"point3 p0\" [-1 -2 -3] \"point3 p1\" [1 2 3]\n"
                 "  \"rgb sigma_a\" [0.5 1 2] \"float scale\" 4 \"rgb Le\" [1 0.5 0.25]\n"
                 "  \"float Lescale\" [6 7 8 9 10 11]\n"
                 "MediumInterface \"smoke\" \"\"\n" +
-                kTriangle);
+                kMediaTriangle);
   ASSERT_EQ(s.media.size(), 1u);
   const Medium& m = s.media[0];
   EXPECT_EQ(m.type, kMediumUniformGrid);
@@ -187,11 +187,11 @@ TEST(MediaPbrt, UniformGridStoresDensityXFastestAndItsEmissionGrid) {
 
   // Without Le it does not emit, and its Lescale grid is not kept; defaults p0 (0 0 0),
   // p1 (1 1 1), nx = ny = nz = 1.
-  const Scene dark = pbrtScene(std::string(kUnmirrored) +
+  const Scene dark = pbrtScene(std::string(kMediaUnmirrored) +
                                "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\"\n"
                                "  \"float density\" [2] \"float Lescale\" [3]\n"
                                "MediumInterface \"smoke\" \"\"\n" +
-                               kTriangle);
+                               kMediaTriangle);
   const Medium& d = dark.media[0];
   EXPECT_EQ(d.emissive, kEmitsNothing);
   EXPECT_EQ(d.emission, kNoGrid);
@@ -203,13 +203,13 @@ TEST(MediaPbrt, UniformGridStoresDensityXFastestAndItsEmissionGrid) {
 
 TEST(MediaPbrt, RgbGridHasItsScalesInItsGrids) {
   const Scene s =
-      pbrtScene(std::string(kUnmirrored) +
+      pbrtScene(std::string(kMediaUnmirrored) +
                 "MakeNamedMedium \"c\" \"string type\" \"rgbgrid\"\n"
                 "  \"integer nx\" 2 \"rgb sigma_a\" [1 2 3  4 5 6]\n"
                 "  \"rgb sigma_s\" [0.5 0.5 0.5  1 1 1] \"float scale\" 2\n"
                 "  \"rgb Le\" [2 4 6  8 10 12] \"float Lescale\" 0.5 \"float g\" -0.25\n"
                 "MediumInterface \"\" \"c\"\n" +
-                kTriangle);
+                kMediaTriangle);
   ASSERT_EQ(s.media.size(), 1u);
   const Medium& m = s.media[0];
   EXPECT_EQ(m.type, kMediumRgbGrid);
@@ -226,11 +226,11 @@ TEST(MediaPbrt, RgbGridHasItsScalesInItsGrids) {
   EXPECT_EQ(s.mediumInterfaces[0].outside, 0u);
 
   // A missing sigma_s is pbrt-v4's constant 1 (times scale), stored as a grid, warned.
-  const Scene one = pbrtScene(std::string(kUnmirrored) +
+  const Scene one = pbrtScene(std::string(kMediaUnmirrored) +
                               "MakeNamedMedium \"c\" \"string type\" \"rgbgrid\"\n"
                               "  \"rgb sigma_a\" [1 2 3] \"float scale\" 3\n"
                               "MediumInterface \"\" \"c\"\n" +
-                              kTriangle);
+                              kMediaTriangle);
   EXPECT_EQ(one.mediumGrids, (std::vector<float>{3, 6, 9, 3, 3, 3}));
   EXPECT_EQ(one.media[0].emission, kNoGrid);
   EXPECT_EQ(one.media[0].emissive, kEmitsNothing);
@@ -241,14 +241,14 @@ TEST(MediaPbrt, RgbGridHasItsScalesInItsGrids) {
 TEST(MediaPbrt, TheCtmAtMakeNamedMediumPlacesAGrid) {
   const std::string grid =
       "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" \"float density\" [1]\n";
-  const std::string use = "MediumInterface \"g\" \"\"\n" + std::string(kTriangle);
+  const std::string use = "MediumInterface \"g\" \"\"\n" + std::string(kMediaTriangle);
   // Medium to world: translate (1, 2, 3) after a scale by 2.
-  const Scene s = pbrtScene(std::string(kUnmirrored) + "AttributeBegin\nTranslate 1 2 3\n" +
+  const Scene s = pbrtScene(std::string(kMediaUnmirrored) + "AttributeBegin\nTranslate 1 2 3\n" +
                             "Scale 2 2 2\n" + grid + "AttributeEnd\n" + use);
   const Medium& m = s.media[0];
-  expectNear(toMedium(m, {1, 2, 3}), {0, 0, 0}, "origin");
-  expectNear(toMedium(m, {3, 2, 3}), {1, 0, 0}, "x");
-  expectNear(toMedium(m, {1, 2, 5}), {0, 0, 1}, "z");
+  expectNearMedia(toMedium(m, {1, 2, 3}), {0, 0, 0}, "origin");
+  expectNearMedia(toMedium(m, {3, 2, 3}), {1, 0, 0}, "x");
+  expectNearMedia(toMedium(m, {1, 2, 5}), {0, 0, 1}, "z");
   EXPECT_EQ(m.toMedium0, vec4(0.5f, 0.0f, 0.0f, -0.5f));
 
   // A camera that pbrt's left-handed space makes this renderer mirror in x: the medium is
@@ -256,20 +256,20 @@ TEST(MediaPbrt, TheCtmAtMakeNamedMediumPlacesAGrid) {
   const Scene mirrored = pbrtScene(
       "LookAt 0 0 -10  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nTranslate 1 2 3\n" + grid +
       use);
-  expectNear(toMedium(mirrored.media[0], {-1, 2, 3}), {0, 0, 0}, "mirrored origin");
-  expectNear(toMedium(mirrored.media[0], {-2, 2, 3}), {1, 0, 0}, "mirrored x");
+  expectNearMedia(toMedium(mirrored.media[0], {-1, 2, 3}), {0, 0, 0}, "mirrored origin");
+  expectNearMedia(toMedium(mirrored.media[0], {-2, 2, 3}), {1, 0, 0}, "mirrored x");
 
   // Before the Camera directive pbrt-v4 takes the CTM in its render space, the world moved
   // to the camera's position (0, 0, -10).
   const Scene before = pbrtScene(grid + "Scale -1 1 1\nLookAt 0 0 -10  0 0 0  0 1 0\n" +
                                  "Camera \"perspective\"\nWorldBegin\n" + use);
-  expectNear(toMedium(before.media[0], {0, 0, -10}), {0, 0, 0}, "before the camera");
+  expectNearMedia(toMedium(before.media[0], {0, 0, -10}), {0, 0, 0}, "before the camera");
 
   // Homogeneous media ignore it.
   const Scene homogeneous =
-      pbrtScene(std::string(kUnmirrored) + "Scale 0 0 0\n" +
+      pbrtScene(std::string(kMediaUnmirrored) + "Scale 0 0 0\n" +
                 "MakeNamedMedium \"h\" \"string type\" \"homogeneous\"\nIdentity\n" +
-                "MediumInterface \"h\" \"\"\n" + kTriangle);
+                "MediumInterface \"h\" \"\"\n" + kMediaTriangle);
   EXPECT_EQ(homogeneous.media[0].toMedium0, vec4(1, 0, 0, 0));
 }
 
@@ -277,24 +277,24 @@ TEST(MediaPbrt, TheCtmAtMakeNamedMediumPlacesAGrid) {
 
 TEST(MediaPbrt, EveryTriangleGetsTheInterfaceOfItsShapeThroughDropsAndInstances) {
   const Scene s = pbrtScene(
-      std::string(kUnmirrored) +
+      std::string(kMediaUnmirrored) +
       "MakeNamedMedium \"a\" \"string type\" \"homogeneous\"\n"
       "MakeNamedMedium \"b\" \"string type\" \"homogeneous\" \"float g\" 0.5\n"
       "ObjectBegin \"o\"\n"
       "  MediumInterface \"b\" \"a\"\n" +
-      kTriangle + "ObjectEnd\n" +
+      kMediaTriangle + "ObjectEnd\n" +
       // 0: vacuum; 1, 2: a inside, vacuum outside (one zero-area triangle between them dropped)
-      kTriangle +
+      kMediaTriangle +
       "AttributeBegin\n  MediumInterface \"a\" \"\"\n"
       "  Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 2 0 0 0 0 1]\n"
       "    \"integer indices\" [0 1 2  0 1 3  0 1 4]\n"
       // interface material without a transition: dropped
       "  AttributeBegin\n    Material \"interface\"\n    MediumInterface \"a\"\n" +
-      kTriangle +
+      kMediaTriangle +
       "  AttributeEnd\nAttributeEnd\n"
       // 3: vacuum again after AttributeEnd; 4, 5: the instance, its definition's interface,
       // whatever is current at its use
-      + kTriangle + "MediumInterface \"a\" \"b\"\nObjectInstance \"o\"\nTranslate 0 0 1\n" +
+      + kMediaTriangle + "MediumInterface \"a\" \"b\"\nObjectInstance \"o\"\nTranslate 0 0 1\n" +
       "ObjectInstance \"o\"\n");
   ASSERT_EQ(s.triangles.size(), 6u);
   ASSERT_EQ(s.mediumInterfaces.size(), s.triangles.size());
@@ -318,7 +318,7 @@ TEST(MediaPbrt, TheCameraIsInTheOutsideMediumCurrentAtCamera) {
       "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
       "MakeNamedMedium \"water\" \"string type\" \"homogeneous\" \"float scale\" 2\n"
       "WorldBegin\n" +
-      std::string(kTriangle));
+      std::string(kMediaTriangle));
   // Only water is used: fog, named inside, is not kept.
   ASSERT_EQ(s.media.size(), 1u);
   EXPECT_EQ(s.mediumNames[0], "water");
@@ -333,12 +333,12 @@ TEST(MediaPbrt, TheCameraIsInTheOutsideMediumCurrentAtCamera) {
 TEST(MediaPbrt, InterfaceShapesAreKeptWhereTheyBoundAMedium) {
   const std::string fog = "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n";
   const Scene s =
-      pbrtScene(std::string(kUnmirrored) + fog + kTriangle +
+      pbrtScene(std::string(kMediaUnmirrored) + fog + kMediaTriangle +
                 "AttributeBegin\nMaterial \"interface\"\nMediumInterface \"fog\" \"\"\n" +
-                kTriangle + "AttributeEnd\n" +
+                kMediaTriangle + "AttributeEnd\n" +
                 // defined after its use, with an area light: the light is ignored
                 "AttributeBegin\nNamedMaterial \"later\"\nMediumInterface \"\" \"fog\"\n" +
-                "AreaLightSource \"diffuse\"\n" + kTriangle + "AttributeEnd\n" +
+                "AreaLightSource \"diffuse\"\n" + kMediaTriangle + "AttributeEnd\n" +
                 "MakeNamedMaterial \"later\" \"string type\" \"interface\"\n");
   ASSERT_EQ(s.triangles.size(), 3u);
   ASSERT_EQ(s.materials.size(), 3u);
@@ -357,8 +357,8 @@ TEST(MediaPbrt, InterfaceShapesAreKeptWhereTheyBoundAMedium) {
 
   // Without a medium they change nothing and go silently; the scene has no media fields.
   const Scene none =
-      pbrtScene(std::string(kUnmirrored) + fog + kTriangle + "Material \"interface\"\n" +
-                kTriangle + "MediumInterface \"fog\"\n" + kTriangle);
+      pbrtScene(std::string(kMediaUnmirrored) + fog + kMediaTriangle + "Material \"interface\"\n" +
+                kMediaTriangle + "MediumInterface \"fog\"\n" + kMediaTriangle);
   EXPECT_EQ(none.triangles.size(), 1u);
   EXPECT_TRUE(none.warnings.empty());
   expectNoMedia(none);
@@ -367,22 +367,22 @@ TEST(MediaPbrt, InterfaceShapesAreKeptWhereTheyBoundAMedium) {
 TEST(MediaPbrt, ScenesWithoutMediaHaveEmptyMediaFields) {
   expectNoMedia(loadScene(test::kConfigs / "cornell-box.pbrt"));
   // Media defined but used by no shape and not the camera: left out.
-  expectNoMedia(pbrtScene(std::string(kUnmirrored) +
+  expectNoMedia(pbrtScene(std::string(kMediaUnmirrored) +
                           "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n" +
                           "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" "
                           "\"float density\" [1]\n" +
-                          kTriangle));
+                          kMediaTriangle));
 }
 
 TEST(MediaPbrt, UnusedMediaAndTheirGridsAreLeftOut) {
-  const Scene s = pbrtScene(std::string(kUnmirrored) +
+  const Scene s = pbrtScene(std::string(kMediaUnmirrored) +
                             "MakeNamedMedium \"big\" \"string type\" \"uniformgrid\" "
                             "\"integer nx\" 4 \"float density\" [1 2 3 4]\n"
                             "MakeNamedMedium \"small\" \"string type\" \"uniformgrid\" "
                             "\"integer nx\" 2 \"float density\" [5 6] \"rgb Le\" [1 1 1] "
                             "\"float Lescale\" [7 8]\n"
                             "MediumInterface \"small\" \"\"\n" +
-                            kTriangle);
+                            kMediaTriangle);
   ASSERT_EQ(s.media.size(), 1u);
   EXPECT_EQ(s.mediumNames[0], "small");
   EXPECT_EQ(s.mediumGrids, (std::vector<float>{5, 6, 7, 8}));
@@ -393,10 +393,10 @@ TEST(MediaPbrt, UnusedMediaAndTheirGridsAreLeftOut) {
 TEST(MediaPbrt, CloudsAreRead) {
   // A cloud: pbrt-v4's parameters and defaults (wispiness 1, frequency 5, p0 0 0 0, p1 1 1 1).
   const Scene cloud =
-      pbrtScene(std::string(kUnmirrored) +
+      pbrtScene(std::string(kMediaUnmirrored) +
                 "MakeNamedMedium \"c\" \"string type\" \"cloud\" \"float density\" 2\n"
                 "MediumInterface \"c\" \"\"\n" +
-                kTriangle);
+                kMediaTriangle);
   ASSERT_EQ(cloud.media.size(), 1u);
   EXPECT_EQ(cloud.media[0].type, kMediumCloud);
   EXPECT_EQ(cloud.media[0].Le, vec3(2.0f, 1.0f, 5.0f));
@@ -404,10 +404,10 @@ TEST(MediaPbrt, CloudsAreRead) {
   EXPECT_EQ(cloud.media[0].boundsMax, vec3(1.0f));
   EXPECT_TRUE(cloud.warnings.empty());
   // A nanovdb medium names its file: a missing one is an error at the parameter.
-  EXPECT_EQ(pbrtError(std::string(kUnmirrored) +
+  EXPECT_EQ(pbrtError(std::string(kMediaUnmirrored) +
                       "MakeNamedMedium \"vdb\" \"string type\" \"nanovdb\"\n"
                       "MediumInterface \"vdb\" \"\"\n" +
-                      kTriangle),
+                      kMediaTriangle),
             "scene.pbrt:5:1: MakeNamedMedium 'vdb': a \"nanovdb\" medium needs a \"string "
             "filename\"");
 }
@@ -417,10 +417,10 @@ TEST(MediaPbrt, CloudsAreRead) {
 // is read where "temperatureoffset" is missing.
 TEST(MediaPbrt, UniformGridTemperaturesEmitBlackbody) {
   const auto medium = [](const std::string& params) {
-    const Scene s = pbrtScene(std::string(kUnmirrored) +
+    const Scene s = pbrtScene(std::string(kMediaUnmirrored) +
                               "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" "
                               "\"integer nx\" 2 \"float density\" [1 1] " +
-                              params + "\nMediumInterface \"g\" \"\"\n" + kTriangle);
+                              params + "\nMediumInterface \"g\" \"\"\n" + kMediaTriangle);
     EXPECT_TRUE(s.warnings.empty());
     return s;
   };
@@ -449,25 +449,25 @@ TEST(MediaPbrt, UniformGridTemperaturesEmitBlackbody) {
   EXPECT_EQ(medium("\"float temperature\" [1500 800] \"float Lescale\" [0 0]").media[0].emissive,
             kEmitsNothing);
 
-  EXPECT_EQ(pbrtError(std::string(kUnmirrored) +
+  EXPECT_EQ(pbrtError(std::string(kMediaUnmirrored) +
                       "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" "
                       "\"float density\" [1] \"float temperature\" [1 2]\n"
                       "MediumInterface \"g\" \"\"\n" +
-                      kTriangle),
+                      kMediaTriangle),
             "scene.pbrt:5:69: 'temperature' of MakeNamedMedium 'g': has 2 values; expected nx * "
             "ny * nz = 1");
-  EXPECT_EQ(pbrtError(std::string(kUnmirrored) +
+  EXPECT_EQ(pbrtError(std::string(kMediaUnmirrored) +
                       "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" "
                       "\"float density\" [1] \"float temperature\" [1000] \"rgb Le\" [1 1 1]\n"
                       "MediumInterface \"g\" \"\"\n" +
-                      kTriangle),
+                      kMediaTriangle),
             "scene.pbrt:5:69: 'temperature' of MakeNamedMedium 'g': a medium emits by \"Le\" or "
             "by \"temperature\", not both (pbrt-v4's rule)");
 }
 
 TEST(MediaPbrt, EveryErrorIsOneLineAtItsPlace) {
-  const std::string w = kUnmirrored;
-  const std::string use = "MediumInterface \"m\" \"\"\n" + std::string(kTriangle);
+  const std::string w = kMediaUnmirrored;
+  const std::string use = "MediumInterface \"m\" \"\"\n" + std::string(kMediaTriangle);
   const auto grid = [&](const std::string& params) {
     return w + "MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" " + params + "\n" + use;
   };
@@ -478,9 +478,9 @@ TEST(MediaPbrt, EveryErrorIsOneLineAtItsPlace) {
       {w +
            "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
            "MediumInterface \"fgo\" \"\"\n" +
-           kTriangle,
+           kMediaTriangle,
        "scene.pbrt:6:17: MediumInterface: no medium named 'fgo' (did you mean 'fog'?)"},
-      {w + "MediumInterface \"\" \"nowhere\"\n" + kTriangle,
+      {w + "MediumInterface \"\" \"nowhere\"\n" + kMediaTriangle,
        "scene.pbrt:5:20: MediumInterface: no medium named 'nowhere'"},
       {w +
            "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n"
@@ -614,8 +614,8 @@ TEST(MediaJson, PresetsAreThePbrtTable) {
       jsonText(R"([{"name": "milk", "type": "homogeneous", "preset": "Wholemilk", "scale": 100}])",
                "", R"(, "medium": "milk")"));
   ASSERT_EQ(s.media.size(), 1u);
-  expectNear(s.media[0].sigmaS, glm::dvec3(255, 321, 377), "sigma_s");
-  expectNear(s.media[0].sigmaA, glm::dvec3(0.11, 0.24, 1.4), "sigma_a");
+  expectNearMedia(s.media[0].sigmaS, glm::dvec3(255, 321, 377), "sigma_s");
+  expectNearMedia(s.media[0].sigmaA, glm::dvec3(0.11, 0.24, 1.4), "sigma_a");
   EXPECT_EQ(s.cameraMedium, 0u);
   // Only the camera uses it: every triangle has vacuum on both sides, kept parallel.
   ASSERT_EQ(s.mediumInterfaces.size(), 1u);
@@ -650,8 +650,8 @@ TEST(MediaJson, GridsTheirOrderOffsetsAndTransform) {
                                                0.5f, 0.5f, 0.5f, 0.5f,  // cloud
                                                6,    6,    6,    0,    0,    0}));
   // World (10, 0, 0) is the medium's origin, world (12, 0, 0) its (1, 0, 0).
-  expectNear(toMedium(smoke, {10, 0, 0}), {0, 0, 0}, "origin");
-  expectNear(toMedium(smoke, {12, 0, 0}), {1, 0, 0}, "x");
+  expectNearMedia(toMedium(smoke, {10, 0, 0}), {0, 0, 0}, "origin");
+  expectNearMedia(toMedium(smoke, {12, 0, 0}), {1, 0, 0}, "x");
   EXPECT_EQ(cloud.toMedium0, vec4(1, 0, 0, 0));
 }
 

@@ -37,7 +37,7 @@ std::string errorOf(const F& f) {
   return "(no error)";
 }
 
-std::string loadError(const std::filesystem::path& scene) {
+std::string mtlLoadError(const std::filesystem::path& scene) {
   return errorOf([&] { loadScene(scene); });
 }
 
@@ -274,7 +274,7 @@ TEST(SceneMtl, UnknownUsemtlNamesTheObjLine) {
   dir.write("m.mtl", "newmtl red\nKd 0.8 0.1 0.1\n");
   dir.write("m.obj",
             "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\nusemtl rad\nf 1 3 2\n");
-  const std::string m = loadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
+  const std::string m = mtlLoadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"}]})"));
   EXPECT_NE(m.find("m.obj: line 7: usemtl 'rad': no such material in its mtllib files (did you "
                    "mean 'red'?)"),
@@ -286,7 +286,7 @@ TEST(SceneMtl, UnknownUsemtlNamesTheObjLine) {
 TEST(SceneMtl, MissingMtlFileNamesTheObjLine) {
   test::TempDir dir;
   dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib gone.mtl\nusemtl red\nf 1 2 3\n");
-  const std::string m = loadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
+  const std::string m = mtlLoadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"}]})"));
   EXPECT_NE(m.find("m.obj: line 4: cannot open material library 'gone.mtl'"), std::string::npos)
       << m;
@@ -303,7 +303,7 @@ TEST(SceneMtl, FacesBeforeAnyUsemtlTakeTheShapesMaterialOrFail) {
   EXPECT_EQ(scene.triangles[0].material, 0u);  // "w"
   EXPECT_EQ(scene.materialNames[scene.triangles[1].material], "m.mtl:red");
 
-  const std::string m = loadError(dir.write("t.json", R"({"materials": [{"name": "w"}],
+  const std::string m = mtlLoadError(dir.write("t.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"}]})"));
   EXPECT_NE(m.find("t.json: shapes[0]: needs a 'material' for the faces of"), std::string::npos)
       << m;
@@ -320,7 +320,7 @@ TEST(SceneMtl, UnknownMaterialAfterAnMtlShapeStillSuggestsTheRightName) {
             "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\nusemtl b\n"
             "f 1 3 2\nusemtl c\nf 2 1 3\n");
   const std::string m =
-      loadError(dir.write("s.json", R"({"materials": [{"name": "white"}, {"name": "light"}],
+      mtlLoadError(dir.write("s.json", R"({"materials": [{"name": "white"}, {"name": "light"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"},
                                {"type": "quad", "material": "lihgt",
                                 "vertices": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]}]})"));
@@ -333,10 +333,9 @@ TEST(SceneMtl, LongPathsAreNeverCutInMessages) {
   test::TempDir dir;
   const std::string deep = std::string(90, 'd') + "/" + std::string(40, 'e');
   dir.write(deep + "/m.obj", "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
-  const std::string m =
-      loadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
-                    "shapes": [{"type": "obj", "file": ")" +
-                                        deep + R"(/m.obj", "materials": "mtl"}]})"));
+  const std::string m = mtlLoadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
+                    "shapes": [{"type": "obj", "file": ")" + deep +
+                                                             R"(/m.obj", "materials": "mtl"}]})"));
   const std::string full = (dir.path() / deep / "missing.mtl").string();
   EXPECT_NE(m.find("(looked for '" + full + "': No such file or directory)"), std::string::npos)
       << m;
@@ -346,14 +345,14 @@ TEST(SceneMtl, BadColoursAndBadKeyAreInputErrors) {
   test::TempDir dir;
   dir.write("m.mtl", "newmtl hot\nKd 1.5 0.1 0.1\n");
   dir.write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl hot\nf 1 2 3\n");
-  const std::string m = loadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
+  const std::string m = mtlLoadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "mtl"}]})"));
   EXPECT_NE(m.find("m.mtl: material 'hot': Kd: expected colour components in [0, 1], got (1.5, "
                    "0.1, 0.1)"),
             std::string::npos)
       << m;
 
-  const std::string k = loadError(dir.write("k.json", R"({"materials": [{"name": "w"}],
+  const std::string k = mtlLoadError(dir.write("k.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "obj", "file": "m.obj", "materials": "json"}]})"));
   EXPECT_NE(k.find("shapes[0].materials: expected 'mtl'"), std::string::npos) << k;
 }
@@ -392,7 +391,7 @@ TEST(ScenePly, MalformedPlyNamesTheSceneEntry) {
             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
             "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
             "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n");
-  const std::string m = loadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
+  const std::string m = mtlLoadError(dir.write("s.json", R"({"materials": [{"name": "w"}],
                     "shapes": [{"type": "ply", "file": "m.ply", "material": "w"}]})"));
   EXPECT_NE(m.find("m.ply: face 0"), std::string::npos) << m;
   EXPECT_NE(m.find("out of range"), std::string::npos) << m;
@@ -466,7 +465,7 @@ MappedMaterial mtlMaterial(const Scene& scene) {
   return {scene, scene.materialTextures[1], scene.materials[1]};
 }
 
-void expectNear(vec3 got, glm::dvec3 want, double tolerance, const std::string& what) {
+void expectNearMtl(vec3 got, glm::dvec3 want, double tolerance, const std::string& what) {
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(double(got[c]), want[c], tolerance) << what << " channel " << c;
   }
@@ -489,10 +488,10 @@ TEST(SceneMtlMaps, MapKdIsTheReflectanceTimesKd) {
     for (int x = 0; x < 4; ++x) {
       const vec2 uv = texelCentre(x, y, 4, 2);
       const glm::dvec3 want = glm::dvec3(0.5, 0.25, 1.0) * fileTexel(dir / "wood.exr", x, y, false);
-      expectNear(m.at(m.textures.reflectance, uv), want, 1e-6, "texel " + std::to_string(x));
+      expectNearMtl(m.at(m.textures.reflectance, uv), want, 1e-6, "texel " + std::to_string(x));
       // The material at that point: the diffuse reflectance replaced.
       const Material r = resolveMaterial(m.tables(), m.material, m.textures, uv);
-      expectNear(r.reflectance, want, 1e-6, "resolved");
+      expectNearMtl(r.reflectance, want, 1e-6, "resolved");
     }
   }
 }
@@ -506,10 +505,10 @@ TEST(SceneMtlMaps, EightBitMapKdIsDecodedFromSrgbAndUsedAloneWithoutKd) {
   EXPECT_EQ(m.material.type, kMaterialDiffuse);
   ASSERT_NE(m.textures.reflectance, kNoTexture);
   const glm::dvec3 want = fileTexel(dir / "wood.png", 2, 1, true);
-  expectNear(m.at(m.textures.reflectance, texelCentre(2, 1, 4, 2)), want, 1e-6, "texel (2, 1)");
+  expectNearMtl(m.at(m.textures.reflectance, texelCentre(2, 1, 4, 2)), want, 1e-6, "texel (2, 1)");
   // And close to the colour written (8-bit sRGB quantizes it).
-  expectNear(m.at(m.textures.reflectance, texelCentre(2, 1, 4, 2)), glm::dvec3(mapImage().at(2, 1)),
-             5e-3, "written");
+  expectNearMtl(m.at(m.textures.reflectance, texelCentre(2, 1, 4, 2)),
+                glm::dvec3(mapImage().at(2, 1)), 5e-3, "written");
 }
 
 TEST(SceneMtlMaps, MapKsTexturesMirrorsAndConductorsTimesKs) {
@@ -521,15 +520,15 @@ TEST(SceneMtlMaps, MapKsTexturesMirrorsAndConductorsTimesKs) {
     EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
     const MappedMaterial m = mtlMaterial(scene);
     ASSERT_NE(m.textures.reflectance, kNoTexture) << rule;
-    expectNear(m.at(m.textures.reflectance, texelCentre(1, 0, 4, 2)),
-               0.5 * fileTexel(dir / "s.exr", 1, 0, false), 1e-6, rule);
+    expectNearMtl(m.at(m.textures.reflectance, texelCentre(1, 0, 4, 2)),
+                  0.5 * fileTexel(dir / "s.exr", 1, 0, false), 1e-6, rule);
   }
   // A mirror of black Ks has reflectance 1: its map alone.
   const Scene black = loadMappedQuad(dir, "newmtl m\nillum 5\nmap_Ks s.exr\n");
   const MappedMaterial m = mtlMaterial(black);
   EXPECT_EQ(m.material.type, kMaterialMirror);
-  expectNear(m.at(m.textures.reflectance, texelCentre(3, 1, 4, 2)),
-             fileTexel(dir / "s.exr", 3, 1, false), 1e-6, "illum 5");
+  expectNearMtl(m.at(m.textures.reflectance, texelCentre(3, 1, 4, 2)),
+                fileTexel(dir / "s.exr", 3, 1, false), 1e-6, "illum 5");
 }
 
 TEST(SceneMtlMaps, ScaleOffsetAndClampOptionsMapTheCoordinates) {
@@ -544,11 +543,11 @@ TEST(SceneMtlMaps, ScaleOffsetAndClampOptionsMapTheCoordinates) {
   EXPECT_EQ((node.flags >> 4) & 0xFu, kWrapClamp);
   // (s, t) = (2 u + 0.25, 3 v + 0.5) at texel (1, 0)'s centre (0.375, 0.75).
   const vec2 uv((0.375f - 0.25f) / 2.0f, (0.75f - 0.5f) / 3.0f);
-  expectNear(m.at(m.textures.reflectance, uv), fileTexel(dir / "t.exr", 1, 0, false), 1e-5,
-             "-s -o");
+  expectNearMtl(m.at(m.textures.reflectance, uv), fileTexel(dir / "t.exr", 1, 0, false), 1e-5,
+                "-s -o");
   // Beyond the image's top-right corner: clamped to its texel.
-  expectNear(m.at(m.textures.reflectance, vec2(0.6f, 0.9f)), fileTexel(dir / "t.exr", 3, 0, false),
-             1e-6, "-clamp on");
+  expectNearMtl(m.at(m.textures.reflectance, vec2(0.6f, 0.9f)),
+                fileTexel(dir / "t.exr", 3, 0, false), 1e-6, "-clamp on");
   // Without -clamp, repeated.
   // Without -clamp, repeated; -s with two numbers (tinyobjloader would take the file name
   // for w and lose the map).

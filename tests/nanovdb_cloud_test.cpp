@@ -79,8 +79,8 @@ PathScene gridScene(const std::vector<float>& grids) {
   return s;
 }
 
-std::string errorOf(const std::filesystem::path& file, const std::string& grid,
-                    const std::string& temperature = "temperature") {
+std::string nvdbErrorOf(const std::filesystem::path& file, const std::string& grid,
+                        const std::string& temperature = "temperature") {
   try {
     readNanoVdbMedium(file, grid, temperature);
   } catch (const InputError& e) {
@@ -221,16 +221,16 @@ TEST(NanoVdb, BlackbodyEmissionFollowsTheTemperatureGrid) {
 TEST(NanoVdb, BadFilesAreOneLineErrors) {
   test::TempDir dir;
   const std::filesystem::path ball = writeFile(dir, "ball.nvdb", ballGrid());
-  EXPECT_EQ(errorOf(dir / "none.nvdb", "density"),
+  EXPECT_EQ(nvdbErrorOf(dir / "none.nvdb", "density"),
             (dir / "none.nvdb").string() + ": Unable to open file named \"" +
                 (dir / "none.nvdb").string() + "\" for input");
-  EXPECT_EQ(errorOf(ball, "smoke"), ball.string() + ": no grid named 'smoke'");
+  EXPECT_EQ(nvdbErrorOf(ball, "smoke"), ball.string() + ": no grid named 'smoke'");
   const std::filesystem::path levelFile =
       writeFile(dir, "level.nvdb",
                 makeGrid(
                     "density", 0.0f, nanovdb::Coord(0), nanovdb::Coord(3), 1.0, nanovdb::Vec3d(0.0),
                     [](int, int, int) { return 0.5f; }, nanovdb::GridClass::LevelSet));
-  EXPECT_EQ(errorOf(levelFile, "density"),
+  EXPECT_EQ(nvdbErrorOf(levelFile, "density"),
             levelFile.string() +
                 ": grid 'density' is not a fog volume (pbrt-v4 reads densities and temperatures "
                 "from fog volumes)");
@@ -238,7 +238,7 @@ TEST(NanoVdb, BadFilesAreOneLineErrors) {
       dir, "negative.nvdb",
       makeGrid("density", 0.0f, nanovdb::Coord(0), nanovdb::Coord(3), 1.0, nanovdb::Vec3d(0.0),
                [](int x, int, int) { return x == 2 ? -1.0f : 0.5f; }));
-  EXPECT_EQ(errorOf(negative, "density"),
+  EXPECT_EQ(nvdbErrorOf(negative, "density"),
             negative.string() +
                 ": grid 'density' holds -1.000000 (densities must be non-negative and finite)");
   // A damaged file: a byte of the grid's own header changed (NanoVDB's checksum covers the
@@ -246,13 +246,13 @@ TEST(NanoVdb, BadFilesAreOneLineErrors) {
   std::string bytes = test::readFile(ball);
   bytes[bytes.size() - ballGrid().size() + 300] ^= 0x55;
   const std::filesystem::path damaged = dir.write("damaged.nvdb", bytes);
-  EXPECT_NE(errorOf(damaged, "density").find(damaged.string() + ": grid 'density' is damaged"),
+  EXPECT_NE(nvdbErrorOf(damaged, "density").find(damaged.string() + ": grid 'density' is damaged"),
             std::string::npos)
-      << errorOf(damaged, "density");
+      << nvdbErrorOf(damaged, "density");
   // Not a NanoVDB file at all.
   const std::filesystem::path text = dir.write("text.nvdb", "not a grid\n");
-  EXPECT_EQ(errorOf(text, "density").rfind(text.string() + ": ", 0), 0u)
-      << errorOf(text, "density");
+  EXPECT_EQ(nvdbErrorOf(text, "density").rfind(text.string() + ": ", 0), 0u)
+      << nvdbErrorOf(text, "density");
 }
 
 // Both readers: the file relative to the scene, and its errors at the parameter.

@@ -26,7 +26,7 @@ std::vector<Statement> parse(const std::string& text, const fs::path& path = "sc
 }
 
 // The message of the InputError that parsing `text` throws, or "no error".
-std::string errorOf(const std::string& text, const fs::path& path = "scene.pbrt") {
+std::string parseErrorOf(const std::string& text, const fs::path& path = "scene.pbrt") {
   try {
     parse(text, path);
   } catch (const InputError& e) {
@@ -247,12 +247,12 @@ TEST(PbrtParser, IncludeErrors) {
   EXPECT_EQ(message, d + "/b.pbrt:2:11: Include cycle: '" + d +
                          "/a.pbrt' is already being read (it includes itself, directly or "
                          "through others)");
-  EXPECT_EQ(errorOf("Include \"missing.pbrt\"", dir / "m.pbrt"),
+  EXPECT_EQ(parseErrorOf("Include \"missing.pbrt\"", dir / "m.pbrt"),
             d + "/m.pbrt:1:9: cannot open 'missing.pbrt' (looked for '" + d +
                 "/missing.pbrt': No such file or directory)");
-  EXPECT_EQ(errorOf("Import \"\""),
+  EXPECT_EQ(parseErrorOf("Import \"\""),
             "scene.pbrt:1:8: Import takes a file name, got an empty string");
-  EXPECT_EQ(errorOf("Include sub.pbrt"),
+  EXPECT_EQ(parseErrorOf("Include sub.pbrt"),
             "scene.pbrt:1:9: Include takes a quoted file name, got 'sub.pbrt'");
   try {
     pbrt::parseFile(dir / "nothing.pbrt", [](Statement&) {});
@@ -363,7 +363,7 @@ TEST(PbrtParser, SyntaxErrorsNameFileLineAndColumn) {
       {"\xff\xfeS\0h\0", "scene.pbrt:1:1: the file is UTF-16 encoded; pbrt files are UTF-8"},
   };
   for (const auto& [text, message] : cases) {
-    EXPECT_EQ(errorOf(text), message) << text;
+    EXPECT_EQ(parseErrorOf(text), message) << text;
   }
 }
 
@@ -373,14 +373,14 @@ TEST(PbrtParser, NumbersAsPbrtWritesThem) {
   EXPECT_EQ(s[0].params[0].numbers,
             (std::vector<double>{1, -1, 1, 0.5, -0.5, 5, 1000, 0.001, 0, 0}));
   for (const char* bad : {"0x10", "nan", "--1", "1.2.3", "+", "1e", "1,5"}) {
-    EXPECT_NE(errorOf(std::string("Shape \"a\" \"float v\" ") + bad).find("expected a number"),
+    EXPECT_NE(parseErrorOf(std::string("Shape \"a\" \"float v\" ") + bad).find("expected a number"),
               std::string::npos)
         << bad;
   }
 }
 
 TEST(PbrtParser, MessagesStayOnOneLine) {
-  const std::string m = errorOf("Shape \"a\" \"float \x01r\" one");
+  const std::string m = parseErrorOf("Shape \"a\" \"float \x01r\" one");
   EXPECT_EQ(m.find('\n'), std::string::npos);
   EXPECT_NE(m.find("\\x01"), std::string::npos) << m;
 }

@@ -44,7 +44,7 @@ Scene load(const std::string& text, const fs::path& path = "scene.pbrt") {
   return loadPbrtSceneText(text, path);
 }
 
-std::string errorOf(const std::string& text, const fs::path& path = "scene.pbrt") {
+std::string pbrtErrorOf(const std::string& text, const fs::path& path = "scene.pbrt") {
   try {
     load(text, path);
   } catch (const InputError& e) {
@@ -53,7 +53,7 @@ std::string errorOf(const std::string& text, const fs::path& path = "scene.pbrt"
   return "no error";
 }
 
-void expectNear(glm::dvec3 a, glm::dvec3 b, double tolerance, const std::string& what) {
+void expectNearPbrt(glm::dvec3 a, glm::dvec3 b, double tolerance, const std::string& what) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], tolerance) << what << " [" << c << "]";
 }
 
@@ -89,18 +89,18 @@ TEST(PbrtTransforms, LookAtAgainstAHandComputedMatrix) {
   expectMatrixNear(pbrt::lookAtMatrix({0, 0, 0}, {-5, 0, 0}, {0, 0, 3}), expected, 1e-15);
   // With a translation: a world point 2 units in front of the eye is camera (0, 0, 2).
   const glm::dmat4 m = pbrt::lookAtMatrix({4, 5, 6}, {4, 5, 0}, {1, 0, 0});
-  expectNear(glm::dvec3(m * glm::dvec4(4, 5, 4, 1)), {0, 0, 2}, 1e-14, "in front");
-  expectNear(glm::dvec3(m * glm::dvec4(5, 5, 6, 1)), {0, 1, 0}, 1e-14, "up");
+  expectNearPbrt(glm::dvec3(m * glm::dvec4(4, 5, 4, 1)), {0, 0, 2}, 1e-14, "in front");
+  expectNearPbrt(glm::dvec3(m * glm::dvec4(5, 5, 6, 1)), {0, 1, 0}, 1e-14, "up");
   // Right = up x dir = (1,0,0) x (0,0,-1) = (0, 1, 0).
-  expectNear(glm::dvec3(m * glm::dvec4(4, 6, 6, 1)), {1, 0, 0}, 1e-14, "right");
+  expectNearPbrt(glm::dvec3(m * glm::dvec4(4, 6, 6, 1)), {1, 0, 0}, 1e-14, "right");
 }
 
 TEST(PbrtTransforms, RotateAboutASkewAxis) {
   // 120 degrees about (1, 1, 1) cycles the axes: x -> y -> z -> x.
   const glm::dmat4 r = pbrt::rotateMatrix(120.0, {2, 2, 2});
-  expectNear(glm::dvec3(r * glm::dvec4(1, 0, 0, 0)), {0, 1, 0}, 1e-15, "x");
-  expectNear(glm::dvec3(r * glm::dvec4(0, 1, 0, 0)), {0, 0, 1}, 1e-15, "y");
-  expectNear(glm::dvec3(r * glm::dvec4(0, 0, 1, 0)), {1, 0, 0}, 1e-15, "z");
+  expectNearPbrt(glm::dvec3(r * glm::dvec4(1, 0, 0, 0)), {0, 1, 0}, 1e-15, "x");
+  expectNearPbrt(glm::dvec3(r * glm::dvec4(0, 1, 0, 0)), {0, 0, 1}, 1e-15, "y");
+  expectNearPbrt(glm::dvec3(r * glm::dvec4(0, 0, 1, 0)), {1, 0, 0}, 1e-15, "z");
   // 90 degrees about z, exactly: counter-clockwise, x -> y.
   const glm::dmat4 z = pbrt::rotateMatrix(90.0, {0, 0, 1});
   EXPECT_EQ(glm::dvec3(z * glm::dvec4(1, 0, 0, 0)), glm::dvec3(0, 1, 0));
@@ -109,8 +109,8 @@ TEST(PbrtTransforms, RotateAboutASkewAxis) {
   const double c = 0.5, s = std::sqrt(3.0) / 2;
   const glm::dvec3 v(1, 2, 0);
   const glm::dvec3 expected = v * c + glm::cross(a, v) * s + a * glm::dot(a, v) * (1 - c);
-  expectNear(glm::dvec3(pbrt::rotateMatrix(60, {0, 3, 3}) * glm::dvec4(v, 0)), expected, 1e-14,
-             "rodrigues");
+  expectNearPbrt(glm::dvec3(pbrt::rotateMatrix(60, {0, 3, 3}) * glm::dvec4(v, 0)), expected, 1e-14,
+                 "rodrigues");
 }
 
 TEST(PbrtTransforms, FileMatricesAreColumnByColumn) {
@@ -134,24 +134,24 @@ std::vector<glm::dvec3> vertices(const std::string& transforms,
 TEST(PbrtTransforms, TheCtmActsOnPointsLastDirectiveFirst) {
   // Translate then Scale: p -> T(S(p)).
   auto v = vertices("Translate 10 0 0\nScale 2 3 4\n");
-  expectNear(v[1], {12, 0, 0}, 0, "v1");
-  expectNear(v[2], {10, 3, 0}, 0, "v2");
+  expectNearPbrt(v[1], {12, 0, 0}, 0, "v1");
+  expectNearPbrt(v[2], {10, 3, 0}, 0, "v2");
   // Rotate 90 about z then Translate: p -> R(T(p)).
   v = vertices("Rotate 90 0 0 1\nTranslate 1 0 0\n");
-  expectNear(v[0], {0, 1, 0}, 0, "v0");
-  expectNear(v[1], {0, 2, 0}, 0, "v1");
-  expectNear(v[2], {-1, 1, 0}, 0, "v2");
+  expectNearPbrt(v[0], {0, 1, 0}, 0, "v0");
+  expectNearPbrt(v[1], {0, 2, 0}, 0, "v1");
+  expectNearPbrt(v[2], {-1, 1, 0}, 0, "v2");
   // ConcatTransform's numbers are column by column: a translation by (5, 6, 7).
   v = vertices("Translate 1 0 0\nConcatTransform [ 1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1 ]\n");
-  expectNear(v[0], {6, 6, 7}, 0, "concat");
+  expectNearPbrt(v[0], {6, 6, 7}, 0, "concat");
   // Transform replaces the CTM; Identity resets it.
   v = vertices("Translate 100 0 0\nTransform [ 2 0 0 0  0 2 0 0  0 0 2 0  0 0 1 1 ]\n");
-  expectNear(v[1], {2, 0, 1}, 0, "transform");
+  expectNearPbrt(v[1], {2, 0, 1}, 0, "transform");
   v = vertices("Translate 100 0 0\nIdentity\n");
-  expectNear(v[1], {1, 0, 0}, 0, "identity");
+  expectNearPbrt(v[1], {1, 0, 0}, 0, "identity");
   // LookAt in the world block is a transform like any other (camera from world).
   v = vertices("LookAt 0 0 0  0 0 1  0 1 0\nTranslate 0 0 5\n");
-  expectNear(v[0], {0, 0, 5}, 1e-12, "lookat");
+  expectNearPbrt(v[0], {0, 0, 5}, 1e-12, "lookat");
 }
 
 TEST(PbrtTransforms, AttributeAndTransformBlocksRestoreTheCtm) {
@@ -179,16 +179,16 @@ TEST(PbrtTransforms, CoordinateSystemsAndTheCamera) {
   auto world = [](vec3 p) { return glm::dvec3(-p.x, p.y, p.z); };
   const Triangle& t = scene.triangles[0];
   // The winding is swapped by the mirroring, so v1 and v2 trade places.
-  expectNear(world(t.v0), {5, 2, 3}, 1e-5, "camera (0,0,4)");
-  expectNear(world(t.v2), {5, 3, 3}, 1e-5, "camera (1,0,4)");
-  expectNear(world(t.v1), {5, 2, 4}, 1e-5, "camera (0,1,4)");
+  expectNearPbrt(world(t.v0), {5, 2, 3}, 1e-5, "camera (0,0,4)");
+  expectNearPbrt(world(t.v2), {5, 3, 3}, 1e-5, "camera (1,0,4)");
+  expectNearPbrt(world(t.v1), {5, 2, 4}, 1e-5, "camera (0,1,4)");
   // "start" was the identity: the second triangle is back at the origin.
   EXPECT_EQ(world(scene.triangles[1].v0), glm::dvec3(0, 0, 0));
   // The camera: at the eye, looking along +x (mirrored: -x), up +z.
   EXPECT_EQ(scene.camera.position, vec3(-1, 2, 3));
   const Camera camera = makeCamera(scene.camera, 16, 16);
-  expectNear(camera.forward, {-1, 0, 0}, 1e-6, "forward");
-  expectNear(camera.up, {0, 0, 1}, 1e-6, "up");
+  expectNearPbrt(camera.forward, {-1, 0, 0}, 1e-6, "forward");
+  expectNearPbrt(camera.up, {0, 0, 1}, 1e-6, "up");
 }
 
 TEST(PbrtTransforms, ReverseOrientationAndHandednessFlipTheFront) {
@@ -237,7 +237,7 @@ TEST(PbrtShapes, NormalsTransformWithTheInverseTranspose) {
   ASSERT_EQ(scene.normals.size(), 1u);
   // (1, 0, 1) under diag(2, 1, 1)^-T is (0.5, 0, 1), reversed: -(0.5, 0, 1) / |.|.
   const glm::dvec3 n = -glm::normalize(glm::dvec3(0.5, 0, 1));
-  expectNear(scene.normals[0].n0, n, 1e-7, "n0");
+  expectNearPbrt(scene.normals[0].n0, n, 1e-7, "n0");
   EXPECT_LT(glm::dot(glm::dvec3(geometricNormal(scene.triangles[0])), n), 0.0 + 1.0);
   EXPECT_EQ(geometricNormal(scene.triangles[0]), vec3(0, 0, -1));
 }
@@ -282,10 +282,11 @@ TEST(PbrtShapes, PlyMeshRelativeToTheFileThatNamesIt) {
   EXPECT_EQ(scene.triangles[0].v0, vec3(0, 0, 5));
   EXPECT_EQ(scene.triangles[1].v2, vec3(0, 1, 5));
   EXPECT_EQ(scene.normals[3].n2, vec3(0, 0, 1));
-  EXPECT_EQ(errorOf(std::string(kUnmirrored) + "Shape \"plymesh\" \"string filename\" \"no.ply\"",
-                    dir / "x.pbrt"),
-            (dir / "x.pbrt").string() + ":6:17: cannot open 'no.ply' (looked for '" +
-                (dir / "no.ply").string() + "': No such file or directory)");
+  EXPECT_EQ(
+      pbrtErrorOf(std::string(kUnmirrored) + "Shape \"plymesh\" \"string filename\" \"no.ply\"",
+                  dir / "x.pbrt"),
+      (dir / "x.pbrt").string() + ":6:17: cannot open 'no.ply' (looked for '" +
+          (dir / "no.ply").string() + "': No such file or directory)");
 }
 
 TEST(PbrtShapes, SpheresAndDisksAreTessellated) {
@@ -307,7 +308,7 @@ TEST(PbrtShapes, SpheresAndDisksAreTessellated) {
     EXPECT_GT(glm::dot(scene.normals[i].n0, t.v0 - vec3(0, 5, 0)), 0.0f);
   }
   for (std::size_t i = sphere; i < scene.triangles.size(); ++i) {
-    expectNear(geometricNormal(scene.triangles[i]), {0, 0, 1}, 1e-6, "disk");  // faces +z
+    expectNearPbrt(geometricNormal(scene.triangles[i]), {0, 0, 1}, 1e-6, "disk");  // faces +z
   }
   EXPECT_EQ(scene.triangles[sphere].v0, vec3(0, 5, 1));  // the first disk's centre
   std::string joined;
@@ -749,7 +750,7 @@ TEST(PbrtSceneErrors, NameFileLineAndColumn) {
       {w + "Material \"interface\"\n" + kTriangle,
        "scene.pbrt:8:1: the scene has no triangles to render"},
   };
-  for (const auto& [text, message] : cases) EXPECT_EQ(errorOf(text), message) << text;
+  for (const auto& [text, message] : cases) EXPECT_EQ(pbrtErrorOf(text), message) << text;
 }
 
 TEST(PbrtSceneErrors, CommandLineExitsWithStatus2AndOneLine) {
@@ -923,7 +924,7 @@ TEST(PbrtCameraFilm, BadCameraAndFilmParametersAreErrors) {
       {"Film \"rgb\" \"float cropwindow\" [0 1]\n" + w,
        "scene.pbrt:1:12: 'cropwindow' of Film \"rgb\" takes 4 values, got 2"},
   };
-  for (const auto& [text, message] : cases) EXPECT_EQ(errorOf(text), message) << text;
+  for (const auto& [text, message] : cases) EXPECT_EQ(pbrtErrorOf(text), message) << text;
 }
 
 TEST(PbrtCameraFilm, StrictMakesEveryWarningAnError) {

@@ -29,7 +29,7 @@ using scene_detail::loadPlyTriangles;
 using scene_detail::PlyMesh;
 using Triangles = std::vector<std::array<glm::dvec3, 3>>;
 
-const std::string kContext = " (referenced by scene.json: shapes[0].file)";
+const std::string kPlyContext = " (referenced by scene.json: shapes[0].file)";
 const std::vector<std::string> kFormats = {"ascii", "binary_little_endian", "binary_big_endian"};
 
 // ---- A small PLY writer, independent of the reader ----
@@ -156,7 +156,7 @@ struct Layout {
   bool facesFirst = false;  // the face element before the vertex element
 };
 
-std::string describe(const Layout& l) {
+std::string describeLayout(const Layout& l) {
   return l.vertexType + " vertices, " + l.countType + " " + l.indexType + " indices" +
          (l.extras ? ", extras" : "") + (l.vertexList ? ", vertex list" : "") +
          (l.facesFirst ? ", faces first" : "");
@@ -234,12 +234,13 @@ const std::vector<Layout> kLayouts = {
 };
 
 TEST(PlyMesh, EveryFormatAndLayoutGivesTheObjTriangles) {
-  const Triangles obj = loadObjTriangles(objText(), "mesh.obj", kContext);
+  const Triangles obj = loadObjTriangles(objText(), "mesh.obj", kPlyContext);
   ASSERT_EQ(obj.size(), 7u);
   for (const Layout& layout : kLayouts) {
     for (const std::string& format : kFormats) {
-      SCOPED_TRACE(format + ", " + describe(layout));
-      const PlyMesh ply = loadPlyMesh(plyFile(format, meshElements(layout)), "mesh.ply", kContext);
+      SCOPED_TRACE(format + ", " + describeLayout(layout));
+      const PlyMesh ply =
+          loadPlyMesh(plyFile(format, meshElements(layout)), "mesh.ply", kPlyContext);
       EXPECT_TRUE(ply.triangles == obj);
       // The extras include normals, all (0, 0, 1).
       if (layout.extras) {
@@ -250,15 +251,15 @@ TEST(PlyMesh, EveryFormatAndLayoutGivesTheObjTriangles) {
       } else {
         EXPECT_TRUE(ply.normals.empty());
       }
-      EXPECT_TRUE(loadPlyTriangles(plyFile(format, meshElements(layout)), "mesh.ply", kContext) ==
-                  obj);
+      EXPECT_TRUE(
+          loadPlyTriangles(plyFile(format, meshElements(layout)), "mesh.ply", kPlyContext) == obj);
     }
   }
 }
 
 TEST(PlyMesh, PolygonsAreFannedFromTheirFirstVertex) {
   const Triangles ply =
-      loadPlyTriangles(plyFile("ascii", meshElements(kLayouts[0])), "mesh.ply", kContext);
+      loadPlyTriangles(plyFile("ascii", meshElements(kLayouts[0])), "mesh.ply", kPlyContext);
   ASSERT_EQ(ply.size(), 7u);
   // The pentagon (1, 6, 2, 4, 3) is triangles 3 to 5.
   const std::array<std::array<int, 3>, 3> expected = {{{1, 6, 2}, {1, 2, 4}, {1, 4, 3}}};
@@ -271,19 +272,19 @@ TEST(PlyMesh, PolygonsAreFannedFromTheirFirstVertex) {
 
 TEST(PlyMesh, CrlfLinesAndBlankDataLinesAreTolerated) {
   const Triangles expected =
-      loadPlyTriangles(plyFile("ascii", meshElements(kLayouts[1])), "mesh.ply", kContext);
+      loadPlyTriangles(plyFile("ascii", meshElements(kLayouts[1])), "mesh.ply", kPlyContext);
   std::string crlf;
   for (char c : plyFile("ascii", meshElements(kLayouts[1]))) {
     crlf += c == '\n' ? std::string("\r\n\r\n") : std::string(1, c);
   }
   // Blank lines inside the header are tolerated too.
-  EXPECT_TRUE(loadPlyTriangles(crlf, "mesh.ply", kContext) == expected);
+  EXPECT_TRUE(loadPlyTriangles(crlf, "mesh.ply", kPlyContext) == expected);
   for (const std::string& format : {kFormats[1], kFormats[2]}) {
     const std::vector<Elem> elements = meshElements(kLayouts[1]);
     std::string header = plyHeader(format, elements);
     std::string crlfHeader;
     for (char c : header) crlfHeader += c == '\n' ? std::string("\r\n") : std::string(1, c);
-    EXPECT_TRUE(loadPlyTriangles(crlfHeader + plyData(format, elements), "mesh.ply", kContext) ==
+    EXPECT_TRUE(loadPlyTriangles(crlfHeader + plyData(format, elements), "mesh.ply", kPlyContext) ==
                 expected)
         << format;
   }
@@ -298,7 +299,7 @@ TEST(PlyMesh, DoubleCoordinatesKeepTheirPrecision) {
            {{type, "x", ""}, {type, "y", ""}, {type, "z", ""}},
            {{0.1, 0, 0}, {1, 0, 0}, {0, 1, 0.3}}},
           {"face", {{"int", "vertex_indices", "uchar"}}, {{3, 0, 1, 2}}}};
-      const Triangles t = loadPlyTriangles(plyFile(format, elements), "m.ply", kContext);
+      const Triangles t = loadPlyTriangles(plyFile(format, elements), "m.ply", kPlyContext);
       ASSERT_EQ(t.size(), 1u);
       const bool isDouble = type == "double";
       EXPECT_EQ(t[0][0].x, isDouble ? 0.1 : double(0.1f));
@@ -318,7 +319,7 @@ TEST(PlyMesh, TristripsAreAccepted) {
       {0, 1, 2}, {2, 1, 3}, {4, 5, 6}, {6, 5, 3}, {1, 2, 3}};
   for (const std::string& format : kFormats) {
     SCOPED_TRACE(format);
-    const Triangles t = loadPlyTriangles(plyFile(format, elements), "strips.ply", kContext);
+    const Triangles t = loadPlyTriangles(plyFile(format, elements), "strips.ply", kPlyContext);
     ASSERT_EQ(t.size(), expected.size());
     for (std::size_t i = 0; i < expected.size(); ++i) {
       for (std::size_t k = 0; k < 3; ++k) {
@@ -363,7 +364,7 @@ Elem normalVertices(const std::string& type, bool list) {
 }
 
 // Checks triangle t of `mesh` against the vertex indices `expected`, points and normals.
-void expectTriangle(const PlyMesh& mesh, std::size_t t, const std::array<int, 3>& expected) {
+void expectPlyTriangle(const PlyMesh& mesh, std::size_t t, const std::array<int, 3>& expected) {
   for (std::size_t k = 0; k < 3; ++k) {
     const std::size_t v = static_cast<std::size_t>(expected[k]);
     EXPECT_EQ(mesh.triangles[t][k], kVertices[v]) << "triangle " << t << " vertex " << k;
@@ -381,10 +382,10 @@ TEST(PlyMesh, NormalsFollowTheFannedPolygons) {
         SCOPED_TRACE(format + ", " + type + (list ? ", vertex list" : ""));
         std::vector<Elem> elements = meshElements(kLayouts[0]);
         elements[0] = normalVertices(type, list);
-        const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "normals.ply", kContext);
+        const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "normals.ply", kPlyContext);
         ASSERT_EQ(mesh.triangles.size(), expected.size());
         ASSERT_EQ(mesh.normals.size(), expected.size());
-        for (std::size_t t = 0; t < expected.size(); ++t) expectTriangle(mesh, t, expected[t]);
+        for (std::size_t t = 0; t < expected.size(); ++t) expectPlyTriangle(mesh, t, expected[t]);
       }
     }
   }
@@ -400,10 +401,10 @@ TEST(PlyMesh, NormalsFollowTheTristrips) {
       {0, 1, 2}, {2, 1, 3}, {4, 5, 6}, {6, 5, 3}, {1, 2, 3}};
   for (const std::string& format : kFormats) {
     SCOPED_TRACE(format);
-    const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "strips.ply", kContext);
+    const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "strips.ply", kPlyContext);
     ASSERT_EQ(mesh.triangles.size(), expected.size());
     ASSERT_EQ(mesh.normals.size(), expected.size());
-    for (std::size_t t = 0; t < expected.size(); ++t) expectTriangle(mesh, t, expected[t]);
+    for (std::size_t t = 0; t < expected.size(); ++t) expectPlyTriangle(mesh, t, expected[t]);
   }
 }
 
@@ -421,7 +422,7 @@ TEST(PlyMesh, DoubleNormalsKeepTheirPrecision) {
             {type, "nz", ""}},
            {{0, 0, 0, 0.1, 0, 0}, {1, 0, 0, 0, 0, 0}, {0, 1, 0, 0, 0, 0.3}}},
           {"face", {{"int", "vertex_indices", "uchar"}}, {{3, 0, 1, 2}}}};
-      const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "m.ply", kContext);
+      const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "m.ply", kPlyContext);
       ASSERT_EQ(mesh.normals.size(), 1u);
       const bool isDouble = type == "double";
       EXPECT_EQ(mesh.normals[0][0].x, isDouble ? 0.1 : double(0.1f));
@@ -436,7 +437,7 @@ TEST(PlyMesh, FilesWithoutNormalsHaveNone) {
   for (const std::string& format : kFormats) {
     SCOPED_TRACE(format);
     const PlyMesh mesh =
-        loadPlyMesh(plyFile(format, meshElements(kLayouts[0])), "plain.ply", kContext);
+        loadPlyMesh(plyFile(format, meshElements(kLayouts[0])), "plain.ply", kPlyContext);
     EXPECT_EQ(mesh.triangles.size(), 7u);
     EXPECT_TRUE(mesh.normals.empty());
   }
@@ -511,7 +512,7 @@ TEST(PlyMeshUvs, UvsFollowTheFannedPolygons) {
                        (list ? ", vertex list" : ""));
           std::vector<Elem> elements = meshElements(kLayouts[0]);
           elements[0] = uvVertices(type, names, list);
-          const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "uvs.ply", kContext);
+          const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "uvs.ply", kPlyContext);
           ASSERT_EQ(mesh.triangles.size(), expected.size());
           ASSERT_EQ(mesh.uvs.size(), expected.size());
           EXPECT_TRUE(mesh.normals.empty());
@@ -532,7 +533,7 @@ TEST(PlyMeshUvs, UvsAndNormalsTogether) {
       SCOPED_TRACE(format + (list ? ", vertex list" : ""));
       std::vector<Elem> elements = meshElements(kLayouts[0]);
       elements[0] = uvVertices("float", kUvNames[0], list, /*normals=*/true);
-      const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "uvs.ply", kContext);
+      const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "uvs.ply", kPlyContext);
       ASSERT_EQ(mesh.uvs.size(), expected.size());
       ASSERT_EQ(mesh.normals.size(), expected.size());
       for (std::size_t t = 0; t < expected.size(); ++t) {
@@ -555,7 +556,7 @@ TEST(PlyMeshUvs, UvsFollowTheTristrips) {
       {0, 1, 2}, {2, 1, 3}, {4, 5, 6}, {6, 5, 3}, {1, 2, 3}};
   for (const std::string& format : kFormats) {
     SCOPED_TRACE(format);
-    const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "strips.ply", kContext);
+    const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "strips.ply", kPlyContext);
     ASSERT_EQ(mesh.triangles.size(), expected.size());
     ASSERT_EQ(mesh.uvs.size(), expected.size());
     for (std::size_t t = 0; t < expected.size(); ++t) expectUvTriangle(mesh, t, expected[t]);
@@ -575,7 +576,7 @@ TEST(PlyMeshUvs, DoubleUvsAreRoundedToFloat) {
             {type, "texture_v", ""}},
            {{0, 0, 0, 0.1, -2.5}, {1, 0, 0, 0, 0}, {0, 1, 0, 1e-3, 0.3}}},
           {"face", {{"int", "vertex_indices", "uchar"}}, {{3, 0, 1, 2}}}};
-      const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "m.ply", kContext);
+      const PlyMesh mesh = loadPlyMesh(plyFile(format, elements), "m.ply", kPlyContext);
       ASSERT_EQ(mesh.uvs.size(), 1u);
       EXPECT_EQ(mesh.uvs[0][0], glm::vec2(0.1f, -2.5f));
       EXPECT_EQ(mesh.uvs[0][1], glm::vec2(0.0f));
@@ -589,7 +590,7 @@ TEST(PlyMeshUvs, FilesWithoutUvsHaveNone) {
     SCOPED_TRACE(format);
     for (const Layout& layout : kLayouts) {
       const PlyMesh mesh =
-          loadPlyMesh(plyFile(format, meshElements(layout)), "plain.ply", kContext);
+          loadPlyMesh(plyFile(format, meshElements(layout)), "plain.ply", kPlyContext);
       EXPECT_EQ(mesh.triangles.size(), 7u);
       EXPECT_TRUE(mesh.uvs.empty());
     }
@@ -602,13 +603,14 @@ TEST(PlyMeshUvs, FilesWithoutUvsHaveNone) {
 // context; empty (and a test failure) if it loads or throws anything else.
 std::string plyError(const std::string& bytes, const std::string& file = "bad.ply") {
   try {
-    loadPlyTriangles(bytes, file, kContext);
+    loadPlyTriangles(bytes, file, kPlyContext);
   } catch (const InputError& e) {
     const std::string message = e.what();
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     EXPECT_EQ(message.rfind(file + ": ", 0), 0u) << message;
-    EXPECT_TRUE(message.size() >= kContext.size() &&
-                message.compare(message.size() - kContext.size(), kContext.size(), kContext) == 0)
+    EXPECT_TRUE(
+        message.size() >= kPlyContext.size() &&
+        message.compare(message.size() - kPlyContext.size(), kPlyContext.size(), kPlyContext) == 0)
         << message;
     return message;
   }
@@ -638,7 +640,7 @@ std::string replaced(std::string s, const std::string& from, const std::string& 
 }
 
 TEST(PlyMesh, ValidAsciiBaseline) {
-  EXPECT_EQ(loadPlyTriangles(kAscii, "good.ply", kContext).size(), 1u);
+  EXPECT_EQ(loadPlyTriangles(kAscii, "good.ply", kPlyContext).size(), 1u);
 }
 
 TEST(PlyMesh, HeaderErrorsNameTheLine) {
@@ -869,9 +871,9 @@ const std::string kNormalHeader =
 const std::string kNormalAscii = kNormalHeader + "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n";
 
 TEST(PlyMesh, NormalErrors) {
-  ASSERT_EQ(loadPlyMesh(kNormalAscii, "good.ply", kContext).normals.size(), 1u);
+  ASSERT_EQ(loadPlyMesh(kNormalAscii, "good.ply", kPlyContext).normals.size(), 1u);
   // Only some of nx, ny, nz: the line of the first of them.
-  const std::string needAll = " (a vertex normal needs all of 'nx', 'ny' and 'nz')" + kContext;
+  const std::string needAll = " (a vertex normal needs all of 'nx', 'ny' and 'nz')" + kPlyContext;
   EXPECT_EQ(plyError(replaced(replaced(kNormalAscii, "property float ny\n", ""),
                               "property float nz\n", "")),
             "bad.ply: line 7: vertex property 'nx' without 'ny' and 'nz'" + needAll);
@@ -883,23 +885,24 @@ TEST(PlyMesh, NormalErrors) {
                               "property float ny\nproperty float nn\n")),
             "bad.ply: line 7: vertex properties 'ny' and 'nz' without 'nx'" + needAll);
   // Types, duplicates.
-  EXPECT_EQ(
-      plyError(replaced(kNormalAscii, "property float ny", "property uchar ny")),
-      "bad.ply: line 8: vertex property 'ny' is 'uchar' (it must be float or double)" + kContext);
+  EXPECT_EQ(plyError(replaced(kNormalAscii, "property float ny", "property uchar ny")),
+            "bad.ply: line 8: vertex property 'ny' is 'uchar' (it must be float or double)" +
+                kPlyContext);
   EXPECT_EQ(
       plyError(replaced(kNormalAscii, "property float nz", "property list uchar float nz")),
-      "bad.ply: line 9: vertex property 'nz' is a list (it must be float or double)" + kContext);
-  EXPECT_EQ(plyError(replaced(kNormalAscii, "property float nz\n",
-                              "property float nz\nproperty double nx\n")),
-            "bad.ply: line 10: element 'vertex' already has a property 'nx' (line 7)" + kContext);
+      "bad.ply: line 9: vertex property 'nz' is a list (it must be float or double)" + kPlyContext);
+  EXPECT_EQ(
+      plyError(
+          replaced(kNormalAscii, "property float nz\n", "property float nz\nproperty double nx\n")),
+      "bad.ply: line 10: element 'vertex' already has a property 'nx' (line 7)" + kPlyContext);
   // Values (ascii).
   // A normal that is not finite is read as 0 0 0 and counted (the scene loaders warn and use
   // the geometric normal there); the rest of the mesh is as written.
   for (const char* bad : {"1 0 0 0 nan 1\n", "1 0 0 0 0 -inf\n"}) {
     const PlyMesh mesh =
-        loadPlyMesh(replaced(kNormalAscii, "1 0 0 0 0 1\n", bad), "n.ply", kContext);
+        loadPlyMesh(replaced(kNormalAscii, "1 0 0 0 0 1\n", bad), "n.ply", kPlyContext);
     EXPECT_EQ(mesh.nonFiniteNormals, 1u);
-    const PlyMesh good = loadPlyMesh(kNormalAscii, "n.ply", kContext);
+    const PlyMesh good = loadPlyMesh(kNormalAscii, "n.ply", kPlyContext);
     EXPECT_EQ(good.nonFiniteNormals, 0u);
     ASSERT_EQ(mesh.normals.size(), good.normals.size());
     size_t zeros = 0;
@@ -916,9 +919,9 @@ TEST(PlyMesh, NormalErrors) {
   }
   EXPECT_EQ(plyError(replaced(kNormalAscii, "0 0 0 0 0 1\n", "0 0 0 1e39 0 1\n")),
             "bad.ply: vertex 0 (line 13): normal is too large for a 32-bit float (nx = '1e39')" +
-                kContext);
+                kPlyContext);
   EXPECT_EQ(plyError(replaced(kNormalAscii, "1 0 0 0 0 1\n", "1 0 0 0 abc 1\n")),
-            "bad.ply: vertex 1 (line 14): normal ny 'abc' is not a number" + kContext);
+            "bad.ply: vertex 1 (line 14): normal ny 'abc' is not a number" + kPlyContext);
   // Values (binary), for entries of one size and, with a vertex list, of varying size.
   for (const std::string& format : {kFormats[1], kFormats[2]}) {
     for (const bool list : {false, true}) {
@@ -928,12 +931,12 @@ TEST(PlyMesh, NormalErrors) {
       // Properties: nz x flags nx y z ny.
       elements[0].rows[3][6] = std::numeric_limits<double>::quiet_NaN();
       elements[0].rows[5][0] = -std::numeric_limits<double>::infinity();
-      EXPECT_EQ(loadPlyMesh(plyFile(format, elements), "n.ply", kContext).nonFiniteNormals, 2u);
+      EXPECT_EQ(loadPlyMesh(plyFile(format, elements), "n.ply", kPlyContext).nonFiniteNormals, 2u);
       elements[0] = normalVertices("double", list);
       elements[0].rows[2][3] = 1e300;
       EXPECT_EQ(
           plyError(plyFile(format, elements)),
-          "bad.ply: vertex 2: normal is too large for a 32-bit float (nx = 1e+300)" + kContext);
+          "bad.ply: vertex 2: normal is too large for a 32-bit float (nx = 1e+300)" + kPlyContext);
     }
   }
 }
@@ -946,12 +949,12 @@ TEST(PlyMeshUvs, TheFirstWholePairIsRead) {
       "property float z\nproperty float s\nproperty float t\nproperty float u\n"
       "property float v\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
   const std::string data = "0 0 0 1 2 3 4\n1 0 0 5 6 7 8\n0 1 0 9 10 11 12\n3 0 1 2\n";
-  PlyMesh mesh = loadPlyMesh(header + data, "m.ply", kContext);
+  PlyMesh mesh = loadPlyMesh(header + data, "m.ply", kPlyContext);
   ASSERT_EQ(mesh.uvs.size(), 1u);
   EXPECT_EQ(mesh.uvs[0][0], glm::vec2(3, 4));
   EXPECT_EQ(mesh.uvs[0][2], glm::vec2(11, 12));
   mesh = loadPlyMesh(replaced(header, "property float v\n", "property float w\n") + data, "m.ply",
-                     kContext);
+                     kPlyContext);
   ASSERT_EQ(mesh.uvs.size(), 1u);
   EXPECT_EQ(mesh.uvs[0][0], glm::vec2(1, 2));
   EXPECT_EQ(mesh.uvs[0][1], glm::vec2(5, 6));
@@ -965,43 +968,45 @@ const std::string kUvHeader =
 const std::string kUvAscii = kUvHeader + "0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n3 0 1 2\n";
 
 TEST(PlyMeshUvs, UvErrors) {
-  ASSERT_EQ(loadPlyMesh(kUvAscii, "good.ply", kContext).uvs.size(), 1u);
+  ASSERT_EQ(loadPlyMesh(kUvAscii, "good.ply", kPlyContext).uvs.size(), 1u);
   // One of a pair alone: its line.
   EXPECT_EQ(plyError(replaced(kUvAscii, "property float v\n", "")),
             "bad.ply: line 7: vertex property 'u' without 'v' (texture coordinates need both "
             "'u' and 'v')" +
-                kContext);
+                kPlyContext);
   EXPECT_EQ(plyError(replaced(kUvAscii, "property float u\n", "property float w\n")),
             "bad.ply: line 8: vertex property 'v' without 'u' (texture coordinates need both "
             "'u' and 'v')" +
-                kContext);
+                kPlyContext);
   EXPECT_EQ(plyError(replaced(replaced(kUvAscii, "property float u\n", "property float q\n"),
                               "property float v\n", "property double texture_t\n")),
             "bad.ply: line 8: vertex property 'texture_t' without 'texture_s' (texture "
             "coordinates need both 'texture_s' and 'texture_t')" +
-                kContext);
+                kPlyContext);
   // Types, duplicates.
-  EXPECT_EQ(
-      plyError(replaced(kUvAscii, "property float v", "property ushort v")),
-      "bad.ply: line 8: vertex property 'v' is 'ushort' (it must be float or double)" + kContext);
+  EXPECT_EQ(plyError(replaced(kUvAscii, "property float v", "property ushort v")),
+            "bad.ply: line 8: vertex property 'v' is 'ushort' (it must be float or double)" +
+                kPlyContext);
   EXPECT_EQ(
       plyError(replaced(kUvAscii, "property float u", "property list uchar float u")),
-      "bad.ply: line 7: vertex property 'u' is a list (it must be float or double)" + kContext);
+      "bad.ply: line 7: vertex property 'u' is a list (it must be float or double)" + kPlyContext);
   EXPECT_EQ(
       plyError(replaced(kUvAscii, "property float v\n", "property float v\nproperty double u\n")),
-      "bad.ply: line 9: element 'vertex' already has a property 'u' (line 7)" + kContext);
+      "bad.ply: line 9: element 'vertex' already has a property 'u' (line 7)" + kPlyContext);
   // Values (ascii).
-  EXPECT_EQ(plyError(replaced(kUvAscii, "1 0 0 1 0\n", "1 0 0 nan 0\n")),
-            "bad.ply: vertex 1 (line 13): texture coordinate is not finite (u = 'nan')" + kContext);
+  EXPECT_EQ(
+      plyError(replaced(kUvAscii, "1 0 0 1 0\n", "1 0 0 nan 0\n")),
+      "bad.ply: vertex 1 (line 13): texture coordinate is not finite (u = 'nan')" + kPlyContext);
   EXPECT_EQ(
       plyError(replaced(kUvAscii, "0 1 0 0 1\n", "0 1 0 0 -inf\n")),
-      "bad.ply: vertex 2 (line 14): texture coordinate is not finite (v = '-inf')" + kContext);
+      "bad.ply: vertex 2 (line 14): texture coordinate is not finite (v = '-inf')" + kPlyContext);
   EXPECT_EQ(plyError(replaced(kUvAscii, "0 0 0 0 0\n", "0 0 0 0 1e39\n")),
             "bad.ply: vertex 0 (line 12): texture coordinate is too large for a 32-bit float "
             "(v = '1e39')" +
-                kContext);
-  EXPECT_EQ(plyError(replaced(kUvAscii, "1 0 0 1 0\n", "1 0 0 abc 0\n")),
-            "bad.ply: vertex 1 (line 13): texture coordinate u 'abc' is not a number" + kContext);
+                kPlyContext);
+  EXPECT_EQ(
+      plyError(replaced(kUvAscii, "1 0 0 1 0\n", "1 0 0 abc 0\n")),
+      "bad.ply: vertex 1 (line 13): texture coordinate u 'abc' is not a number" + kPlyContext);
   // Values (binary), for entries of one size and, with a vertex list, of varying size.
   for (const std::string& format : {kFormats[1], kFormats[2]}) {
     for (const bool list : {false, true}) {
@@ -1011,17 +1016,18 @@ TEST(PlyMeshUvs, UvErrors) {
       elements[0] = uvVertices("float", kUvNames[0], list);
       elements[0].rows[3][1] = std::numeric_limits<double>::quiet_NaN();
       EXPECT_EQ(plyError(plyFile(format, elements)),
-                "bad.ply: vertex 3: texture coordinate is not finite (v = nan)" + kContext);
+                "bad.ply: vertex 3: texture coordinate is not finite (v = nan)" + kPlyContext);
       elements[0] = uvVertices("float", kUvNames[2], list);
       elements[0].rows[5][4] = -std::numeric_limits<double>::infinity();
-      EXPECT_EQ(plyError(plyFile(format, elements)),
-                "bad.ply: vertex 5: texture coordinate is not finite (texture_u = inf)" + kContext);
+      EXPECT_EQ(
+          plyError(plyFile(format, elements)),
+          "bad.ply: vertex 5: texture coordinate is not finite (texture_u = inf)" + kPlyContext);
       elements[0] = uvVertices("double", kUvNames[1], list);
       elements[0].rows[2][4] = 1e300;
       EXPECT_EQ(plyError(plyFile(format, elements)),
                 "bad.ply: vertex 2: texture coordinate is too large for a 32-bit float (s = "
                 "1e+300)" +
-                    kContext);
+                    kPlyContext);
     }
   }
 }
@@ -1042,7 +1048,7 @@ TEST(PlyMesh, TruncationsAndCorruptionsNeverCrash) {
     const std::size_t headerSize = plyHeader(format, meshElements(kLayouts[5])).size();
     auto tryLoad = [&](const std::string& bytes) {
       try {
-        const PlyMesh mesh = loadPlyMesh(bytes, "fuzz.ply", kContext);
+        const PlyMesh mesh = loadPlyMesh(bytes, "fuzz.ply", kPlyContext);
         ASSERT_TRUE(mesh.normals.empty() || mesh.normals.size() == mesh.triangles.size());
         for (const Triangles* list : {&mesh.triangles, &mesh.normals}) {
           for (const auto& tri : *list) {
@@ -1081,7 +1087,7 @@ TEST(PlyMeshUvs, TruncationsAndCorruptionsNeverCrash) {
       const std::size_t headerSize = plyHeader(format, elements).size();
       auto tryLoad = [&](const std::string& bytes) {
         try {
-          const PlyMesh mesh = loadPlyMesh(bytes, "fuzz.ply", kContext);
+          const PlyMesh mesh = loadPlyMesh(bytes, "fuzz.ply", kPlyContext);
           ASSERT_TRUE(mesh.uvs.empty() || mesh.uvs.size() == mesh.triangles.size());
           for (const auto& tri : mesh.uvs) {
             for (const glm::vec2& uv : tri) ASSERT_TRUE(std::isfinite(uv.x) && std::isfinite(uv.y));

@@ -38,7 +38,7 @@ std::vector<RayResult> traceChecked(const Bvh& bvh, const std::vector<RayQuery>&
   return results;
 }
 
-bool contains(vec3 lo, vec3 hi, vec3 p) {
+bool boxContains(vec3 lo, vec3 hi, vec3 p) {
   return all(lessThanEqual(lo, p)) && all(lessThanEqual(p, hi));
 }
 
@@ -81,8 +81,8 @@ class LayoutCheck {
     }
     const GpuBvhNode* n = interior(ref, depth);
     if (!n) return;
-    notContained += !contains(lo, hi, n->leftMin) || !contains(lo, hi, n->leftMax) ||
-                    !contains(lo, hi, n->rightMin) || !contains(lo, hi, n->rightMax);
+    notContained += !boxContains(lo, hi, n->leftMin) || !boxContains(lo, hi, n->leftMax) ||
+                    !boxContains(lo, hi, n->rightMin) || !boxContains(lo, hi, n->rightMax);
     child(n->left, n->leftMin, n->leftMax, index + 1, depth + 1);
     child(n->right, n->rightMin, n->rightMax, b.offset, depth + 1);
   }
@@ -95,7 +95,7 @@ class LayoutCheck {
       for (uint i = first; i < first + count && i < bvh_.triangles.size(); ++i) {
         const Triangle& t = bvh_.triangles[i];
         notContained +=
-            !contains(lo, hi, t.v0) || !contains(lo, hi, t.v1) || !contains(lo, hi, t.v2);
+            !boxContains(lo, hi, t.v0) || !boxContains(lo, hi, t.v1) || !boxContains(lo, hi, t.v2);
       }
       nextTriangle_ = std::min(size_t(first) + count, bvh_.triangles.size());
       return;

@@ -159,7 +159,7 @@ struct Integration {
   double mse, mean, standardError;
 };
 template <class F, class Sampler>
-Integration integrate(F f, double exact, int n, Sampler sampler) {
+Integration integrateWith(F f, double exact, int n, Sampler sampler) {
   constexpr int kPixels = 1024;
   double se = 0, sum = 0, sq = 0;
   for (uint p = 0; p < kPixels; ++p) {
@@ -188,15 +188,15 @@ TEST(SobolSampler, UnbiasedAndMoreAccurateThanIndependentNumbers) {
   }
   for (int n : {16, 256}) {
     SCOPED_TRACE(std::to_string(n) + " samples");
-    const Integration sd = integrate(disc, discArea, n, sobol);
-    const Integration id = integrate(disc, discArea, n, independent);
+    const Integration sd = integrateWith(disc, discArea, n, sobol);
+    const Integration id = integrateWith(disc, discArea, n, independent);
     EXPECT_NEAR(sd.mean, discArea, 4.0 * sd.standardError);  // unbiased
     EXPECT_NEAR(id.mean, discArea, 4.0 * id.standardError);
     // Owen-scrambled nets: variance about n^-1.5 instead of n^-1 for the disc's edge, and
     // n^-3 for smooth integrands. Asked for with a margin: half and 1/n of those gains.
     EXPECT_LT(sd.mse, id.mse / (0.5 * std::sqrt(double(n))));
-    const Integration ss = integrate(smooth, smoothExact, n, sobol);
-    const Integration is = integrate(smooth, smoothExact, n, independent);
+    const Integration ss = integrateWith(smooth, smoothExact, n, sobol);
+    const Integration is = integrateWith(smooth, smoothExact, n, independent);
     // (Numbers are truncated to 24 bits, which moves the mean by about 3e-8: allowed for.)
     EXPECT_NEAR(ss.mean, smoothExact, 4.0 * ss.standardError + 1e-7);
     EXPECT_LT(ss.mse, is.mse / double(n));

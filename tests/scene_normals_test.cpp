@@ -13,7 +13,7 @@
 namespace pt {
 namespace {
 
-void expectNear(vec3 a, vec3 b, const char* what) {
+void expectNormalNear(vec3 a, vec3 b, const char* what) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 1e-6f) << what << " component " << c;
 }
 
@@ -32,7 +32,7 @@ constexpr char kPly[] =
     "0 0 0 1 0 1\n1 0 0 1 0 1\n0 1 0 1 0 1\n"
     "3 0 1 2\n";
 
-std::string sceneJson() {
+std::string normalsSceneJson() {
   return R"({
   "camera": {"position": [0, 0, 5], "target": [0, 0, 0]},
   "materials": [{"name": "m", "type": "diffuse"}],
@@ -49,20 +49,20 @@ TEST(SceneNormals, FromObjAndPlyTransformedAndFilled) {
   test::TempDir dir;
   dir.write("mesh.obj", kObj);
   dir.write("mesh.ply", kPly);
-  const Scene scene = loadScene(dir.write("scene.json", sceneJson()));
+  const Scene scene = loadScene(dir.write("scene.json", normalsSceneJson()));
   ASSERT_EQ(scene.triangles.size(), 5u);  // quad 2, OBJ 2, PLY 1
   ASSERT_EQ(scene.normals.size(), scene.triangles.size());
   // The quad, before any mesh with normals: its geometric normal (+z: counter-clockwise).
-  expectNear(scene.normals[0].n0, vec3(0, 0, 1), "quad");
-  expectNear(scene.normals[1].n2, vec3(0, 0, 1), "quad");
+  expectNormalNear(scene.normals[0].n0, vec3(0, 0, 1), "quad");
+  expectNormalNear(scene.normals[1].n2, vec3(0, 0, 1), "quad");
   // The OBJ's first face: its normals, unit length.
-  expectNear(scene.normals[2].n0, vec3(0, 0, 1), "obj face 1, v1");
-  expectNear(scene.normals[2].n1, vec3(0.6f, 0, 0.8f), "obj face 1, v2");
+  expectNormalNear(scene.normals[2].n0, vec3(0, 0, 1), "obj face 1, v1");
+  expectNormalNear(scene.normals[2].n1, vec3(0.6f, 0, 0.8f), "obj face 1, v2");
   // The OBJ's second face has no normals: the geometric normal.
-  expectNear(scene.normals[3].n1, vec3(0, 0, 1), "obj face 2");
+  expectNormalNear(scene.normals[3].n1, vec3(0, 0, 1), "obj face 2");
   // The PLY's normal (1, 0, 1) / sqrt(2) under scale (2, 1, 1) and 90 degrees about z: the
   // inverse transpose scales x by 1/2, giving (0.5, 0, 1), rotated to (0, 0.5, 1).
-  expectNear(scene.normals[4].n0, normalize(vec3(0, 0.5f, 1)), "ply");
+  expectNormalNear(scene.normals[4].n0, normalize(vec3(0, 0.5f, 1)), "ply");
 }
 
 TEST(SceneNormals, MeshesWithoutNormalsLeaveNone) {
@@ -76,7 +76,7 @@ TEST(SceneNormals, ReachTheRendererAsAnEffect) {
   test::TempDir dir;
   dir.write("mesh.obj", kObj);
   dir.write("mesh.ply", kPly);
-  const SceneData data = prepareScene(loadScene(dir.write("scene.json", sceneJson())),
+  const SceneData data = prepareScene(loadScene(dir.write("scene.json", normalsSceneJson())),
                                       RenderSettings{.width = 8, .height = 8});
   EXPECT_TRUE(data.effects.shadingNormals);
   EXPECT_EQ(data.params.normalsPresent, 1u);

@@ -32,11 +32,11 @@ glm::dvec2 chromaticity(glm::dvec3 xyz) {
 }
 
 // Luminance of a linear sRGB colour: Y of its XYZ.
-double luminance(glm::dvec3 rgb) {
+double rgbLuminance(glm::dvec3 rgb) {
   return (glm::inverse(spectra::xyzToLinearSrgb()) * rgb).y;
 }
 
-void expectNear(glm::dvec3 a, glm::dvec3 b, double tolerance, const std::string& what) {
+void expectRgbNear(glm::dvec3 a, glm::dvec3 b, double tolerance, const std::string& what) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], tolerance) << what << " [" << c << "]";
 }
 
@@ -51,7 +51,7 @@ TEST(Spectra, MatchingFunctionsAreTheCiesTable) {
   // 106.856917 (the CIE's tabulated values, rounded).
   EXPECT_NEAR(spectra::cieYIntegral(), 106.856895, 1e-4);
   EXPECT_EQ(spectra::cmf(555).y, 1.0);  // y-bar's peak
-  expectNear(spectra::cmf(600), {1.0622, 0.631, 0.0008}, 0, "600 nm");
+  expectRgbNear(spectra::cmf(600), {1.0622, 0.631, 0.0008}, 0, "600 nm");
   // The equal-energy spectrum is white at (1/3, 1/3): x-bar, y-bar and z-bar have equal
   // integrals (to the table's rounding).
   const glm::dvec2 e = chromaticity(spectra::toXyz(constant(1.0)));
@@ -64,7 +64,7 @@ TEST(Spectra, D65IsWhiteInPbrtV4sSrgb) {
   const glm::dvec2 w = chromaticity(spectra::toXyz(spectra::illuminantD65()));
   EXPECT_NEAR(w.x, 0.31272, 2e-5);
   EXPECT_NEAR(w.y, 0.32903, 2e-5);
-  expectNear(*spectra::emissionToRgb(spectra::illuminantD65()), glm::dvec3(1.0), 1e-9, "D65");
+  expectRgbNear(*spectra::emissionToRgb(spectra::illuminantD65()), glm::dvec3(1.0), 1e-9, "D65");
   // IEC 61966-2-1's matrix, which rounds its white to (0.3127, 0.3290).
   const glm::dmat3 iec = glm::transpose(glm::dmat3(3.2406, -1.5372, -0.4986,  //
                                                    -0.9689, 1.8758, 0.0415,   //
@@ -78,14 +78,14 @@ TEST(Spectra, D65IsWhiteInPbrtV4sSrgb) {
 
 TEST(Spectra, ConstantSpectraAreGrey) {
   for (double r : {0.0, 0.18, 0.5, 1.0}) {
-    expectNear(spectra::reflectanceToRgb(constant(r)), glm::dvec3(r), 1e-9, "reflectance");
+    expectRgbNear(spectra::reflectanceToRgb(constant(r)), glm::dvec3(r), 1e-9, "reflectance");
   }
-  expectNear(spectra::unboundedToRgb(constant(1.5)), glm::dvec3(1.5), 1e-9, "index");
-  expectNear(spectra::unboundedToRgb(constant(0.0)), glm::dvec3(0.0), 0, "zero k");
+  expectRgbNear(spectra::unboundedToRgb(constant(1.5)), glm::dvec3(1.5), 1e-9, "index");
+  expectRgbNear(spectra::unboundedToRgb(constant(0.0)), glm::dvec3(0.0), 0, "zero k");
   // An emission is normalized to luminance 1, whatever its scale: the equal-energy white
   // is then slightly pink against D65 (x = y = 1/3 lies towards red and away from blue).
   const glm::dvec3 e = *spectra::emissionToRgb(constant(7.0));
-  EXPECT_NEAR(luminance(e), 1.0, 1e-9);
+  EXPECT_NEAR(rgbLuminance(e), 1.0, 1e-9);
   EXPECT_GT(e.r, 1.0);
   EXPECT_LT(e.b, 1.0);
   EXPECT_FALSE(spectra::emissionToRgb(constant(0.0)).has_value());  // nothing to normalize
@@ -119,11 +119,11 @@ TEST(Spectra, BlackbodiesAndIlluminantA) {
   // 6504 K, D65's correlated colour temperature, is near white: D65 lies 0.003 in uv above
   // the Planckian locus, so the blackbody is a little magenta (green low).
   const glm::dvec3 d = spectra::blackbodyRgb(6504.0);
-  expectNear(d, glm::dvec3(1.0), 0.06, "6504 K");
+  expectRgbNear(d, glm::dvec3(1.0), 0.06, "6504 K");
   EXPECT_LT(d.g, std::min(d.r, d.b));
   // Lights of luminance 1, red when cool and blue when hot.
   for (double kelvin : {1500.0, 3000.0, 6504.0, 10000.0, 40000.0}) {
-    EXPECT_NEAR(luminance(spectra::blackbodyRgb(kelvin)), 1.0, 1e-9) << kelvin;
+    EXPECT_NEAR(rgbLuminance(spectra::blackbodyRgb(kelvin)), 1.0, 1e-9) << kelvin;
   }
   const glm::dvec3 warm = spectra::blackbodyRgb(3000.0), cool = spectra::blackbodyRgb(10000.0);
   EXPECT_GT(warm.r, warm.g);
@@ -173,7 +173,7 @@ TEST(Spectra, NamedMetalsMatchTheirSpectralReflectance) {
     ASSERT_NE(m, nullptr) << e.name;
     glm::dvec3 r;
     for (int c = 0; c < 3; ++c) r[c] = normalReflectance(m->eta[c], m->k[c]);
-    expectNear(r, e.reflectance, 1e-4, e.name);
+    expectRgbNear(r, e.reflectance, 1e-4, e.name);
   }
   // Gold and copper are red-yellow: more red than green, more green than blue.
   for (const char* name : {"Au", "Cu"}) {
@@ -186,10 +186,11 @@ TEST(Spectra, NamedMetalsMatchTheirSpectralReflectance) {
 }
 
 TEST(Spectra, NamedIlluminantsAndGlasses) {
-  expectNear(*spectra::namedIlluminantRgb("stdillum-D65"), glm::dvec3(1.0), 1e-9, "D65");
+  expectRgbNear(*spectra::namedIlluminantRgb("stdillum-D65"), glm::dvec3(1.0), 1e-9, "D65");
   // Computed here from the CIE's formulas; tools/metal-rgb.py integrates pbrt-v4's tables of
   // the same illuminants to these.
-  expectNear(*spectra::namedIlluminantRgb("stdillum-A"), {1.845044, 0.826069, 0.233373}, 2e-3, "A");
+  expectRgbNear(*spectra::namedIlluminantRgb("stdillum-A"), {1.845044, 0.826069, 0.233373}, 2e-3,
+                "A");
   // D50 from the daylight basis has the CIE's chromaticity (0.3457, 0.3585). pbrt-v4's table
   // "CIE_Illum_D5000" does not: it integrates to (0.3368, 0.3580), RGB (1.0866, 0.9995,
   // 0.7497) against these (1.176, 0.976, 0.722) (docs/pbrt-format.md).
@@ -197,13 +198,13 @@ TEST(Spectra, NamedIlluminantsAndGlasses) {
   const glm::dvec2 xy = chromaticity(glm::inverse(spectra::xyzToLinearSrgb()) * d50);
   EXPECT_NEAR(xy.x, 0.3457, 1e-4);
   EXPECT_NEAR(xy.y, 0.3585, 1e-4);
-  expectNear(*spectra::namedIlluminantRgb("illum-acesD60"), {1.046912, 0.994574, 0.915528}, 2e-3,
-             "ACES D60");
+  expectRgbNear(*spectra::namedIlluminantRgb("illum-acesD60"), {1.046912, 0.994574, 0.915528}, 2e-3,
+                "ACES D60");
   for (int i = 1; i <= 12; ++i) {
     const std::string name = "stdillum-F" + std::to_string(i);
     const std::optional<glm::dvec3> f = spectra::namedIlluminantRgb(name);
     ASSERT_TRUE(f.has_value()) << name;
-    EXPECT_NEAR(luminance(*f), 1.0, 1e-5) << name;
+    EXPECT_NEAR(rgbLuminance(*f), 1.0, 1e-5) << name;
   }
   EXPECT_FALSE(spectra::namedIlluminantRgb("stdillum-F13").has_value());
   EXPECT_FALSE(spectra::namedIlluminantRgb("stdillum-D55").has_value());
@@ -219,7 +220,7 @@ TEST(Spectra, NamedIlluminantsAndGlasses) {
 
 constexpr char kPrelude[] =
     "Scale -1 1 1\nLookAt 0 0 -10  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n";
-constexpr char kTriangle[] =
+constexpr char kSpectraTriangle[] =
     "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0 ] \"integer indices\" [ 0 1 2 ]\n";
 
 // The material of each triangle of `body` (after the prelude), and the scene's warnings.
@@ -236,26 +237,26 @@ TEST(PbrtSpectra, BlackbodyAndSampledSpectraBecomeTheirColours) {
   const std::vector<Material> m = materials(
       std::string("AttributeBegin\nAreaLightSource \"diffuse\" \"blackbody L\" [3000] "
                   "\"float scale\" 2\n") +
-          kTriangle +
+          kSpectraTriangle +
           "AttributeEnd\n"
           "AttributeBegin\nAreaLightSource \"diffuse\" \"spectrum L\" [500 1 510 1]\n" +
-          kTriangle +
+          kSpectraTriangle +
           "AttributeEnd\n"
           "AttributeBegin\nAreaLightSource \"diffuse\" \"spectrum L\" \"stdillum-A\"\n" +
-          kTriangle +
+          kSpectraTriangle +
           "AttributeEnd\n"
           "Material \"diffuse\" \"spectrum reflectance\" [360 0.5 830 0.5]\n" +
-          kTriangle +
+          kSpectraTriangle +
           "Material \"diffuse\" \"spectrum reflectance\" [360 0.05 560 0.05 620 0.8 830 0.8]\n" +
-          kTriangle +
+          kSpectraTriangle +
           "Material \"conductor\" \"spectrum eta\" \"metal-Cu-eta\" \"spectrum k\" "
           "\"metal-Cu-k\"\n" +
-          kTriangle,
+          kSpectraTriangle,
       &warnings);
   ASSERT_EQ(m.size(), 6u);
   // A 3000 K light: luminance 1 of its colour, times the scale.
   const glm::dvec3 warm = spectra::blackbodyRgb(3000.0);
-  expectNear(glm::dvec3(m[0].emission), 2.0 * warm, 1e-6, "blackbody");
+  expectRgbNear(glm::dvec3(m[0].emission), 2.0 * warm, 1e-6, "blackbody");
   EXPECT_GT(m[0].emission.r, m[0].emission.g);
   EXPECT_GT(m[0].emission.g, m[0].emission.b);
   // Light from 500 to 510 nm only: cyan-green, luminance 1. Its red is negative (outside
@@ -263,16 +264,16 @@ TEST(PbrtSpectra, BlackbodyAndSampledSpectraBecomeTheirColours) {
   EXPECT_EQ(m[1].emission.r, 0.0f);
   EXPECT_GT(m[1].emission.g, m[1].emission.b);
   EXPECT_GT(m[1].emission.b, 0.1f);
-  expectNear(glm::dvec3(m[2].emission), *spectra::namedIlluminantRgb("stdillum-A"), 1e-6,
-             "stdillum-A");
-  expectNear(glm::dvec3(m[3].reflectance), glm::dvec3(0.5), 1e-6, "grey");
+  expectRgbNear(glm::dvec3(m[2].emission), *spectra::namedIlluminantRgb("stdillum-A"), 1e-6,
+                "stdillum-A");
+  expectRgbNear(glm::dvec3(m[3].reflectance), glm::dvec3(0.5), 1e-6, "grey");
   // A reflectance rising from 0.05 below 560 nm to 0.8 above 620 nm: red.
   EXPECT_GT(m[4].reflectance.r, 0.6f);
   EXPECT_LT(m[4].reflectance.b, 0.1f);
-  expectNear(glm::dvec3(m[4].reflectance),
-             spectra::reflectanceToRgb(
-                 spectra::piecewiseLinear({360, 0.05, 560, 0.05, 620, 0.8, 830, 0.8})),
-             1e-6, "red");
+  expectRgbNear(glm::dvec3(m[4].reflectance),
+                spectra::reflectanceToRgb(
+                    spectra::piecewiseLinear({360, 0.05, 560, 0.05, 620, 0.8, 830, 0.8})),
+                1e-6, "red");
   EXPECT_EQ(m[5].eta, spectra::namedMetal("Cu")->eta);
   EXPECT_EQ(m[5].k, spectra::namedMetal("Cu")->k);
   // Only the gamut clamp is an approximation worth a warning.
@@ -284,16 +285,17 @@ TEST(PbrtSpectra, BlackbodyAndSampledSpectraBecomeTheirColours) {
 
 TEST(PbrtSpectra, GlassesAndDarkLights) {
   std::vector<std::string> warnings;
-  const std::vector<Material> m =
-      materials(std::string("Material \"dielectric\" \"spectrum eta\" \"glass-BK7\"\n") + kTriangle,
-                &warnings);
+  const std::vector<Material> m = materials(
+      std::string("Material \"dielectric\" \"spectrum eta\" \"glass-BK7\"\n") + kSpectraTriangle,
+      &warnings);
   const glm::vec3 bk7 = *spectra::namedGlassEta("glass-BK7");
   EXPECT_FLOAT_EQ(m.at(0).eta.x, (bk7.r + bk7.g + bk7.b) / 3.0f);
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("dispersion is not simulated"), std::string::npos) << warnings[0];
   // A light whose spectrum is zero over 360-830 nm has no luminance to normalize by.
   try {
-    materials(std::string("AreaLightSource \"diffuse\" \"spectrum L\" [300 1 350 1]\n") + kTriangle,
+    materials(std::string("AreaLightSource \"diffuse\" \"spectrum L\" [300 1 350 1]\n") +
+                  kSpectraTriangle,
               &warnings);
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {

@@ -19,6 +19,7 @@
 
 #include <hwy/targets.h>
 
+#include "common/check.h"
 #include "common/shared.h"
 #include "cpu/integrator.h"
 #include "scene/scene.h"
@@ -169,6 +170,24 @@ class TempDir {
 inline std::string readFile(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Writes `bytes` to `path`, replacing the file.
+inline void writeBytes(const std::filesystem::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+// Runs `f` and returns the InputError's message ("" and a test failure if none).
+template <typename F>
+std::string inputErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected InputError";
+  return "";
 }
 
 // What a run of the pt command line gave back.

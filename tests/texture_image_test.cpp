@@ -42,10 +42,7 @@ using TextureImageStb = TextureImageTest;
 using TextureImageFloat = TextureImageTest;
 using TextureImageErrors = TextureImageTest;
 
-void writeBytes(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), std::streamsize(bytes.size()));
-}
+using test::writeBytes;
 
 std::string readBytes(const fs::path& path) {
   return test::readFile(path);
@@ -138,21 +135,11 @@ std::string big16(uint16_t v) {
   return {char(v >> 8), char(v & 0xff)};
 }
 
-TextureImage read(const fs::path& path) {
+TextureImage readTexture(const fs::path& path) {
   return readTextureImage(path);
 }
 
-// Runs `f` and returns the InputError's message ("" and a test failure if none).
-template <typename F>
-std::string inputErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError";
-  return "";
-}
+using test::inputErrorOf;
 
 void expectRefused(const fs::path& path, const std::string& expected = "") {
   const std::string message = inputErrorOf([&] { readTextureImage(path); });
@@ -170,7 +157,7 @@ TEST_F(TextureImagePng, EightBitKeepsChannelsBytesAndRowOrder) {
     const std::vector<uint8_t> texels = pattern(width, height, channels);
     const fs::path path = dir_ / ("c" + std::to_string(channels) + ".png");
     writeBytes(path, encode(StbFile::kPng, width, height, channels, texels));
-    const TextureImage image = read(path);
+    const TextureImage image = readTexture(path);
     EXPECT_EQ(image.width, width);
     EXPECT_EQ(image.height, height);
     EXPECT_EQ(image.channels, channels);
@@ -184,7 +171,7 @@ TEST_F(TextureImagePng, GreyAlphaBecomesRgbaWithGreyReplicated) {
   const std::vector<uint8_t> texels = pattern(3, 2, 2);
   const fs::path path = dir_ / "ga.PNG";  // any case
   writeBytes(path, encode(StbFile::kPng, 3, 2, 2, texels));
-  const TextureImage image = read(path);
+  const TextureImage image = readTexture(path);
   ASSERT_EQ(image.channels, 4);
   ASSERT_EQ(image.bytes.size(), 3u * 2u * 4u);
   for (size_t i = 0; i < 6; ++i) {
@@ -212,7 +199,7 @@ TEST_F(TextureImagePng, SixteenBitIsValueOver65535StillEncoded) {
     }
     const fs::path path = dir_ / ("16-" + std::to_string(c.colourType) + ".png");
     writeBytes(path, handPng(width, height, 16, c.colourType, rows));
-    const TextureImage image = read(path);
+    const TextureImage image = readTexture(path);
     ASSERT_EQ(image.width, width);
     ASSERT_EQ(image.height, height);
     ASSERT_EQ(image.channels, c.channels);
@@ -239,14 +226,14 @@ TEST_F(TextureImagePng, PaletteBecomesRgbAndTransparencyAddsAlpha) {
   const std::string palette = std::string("\x10\x20\x30\x40\x50\x60\x70\x80\x90", 9);
   const std::string rows = std::string("\0\x00\x01\0\x02\x00", 6);
   writeBytes(dir_ / "palette.png", handPng(2, 2, 8, 3, rows, chunk("PLTE", palette)));
-  TextureImage image = read(dir_ / "palette.png");
+  TextureImage image = readTexture(dir_ / "palette.png");
   ASSERT_EQ(image.channels, 3);
   EXPECT_EQ(image.bytes, (std::vector<uint8_t>{0x10, 0x20, 0x30, 0x40, 0x50, 0x60, 0x70, 0x80, 0x90,
                                                0x10, 0x20, 0x30}));
   // Entry 1 half transparent, the others opaque.
   writeBytes(dir_ / "palette-trns.png",
              handPng(2, 2, 8, 3, rows, chunk("PLTE", palette) + chunk("tRNS", "\xff\x80")));
-  image = read(dir_ / "palette-trns.png");
+  image = readTexture(dir_ / "palette-trns.png");
   ASSERT_EQ(image.channels, 4);
   EXPECT_EQ(image.bytes, (std::vector<uint8_t>{0x10, 0x20, 0x30, 255, 0x40, 0x50, 0x60, 0x80, 0x70,
                                                0x80, 0x90, 255, 0x10, 0x20, 0x30, 255}));
@@ -254,7 +241,7 @@ TEST_F(TextureImagePng, PaletteBecomesRgbAndTransparencyAddsAlpha) {
   const std::string rgbRows = std::string("\0\x01\x02\x03\x04\x05\x06", 7);
   writeBytes(dir_ / "rgb-trns.png",
              handPng(2, 1, 8, 2, rgbRows, chunk("tRNS", std::string("\0\x04\0\x05\0\x06", 6))));
-  image = read(dir_ / "rgb-trns.png");
+  image = readTexture(dir_ / "rgb-trns.png");
   ASSERT_EQ(image.channels, 4);
   EXPECT_EQ(image.bytes, (std::vector<uint8_t>{1, 2, 3, 255, 4, 5, 6, 0}));
   // readImage still reads them as RGB.
@@ -281,7 +268,7 @@ TEST_F(TextureImageStb, TgaAndBmpKeepBytesAndRowOrder) {
     for (size_t i = 0; i + 4 < texels.size(); i += 9) texels[i + 1] = texels[i + 4] = texels[i];
     const fs::path path = dir_ / c.name;
     writeBytes(path, encode(c.kind, width, height, c.channels, texels));
-    const TextureImage image = read(path);
+    const TextureImage image = readTexture(path);
     EXPECT_EQ(image.width, width);
     EXPECT_EQ(image.height, height);
     EXPECT_EQ(image.channels, c.channels);
@@ -292,7 +279,7 @@ TEST_F(TextureImageStb, TgaAndBmpKeepBytesAndRowOrder) {
 TEST_F(TextureImageStb, TgaGreyAlphaBecomesRgba) {
   const std::vector<uint8_t> texels = pattern(4, 2, 2);
   writeBytes(dir_ / "ga.tga", encode(StbFile::kTga, 4, 2, 2, texels));
-  const TextureImage image = read(dir_ / "ga.tga");
+  const TextureImage image = readTexture(dir_ / "ga.tga");
   ASSERT_EQ(image.channels, 4);
   ASSERT_EQ(image.bytes.size(), 32u);
   for (size_t i = 0; i < 8; ++i) {
@@ -316,7 +303,7 @@ TEST_F(TextureImageStb, JpegWithinToleranceTopRowFirst) {
   }
   for (const char* name : {"a.jpg", "b.JPEG"}) {
     writeBytes(dir_ / name, encode(StbFile::kJpeg, width, height, 3, texels));
-    const TextureImage image = read(dir_ / name);
+    const TextureImage image = readTexture(dir_ / name);
     ASSERT_EQ(image.width, width);
     ASSERT_EQ(image.height, height);
     ASSERT_EQ(image.channels, 3);
@@ -343,7 +330,7 @@ TEST_F(TextureImageFloat, HdrFlatAndRunLengthRowsTopFirst) {
     }
     const fs::path path = dir_ / ("w" + std::to_string(width) + ".hdr");
     writeBytes(path, encodeHdr(width, height, rgb));
-    const TextureImage image = read(path);
+    const TextureImage image = readTexture(path);
     ASSERT_EQ(image.width, width);
     ASSERT_EQ(image.height, height);
     ASSERT_EQ(image.channels, 3);
@@ -407,7 +394,7 @@ TEST_F(TextureImageFloat, ExrKeepsYRgbAndRgbaChannels) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     writeExr(dir_ / c.name, c.names, c.planes, width, height);
-    const TextureImage image = read(dir_ / c.name);
+    const TextureImage image = readTexture(dir_ / c.name);
     ASSERT_EQ(image.width, width);
     ASSERT_EQ(image.height, height);
     ASSERT_EQ(image.channels, int(c.expected.size()));
@@ -430,7 +417,7 @@ TEST_F(TextureImageFloat, ExrAndPfmFromWriteImageAreBitExact) {
   for (const char* name : {"w.exr", "w.pfm", "W.PFM"}) {
     SCOPED_TRACE(name);
     writeImage(rgb, dir_ / name);
-    const TextureImage image = read(dir_ / name);
+    const TextureImage image = readTexture(dir_ / name);
     ASSERT_EQ(image.channels, 3);
     ASSERT_EQ(image.floats.size(), 36u);
     for (int y = 0; y < 3; ++y) {
@@ -452,7 +439,7 @@ TEST_F(TextureImageFloat, GreyPfmIsOneChannelBottomRowFirstInTheFile) {
     for (int k = 0; k < 4; ++k) bytes += char(bits >> (8 * k));
   }
   writeBytes(dir_ / "grey.pfm", bytes);
-  const TextureImage image = read(dir_ / "grey.pfm");
+  const TextureImage image = readTexture(dir_ / "grey.pfm");
   ASSERT_EQ(image.channels, 1);
   EXPECT_EQ(image.floats, (std::vector<float>{1.0f, 2.0f, 3.0f, 4.0f}));
 }
@@ -486,7 +473,7 @@ TEST_F(TextureImageErrors, TruncatedFilesAreRefusedAtEveryLength) {
   for (const auto& [ext, bytes] : goodFiles(dir_)) {
     const fs::path whole = dir_ / ("whole" + std::to_string(n++) + "." + ext);
     writeBytes(whole, bytes);
-    ASSERT_NO_THROW(read(whole)) << whole;
+    ASSERT_NO_THROW(readTexture(whole)) << whole;
     // A few lengths near the start, in the middle and near the end.
     for (size_t length : {size_t(0), size_t(1), size_t(7), size_t(20), bytes.size() / 3,
                           bytes.size() / 2, bytes.size() - 5, bytes.size() - 1}) {

@@ -62,7 +62,7 @@ Built buildImage(const TextureImage& image, ImageTextureDesc desc, bool isFloat 
   return b;
 }
 
-void expectNear(vec3 got, glm::dvec3 want, const std::string& what) {
+void expectTexelNear(vec3 got, glm::dvec3 want, const std::string& what) {
   for (int c = 0; c < 3; ++c)
     EXPECT_NEAR(double(got[c]), want[c], 1e-6) << what << " channel " << c;
 }
@@ -96,7 +96,7 @@ TEST(Textures, BilinearAtCentresEdgesAndCorners) {
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
         const vec2 st((float(x) + 0.5f) / float(w), 1.0f - (float(y) + 0.5f) / float(h));
-        expectNear(b.at(st), rampTexel(x, y), "centre");
+        expectTexelNear(b.at(st), rampTexel(x, y), "centre");
       }
     }
     // Left edge at row 0's centre: s = 0, halfway between texel -1 and texel 0.
@@ -105,7 +105,7 @@ TEST(Textures, BilinearAtCentresEdgesAndCorners) {
     const glm::dvec3 left = wrap == kWrapRepeat  ? rampTexel(w - 1, 0)
                             : wrap == kWrapClamp ? t0
                                                  : glm::dvec3(0.0);
-    expectNear(b.at(edge), 0.5 * (t0 + left), "left edge");
+    expectTexelNear(b.at(edge), 0.5 * (t0 + left), "left edge");
     // Top-left corner: s = 0, t = 1.
     glm::dvec3 corner;
     if (wrap == kWrapRepeat) {
@@ -116,10 +116,10 @@ TEST(Textures, BilinearAtCentresEdgesAndCorners) {
     } else {
       corner = 0.25 * rampTexel(0, 0);
     }
-    expectNear(b.at(vec2(0.0f, 1.0f)), corner, "corner");
+    expectTexelNear(b.at(vec2(0.0f, 1.0f)), corner, "corner");
     // A point inside: weights 0.75 and 0.25 along s between columns 1 and 2 of row 1.
     const vec2 inner((1.5f + 0.25f) / float(w), 1.0f - 1.5f / float(h));
-    expectNear(b.at(inner), 0.75 * rampTexel(1, 1) + 0.25 * rampTexel(2, 1), "inner");
+    expectTexelNear(b.at(inner), 0.75 * rampTexel(1, 1) + 0.25 * rampTexel(2, 1), "inner");
   }
 }
 
@@ -130,14 +130,14 @@ TEST(Textures, MappingScaleInvertAndPointFilter) {
   const Built b = buildImage(rampImage(4, 4), desc);
   // u = 0.3: s = 0.85, texel x = round(0.85 * 4 - 0.5) = 3; v = 0.9: t = 0.9, row
   // round(0.1 * 4 - 0.5) = 0 (halves away from zero: -0.1 rounds to 0).
-  expectNear(b.at(vec2(0.3f, 0.9f)), rampTexel(3, 0), "point");
+  expectTexelNear(b.at(vec2(0.3f, 0.9f)), rampTexel(3, 0), "point");
   // Exactly halfway rounds away from zero: s * 4 - 0.5 = 1.5 gives texel 2.
-  expectNear(b.at(vec2((2.0f / 4.0f - 0.25f) / 2.0f, 0.9f)), rampTexel(2, 0), "half");
+  expectTexelNear(b.at(vec2((2.0f / 4.0f - 0.25f) / 2.0f, 0.9f)), rampTexel(2, 0), "half");
   desc.scale = 2.0f;
   desc.invert = true;
   const Built inverted = buildImage(rampImage(4, 4), desc);
-  expectNear(inverted.at(vec2(0.3f, 0.9f)), glm::max(glm::dvec3(0.0), 1.0 - 2.0 * rampTexel(3, 0)),
-             "scale then invert");
+  expectTexelNear(inverted.at(vec2(0.3f, 0.9f)),
+                  glm::max(glm::dvec3(0.0), 1.0 - 2.0 * rampTexel(3, 0)), "scale then invert");
 }
 
 // 8-bit images decode each byte through a table of 256 values: sRGB's curve (IEC 61966-2-1),
@@ -234,13 +234,14 @@ TEST(Textures, CompositeTexturesEvaluateTheirPrograms) {
   const TextureTables tables{scene.textureNodes.data(), scene.imageWords.data(), nullptr, nullptr};
   const vec2 uv(0.25f, 0.75f);  // texel (0, 0)'s centre
   const glm::dvec3 want = 4.0 * (0.75 * glm::dvec3(0.1, 0.2, 0.3) + 0.25 * rampTexel(0, 0));
-  expectNear(evalTexture(tables, scaled, uv), want, "scale(mix(constant, image, 0.25), 4)");
+  expectTexelNear(evalTexture(tables, scaled, uv), want, "scale(mix(constant, image, 0.25), 4)");
   // A checkerboard of a scaled image and a constant: both operands on its stack.
   const uint board =
       builder.checkerboard(vec4(1.0f, 1.0f, 0.0f, 0.0f), scaled, builder.constant(vec3(7.0f)));
   const TextureTables grown{scene.textureNodes.data(), scene.imageWords.data(), nullptr, nullptr};
-  expectNear(evalTexture(grown, board, uv), want, "checkerboard's tex1");
-  expectNear(evalTexture(grown, board, vec2(1.25f, 0.5f)), glm::dvec3(7.0), "checkerboard's tex2");
+  expectTexelNear(evalTexture(grown, board, uv), want, "checkerboard's tex1");
+  expectTexelNear(evalTexture(grown, board, vec2(1.25f, 0.5f)), glm::dvec3(7.0),
+                  "checkerboard's tex2");
   // Nesting that needs a deeper stack than the shader has is refused when the texture is made.
   uint deep = builder.constant(vec3(1.0f));
   EXPECT_THROW(

@@ -19,12 +19,12 @@ namespace {
 
 using test::kConfigs;
 
-SceneData prepare(const std::string& config, int size) {
+SceneData prepareConfigScene(const std::string& config, int size) {
   return prepareScene(loadScene(kConfigs / config), RenderSettings{.width = size, .height = size});
 }
 
 TEST(Vulkan, CornellBoxMatchesCpuReference) {
-  expectAgreement(renderBoth(prepare("cornell-box.json", 64), 8));
+  expectAgreement(renderBoth(prepareConfigScene("cornell-box.json", 64), 8));
 }
 
 // Where the backends part: a last bit of difference in a normal or a direction grows, over
@@ -70,14 +70,14 @@ AttributeEnd
 }
 
 TEST(Vulkan, MirrorVariantMatchesCpuReference) {
-  const SceneData data = prepare("cornell-mirror.json", 64);
+  const SceneData data = prepareConfigScene("cornell-mirror.json", 64);
   EXPECT_TRUE(data.effects.mirror);
   expectAgreement(renderBoth(data, 8));
 }
 
 TEST(Vulkan, BunnyMeshMatchesCpuReference) {
   // 69,666 triangles: deep BVH traversals on every bounce.
-  expectAgreement(renderBoth(prepare("bunny-box.json", 40), 4));
+  expectAgreement(renderBoth(prepareConfigScene("bunny-box.json", 40), 4));
 }
 
 TEST(Vulkan, FastIntersectionMatchesCpuReference) {
@@ -106,7 +106,7 @@ TEST(Vulkan, BothSamplersMatchCpuReference) {
 
 TEST(Vulkan, UnspecializedShaderGivesTheSameImage) {
   // Every effect compiled in and decided at run time must not change the result.
-  const SceneData data = prepare("cornell-mirror.json", 32);
+  const SceneData data = prepareConfigScene("cornell-mirror.json", 32);
   Film a(32, 32), b(32, 32);
   VulkanRenderOptions options = validatedOptions(4);
   const VulkanRenderStats s1 = renderVulkan(data, options, a);
@@ -125,7 +125,7 @@ TEST(Vulkan, UnspecializedShaderGivesTheSameImage) {
 TEST(Vulkan, SamplesPerPassGiveTheSameBits) {
   // One sample per dispatch, five (in batches of 8: 5 + 3, 2 + 2), and as many as the backend
   // chooses as it goes: the same samples, added to each batch's float sum in the same order.
-  const SceneData data = prepare("cornell-box.json", 32);
+  const SceneData data = prepareConfigScene("cornell-box.json", 32);
   Film a(32, 32), b(32, 32), c(32, 32);
   VulkanRenderOptions options = validatedOptions(12);
   options.samplesPerFold = 8;
@@ -225,7 +225,7 @@ TEST(VulkanLoopCap, ManySamplesPerPassCutShortAreReported) {
 TEST(VulkanLimits, BuffersBeyondMaxStorageBufferRangeFailClearly) {
   // A 4096 x 4096 film needs a 256 MiB accumulation buffer; lavapipe allows 128 MiB per
   // storage buffer. A device with a larger limit renders it instead (skip there).
-  SceneData data = prepare("cornell-box.json", 4096);
+  SceneData data = prepareConfigScene("cornell-box.json", 4096);
   VulkanContext ctx(ContextOptions{});
   if (ctx.limits.maxStorageBufferRange >= 4096ull * 4096ull * sizeof(AccumPixel)) {
     GTEST_SKIP() << "device allows " << ctx.limits.maxStorageBufferRange << " bytes";
@@ -243,7 +243,7 @@ TEST(VulkanLimits, BuffersBeyondMaxStorageBufferRangeFailClearly) {
 // line naming the texture buffer and the limit. (The image buffer is filled here directly, as
 // a scene of that many texels would fill it.)
 TEST(VulkanLimits, TexturesBeyondTheBufferLimitFailClearly) {
-  SceneData data = prepare("cornell-box.json", 16);
+  SceneData data = prepareConfigScene("cornell-box.json", 16);
   VulkanContext ctx(ContextOptions{});
   const uint64_t limit = std::min<uint64_t>(ctx.limits.maxStorageBufferRange,
                                             16ull * ctx.limits.maxTexelBufferElements);

@@ -4,7 +4,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/setup.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+# Unity builds: a fresh clone builds in 35-40 % less CPU time (CMakeLists.txt, README).
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON
 cmake --build build
 ctest --test-dir build --output-on-failure -j "$(nproc)"
 
@@ -19,7 +20,7 @@ ctest --test-dir build --output-on-failure -j "$(nproc)"
 # Line tables only (-g1): the sanitizers' reports name file and line, and the build takes
 # 15-30 % less time per file than with full debug information.
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DPT_SANITIZE=ON
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DPT_SANITIZE=ON -DCMAKE_UNITY_BUILD=ON
 cmake --build build-asan --target pt_tests
 lavapipe='Vulkan|GpuTraversal|BothBackends|OnVulkan'
 # ray_bench (label bench) is not built here: only pt_tests is.

@@ -38,7 +38,7 @@ constexpr int kVersion = 1;
 constexpr size_t kMaxHeaderBytes = 1 << 20;
 constexpr uint64_t kMaxPixels = uint64_t(1) << 28;
 
-[[noreturn]] void fail(const fs::path& path, const std::string& what) {
+[[noreturn]] void failState(const fs::path& path, const std::string& what) {
   throw InputError(path.string() + ": " + what);
 }
 
@@ -97,7 +97,7 @@ class Reader {
   bool atEnd() const { return p_ == end_; }
 
   [[noreturn]] void corrupt(const std::string& what) const {
-    fail(path_, "corrupt film state: " + what);
+    failState(path_, "corrupt film state: " + what);
   }
 
  private:
@@ -126,8 +126,8 @@ bool parseRange(std::string_view text, SampleRange& range) {
 void splitKeyValue(std::string_view text, KeyValues& into, const fs::path& path, const char* what) {
   const size_t eq = text.find('=');
   if (eq == 0 || eq == std::string_view::npos) {
-    fail(path,
-         std::string("corrupt film state: malformed ") + what + " '" + std::string(text) + "'");
+    failState(path, std::string("corrupt film state: malformed ") + what + " '" +
+                        std::string(text) + "'");
   }
   into.emplace_back(std::string(text.substr(0, eq)), std::string(text.substr(eq + 1)));
 }
@@ -135,7 +135,7 @@ void splitKeyValue(std::string_view text, KeyValues& into, const fs::path& path,
 void checkUniqueKeys(const KeyValues& values, const fs::path& path) {
   std::set<std::string> seen;
   for (const auto& [key, value] : values) {
-    if (!seen.insert(key).second) fail(path, "corrupt film state: '" + key + "' given twice");
+    if (!seen.insert(key).second) failState(path, "corrupt film state: '" + key + "' given twice");
   }
 }
 
@@ -347,7 +347,7 @@ FilmState readFilmState(const fs::path& path) {
   const Bytes bytes = readWholeFile(path, "a film state file");
   const std::string_view all(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   if (!all.starts_with(kMagic)) {
-    fail(path, "not a pt film state (it does not begin with '" + std::string(kMagic) + "')");
+    failState(path, "not a pt film state (it does not begin with '" + std::string(kMagic) + "')");
   }
 
   // The header, line by line up to "data N".
@@ -360,18 +360,18 @@ FilmState readFilmState(const fs::path& path) {
   for (int line = 0; !haveData; ++line) {
     const size_t eol = all.find('\n', pos);
     if (eol == std::string_view::npos || eol > kMaxHeaderBytes) {
-      fail(path, "truncated film state: the header ends before its 'data' line");
+      failState(path, "truncated film state: the header ends before its 'data' line");
     }
     const std::string_view text = all.substr(pos, eol - pos);
     pos = eol + 1;
     if (line == 0) {
       uint64_t version = 0;
       if (!parseUnsigned(text.substr(kMagic.size()), version)) {
-        fail(path, "corrupt film state: malformed first line");
+        failState(path, "corrupt film state: malformed first line");
       }
       if (version != kVersion) {
-        fail(path, "film state version " + std::to_string(version) + "; this pt reads version " +
-                       std::to_string(kVersion));
+        failState(path, "film state version " + std::to_string(version) +
+                            "; this pt reads version " + std::to_string(kVersion));
       }
       continue;
     }
@@ -381,7 +381,7 @@ FilmState readFilmState(const fs::path& path) {
         space == std::string_view::npos ? std::string_view() : text.substr(space + 1);
     auto number = [&](uint64_t& into) {
       if (!parseUnsigned(value, into)) {
-        fail(path, "corrupt film state: malformed line '" + std::string(text) + "'");
+        failState(path, "corrupt film state: malformed line '" + std::string(text) + "'");
       }
     };
     if (key == "width") {
@@ -395,7 +395,8 @@ FilmState readFilmState(const fs::path& path) {
           const size_t comma = std::min(value.find(',', start), value.size());
           SampleRange r;
           if (!parseRange(value.substr(start, comma - start), r)) {
-            fail(path, "corrupt film state: malformed sample ranges '" + std::string(value) + "'");
+            failState(path,
+                      "corrupt film state: malformed sample ranges '" + std::string(value) + "'");
           }
           state.ranges.push_back(r);
           start = comma + 1;
@@ -403,7 +404,7 @@ FilmState readFilmState(const fs::path& path) {
       }
     } else if (key == "open") {
       if (!parseRange(value, openRange)) {
-        fail(path, "corrupt film state: malformed open batch '" + std::string(value) + "'");
+        failState(path, "corrupt film state: malformed open batch '" + std::string(value) + "'");
       }
     } else if (key == "setting") {
       splitKeyValue(value, state.settings, path, "setting");
@@ -415,15 +416,15 @@ FilmState readFilmState(const fs::path& path) {
       number(dataSize);
       haveData = true;
     } else {
-      fail(path, "corrupt film state: unknown header line '" + std::string(text) + "'");
+      failState(path, "corrupt film state: unknown header line '" + std::string(text) + "'");
     }
   }
   if (width == 0 || height == 0 || width * height > kMaxPixels || !haveSamples) {
-    fail(path, "corrupt film state: the header lacks a valid width, height or samples line");
+    failState(path, "corrupt film state: the header lacks a valid width, height or samples line");
   }
   if (!normalised(state.ranges)) {
-    fail(path, "corrupt film state: sample ranges " + rangesText(state.ranges) +
-                   " are not sorted and disjoint");
+    failState(path, "corrupt film state: sample ranges " + rangesText(state.ranges) +
+                        " are not sorted and disjoint");
   }
   checkUniqueKeys(state.settings, path);
   checkUniqueKeys(state.info, path);
@@ -431,28 +432,29 @@ FilmState readFilmState(const fs::path& path) {
   // The body and the checksum: lengths first, so that a cut-off file says so.
   const uint64_t available = bytes.size() - pos;
   if (available < dataSize + 8) {
-    fail(path, "truncated film state: " + std::to_string(dataSize + 8) +
-                   " bytes of data and checksum expected, " + std::to_string(available) + " found");
+    failState(path, "truncated film state: " + std::to_string(dataSize + 8) +
+                        " bytes of data and checksum expected, " + std::to_string(available) +
+                        " found");
   }
   if (available > dataSize + 8) {
-    fail(path, "corrupt film state: " + std::to_string(available - dataSize - 8) +
-                   " unexpected bytes after the data");
+    failState(path, "corrupt film state: " + std::to_string(available - dataSize - 8) +
+                        " unexpected bytes after the data");
   }
   const size_t checked = bytes.size() - 8;
   uint64_t recordedSum = 0;
   for (int b = 0; b < 8; ++b) recordedSum |= uint64_t(bytes[checked + size_t(b)]) << (8 * b);
   if (hashBytes(bytes.data(), checked) != recordedSum) {
-    fail(path, "corrupt film state: checksum mismatch (the file was changed or damaged)");
+    failState(path, "corrupt film state: checksum mismatch (the file was changed or damaged)");
   }
   if (recordedHash != hexHash(settingsHash(state.settings))) {
-    fail(path, "corrupt film state: the settings do not match their hash");
+    failState(path, "corrupt film state: the settings do not match their hash");
   }
 
   // Every pixel holds one sample (valid or invalid) per sample index outside the open batch.
   if (openRange.count() > 0 && (state.ranges.empty() || openRange.end != state.ranges.back().end ||
                                 openRange.first < state.ranges.back().first)) {
-    fail(path, "corrupt film state: the open batch " + openRange.toString() +
-                   " does not end the sample ranges");
+    failState(path, "corrupt film state: the open batch " + openRange.toString() +
+                        " does not end the sample ranges");
   }
   const uint64_t inFilm = uint64_t(state.samplesPerPixel()) - openRange.count();
   state.film = Film(int(width), int(height));
@@ -519,13 +521,13 @@ FilmState FilmStateMerger::finish() {
   const Seen& base = seen_.front();
   for (const Seen& s : seen_) {
     if (s.width != base.width || s.height != base.height) {
-      fail(s.path, "is " + std::to_string(s.width) + "x" + std::to_string(s.height) + ", " +
-                       base.path.string() + " is " + std::to_string(base.width) + "x" +
-                       std::to_string(base.height));
+      failState(s.path, "is " + std::to_string(s.width) + "x" + std::to_string(s.height) + ", " +
+                            base.path.string() + " is " + std::to_string(base.width) + "x" +
+                            std::to_string(base.height));
     }
     const std::string diff = settingsDifference(s.meta.settings, base.meta.settings);
     if (!diff.empty()) {
-      fail(s.path, "rendered with other settings than " + base.path.string() + ": " + diff);
+      failState(s.path, "rendered with other settings than " + base.path.string() + ": " + diff);
     }
   }
 

@@ -5,11 +5,10 @@
 #include <cmath>
 
 #include "common/check.h"
+#include "common/numbers.h"
 
 namespace pt {
 namespace {
-
-constexpr double kPiD = 3.14159265358979323846;
 
 // sin theta at the centre of row y of a lat-long map of `height` rows: the solid angle its
 // texels cover, relative to the equator's.

@@ -9,13 +9,13 @@
 
 #include <glm/glm.hpp>
 
+#include "common/numbers.h"
 #include "path_vertex.h"
 
 namespace pt {
 namespace {
 
 using glm::dvec3;
-constexpr double kPiD = 3.14159265358979323846;
 
 // pbrt-v4's LightBounds, in double while the tree is built.
 struct Bounds {

@@ -159,16 +159,16 @@ double loadReal(const unsigned char* p, Type type, bool swap) {
   return load<float>(p, swap);
 }
 
-bool isBlank(char c) {
+bool isPlyBlank(char c) {
   return c == ' ' || c == '\t' || c == '\r';
 }
 
 // Splits off the next blank-separated token of `rest`; empty when none is left.
 std::string_view nextToken(std::string_view& rest) {
   std::size_t i = 0;
-  while (i < rest.size() && isBlank(rest[i])) ++i;
+  while (i < rest.size() && isPlyBlank(rest[i])) ++i;
   std::size_t end = i;
-  while (end < rest.size() && !isBlank(rest[end])) ++end;
+  while (end < rest.size() && !isPlyBlank(rest[end])) ++end;
   const std::string_view token = rest.substr(i, end - i);
   rest.remove_prefix(end);
   return token;
@@ -181,7 +181,7 @@ std::size_t countTokens(std::string_view line) {
 }
 
 // from_chars takes no '+' sign: drop one, but not from "+-3" or "++3".
-bool skipPlus(std::string_view* token) {
+bool skipPlyPlus(std::string_view* token) {
   if (token->empty() || (*token)[0] != '+') return true;
   token->remove_prefix(1);
   return !token->empty() && (*token)[0] != '+' && (*token)[0] != '-';
@@ -190,7 +190,7 @@ bool skipPlus(std::string_view* token) {
 enum class Parse { kOk, kNotNumber, kOutOfRange };
 
 Parse parseInteger(std::string_view token, std::int64_t* value) {
-  if (!skipPlus(&token)) return Parse::kNotNumber;
+  if (!skipPlyPlus(&token)) return Parse::kNotNumber;
   const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), *value);
   if (ptr != token.data() + token.size()) return Parse::kNotNumber;
   if (ec == std::errc::result_out_of_range) return Parse::kOutOfRange;
@@ -200,8 +200,8 @@ Parse parseInteger(std::string_view token, std::int64_t* value) {
 // A whole token as a T (float or double). from_chars also takes "inf" and "nan", left for
 // the caller to report; an overflow becomes an infinity, an underflow a zero.
 template <typename T>
-bool parseReal(std::string_view token, T* value) {
-  if (!skipPlus(&token)) return false;
+bool parsePlyReal(std::string_view token, T* value) {
+  if (!skipPlyPlus(&token)) return false;
   const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), *value,
                                          std::chars_format::general);
   if (ptr != token.data() + token.size()) return false;
@@ -1049,10 +1049,10 @@ class PlyReader {
     bool ok = false;
     if (type == Type::kFloat32) {
       float f = 0.0f;
-      ok = parseReal(token, &f);
+      ok = parsePlyReal(token, &f);
       value = f;
     } else {
-      ok = parseReal(token, &value);
+      ok = parsePlyReal(token, &value);
     }
     if (!ok) {
       failEntry(e, entry, what + " " + name + " " + singleQuoted(token) + " is not a number",
@@ -1062,7 +1062,7 @@ class PlyReader {
     // Too large or really infinite: the text as a double tells which (a float property's
     // overflow has already become an infinity).
     double asDouble = value;
-    parseReal(token, &asDouble);
+    parsePlyReal(token, &asDouble);
     if (keepNonFinite && !std::isfinite(asDouble)) return asDouble;
     failEntry(
         e, entry,

@@ -23,7 +23,18 @@ namespace pt {
 
 namespace {
 
-using namespace gltf;
+using gltf::addPunctualLights;
+using gltf::Context;
+using gltf::indexed;
+using gltf::MaterialSlot;
+using gltf::MeshReader;
+using gltf::parseDocument;
+using gltf::PlacedNode;
+using gltf::placeNodes;
+using gltf::readDocument;
+using gltf::readMaterial;
+using gltf::setCamera;
+using gltf::TextureReader;
 
 // Extensions of the file that the reader reads, in part or whole (docs/gltf.md).
 bool isReadExtension(const std::string& name) {

@@ -18,7 +18,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using namespace pbrt;
+using pbrt::Builder;
+using pbrt::Location;
+using pbrt::parseText;
+using pbrt::Statement;
+using pbrt::StatementHandler;
 
 Scene build(const std::function<void(const StatementHandler&)>& parse, const fs::path& path,
             std::size_t lines, const SceneLoadOptions& options) {
