@@ -961,7 +961,7 @@ PT_INLINE bool bsdfHasSpecular(Material m) {
   }
   if (PT_HAS_THIN_DIELECTRIC && m.type == kMaterialThinDielectric) return true;
   if (PT_HAS_GLTF && m.type == kMaterialGltf) return effectivelySmooth(distributionOf(m));
-  return false;  // diffuse transmission
+  return false;  // diffuse, diffuse transmission (mirror: the integrators' own)
 }
 
 // f(wo, wi) without delta lobes; `rng` feeds the coated material's estimate.

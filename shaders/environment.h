@@ -177,11 +177,19 @@ PT_INLINE uint environmentGuideSize(uint count) {
   return n <= 1u ? 1u : (2u << uint(findMSB(n - 1u)));
 }
 
+// Where the guide table of `row` (-1: the marginal's) of a W x H image starts, in floats from
+// the first texel's; row H's start is the end of the last.
+PT_INLINE uint environmentGuideStart(uint width, uint height, int row) {
+  uint i = 4u * (width * height + (height + 3u) / 4u);
+  if (row >= 0) {
+    i += environmentGuideSize(height) + 1u + uint(row) * (environmentGuideSize(width) + 1u);
+  }
+  return i;
+}
+
 // Entry k of the guide table of `row` (-1: the marginal's).
 PT_INLINE uint environmentGuideEntry(EnvironmentMap env, int row, uint k) {
-  uint marginalEntries = environmentGuideSize(env.height) + 1u;
-  uint i = 4u * (env.width * env.height + (env.height + 3u) / 4u) + k;
-  if (row >= 0) i += marginalEntries + uint(row) * (environmentGuideSize(env.width) + 1u);
+  uint i = environmentGuideStart(env.width, env.height, row) + k;
   vec4 t = PT_ENVIRONMENT_TEXEL(env, i / 4u);
   uint c = i & 3u;
   return uint(c == 0u ? t.x : c == 1u ? t.y : c == 2u ? t.z : t.w);

@@ -254,6 +254,7 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
   // stores (a store-to-load stall on the CPU).
   TriangleShading shading = triangleShadingAt(PT_SCENE_ARG index, tri);
   vec3 ng = shading.normal;
+  bool shadingNormals = PT_HAS_SHADING_NORMALS && PT_PARAMS.normalsPresent != 0u;
 #ifndef PT_NO_BSDF_MATERIALS
   // The parameters that textures give, at the hit's texture coordinates and footprint.
   UVFootprint uv = pointFootprint(vec2(0.0f));
@@ -262,7 +263,6 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
   TriangleDerivatives derivatives;
   bool textured = (PT_HAS_TEXTURES || PT_HAS_BUMP_MAPS) && PT_PARAMS.texturesPresent != 0u;
   bool footprints = textured && footprintsOn(PT_SCENE_ONLY);
-  bool shadingNormals = PT_HAS_SHADING_NORMALS && PT_PARAMS.normalsPresent != 0u;
   bool footprintUVs = false;  // uv.duvdx, uv.duvdy and derivatives hold the hit's
   if (textured) {
     textures = materialTexturesAt(PT_SCENE_TEXTURES tri.material);
@@ -271,8 +271,7 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
     // read: by a texture, or by a specular bounce, which carries it on to the textures the
     // path reaches next. (pbrt-v4 takes it at every hit; elsewhere it goes unused.)
     footprints =
-        footprints && (reads || s.material.type == kMaterialMirror ||
-                       (s.material.type != kMaterialDiffuse && bsdfHasSpecular(s.material)));
+        footprints && (reads || s.material.type == kMaterialMirror || bsdfHasSpecular(s.material));
     if (footprints) {
       surfaceDpdxy(PT_PARAMS, rd, b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2, ng, s.dpdx, s.dpdy);
     }
@@ -292,8 +291,6 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
     }
     if (PT_HAS_TEXTURES) s.material = resolveMaterialAt(PT_SCENE_TEXTURES s.material, textures, uv);
   }
-#else
-  bool shadingNormals = PT_HAS_SHADING_NORMALS && PT_PARAMS.normalsPresent != 0u;
 #endif
   float cosOut = dot(ng, wo);
   // Lambertian and mirror surfaces are two-sided: shaded with the normal facing the ray. With

@@ -135,8 +135,8 @@ using test::objectPixels;
 TEST(AnalyticLights, FurnaceUnderAConstantEnvironmentOnBothBackends) {
   for (uint strategy : {kStrategyMis, kStrategyNee, kStrategyBsdf}) {
     SCOPED_TRACE(strategy);
-    Scene scene =
-        loadPbrtSceneText(furnaceText(64, "LightSource \"infinite\" \"rgb L\" [1 1 1]\n"), "f.pbrt");
+    Scene scene = loadPbrtSceneText(furnaceText(64, "LightSource \"infinite\" \"rgb L\" [1 1 1]\n"),
+                                    "f.pbrt");
     RenderSettings settings;
     settings.strategy = strategy;
     const SceneData data = prepareScene(std::move(scene), settings);
@@ -161,9 +161,10 @@ TEST(AnalyticLights, MaxDepthCountsScatteringEventsAsPbrtDoesOnBothBackends) {
   for (int depth : {0, 1}) {
     RenderSettings settings;
     settings.maxDepth = depth;
-    const SceneData data = prepareScene(
-        loadPbrtSceneText(furnaceText(16, "LightSource \"infinite\" \"rgb L\" [1 1 1]\n"), "f.pbrt"),
-        settings);
+    const SceneData data =
+        prepareScene(loadPbrtSceneText(
+                         furnaceText(16, "LightSource \"infinite\" \"rgb L\" [1 1 1]\n"), "f.pbrt"),
+                     settings);
     const Comparison cmp = renderBoth(data, data.spp);
     for (const Image* image : {&cmp.cpuImage, &cmp.gpuImage}) {
       const std::vector<size_t> inside = objectPixels(*image);

@@ -71,9 +71,6 @@ std::vector<vec4> buildEnvironmentTexels(const Image& radiance, uint mapping, bo
   }
   std::vector<vec4> texels(environmentTexelCount(w, h), vec4(0.0f));
   const size_t marginalBase = size_t(w) * size_t(h);
-  const size_t marginalGuide = 4 * (marginalBase + (size_t(h) + 3) / 4);
-  const size_t rowGuides = marginalGuide + environmentGuideSize(uint(h)) + 1;
-  const size_t rowGuideEntries = environmentGuideSize(uint(w)) + 1;
   std::vector<double> rowSums(size_t(h), 0.0);
   std::vector<float> ends(static_cast<size_t>(w));
   for (int y = 0; y < h; ++y) {
@@ -82,12 +79,12 @@ std::vector<vec4> buildEnvironmentTexels(const Image& radiance, uint mapping, bo
     for (int x = 0; x < w; ++x) {
       texels[base + size_t(x)] = vec4(max(radiance.at(x, y), vec3(0.0f)), ends[size_t(x)]);
     }
-    writeGuide(ends.data(), uint(w), texels, rowGuides + size_t(y) * rowGuideEntries);
+    writeGuide(ends.data(), uint(w), texels, environmentGuideStart(uint(w), uint(h), y));
   }
   std::vector<float> marginal(static_cast<size_t>(h));
   cdfEnds(rowSums.data(), size_t(h), marginal.data());
   for (int y = 0; y < h; ++y) texels[marginalBase + size_t(y) / 4][y % 4] = marginal[size_t(y)];
-  writeGuide(marginal.data(), uint(h), texels, marginalGuide);
+  writeGuide(marginal.data(), uint(h), texels, environmentGuideStart(uint(w), uint(h), -1));
   return texels;
 }
 

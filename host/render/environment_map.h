@@ -33,9 +33,7 @@ std::vector<vec4> buildEnvironmentTexels(const Image& radiance, uint mapping, bo
 
 // The number of texels buildEnvironmentTexels gives for a W x H image.
 inline size_t environmentTexelCount(int width, int height) {
-  const size_t guideFloats = size_t(environmentGuideSize(uint(height))) + 1 +
-                             size_t(height) * (size_t(environmentGuideSize(uint(width))) + 1);
-  return size_t(width) * size_t(height) + (size_t(height) + 3) / 4 + (guideFloats + 3) / 4;
+  return (size_t(environmentGuideStart(uint(width), uint(height), height)) + 3) / 4;
 }
 
 // The mean radiance over the sphere of directions (each texel weighed by its solid angle).
