@@ -19,8 +19,8 @@
 namespace pt {
 #endif
 
-// Which material types the code is compiled for. The shader defines these as its
-// specialization constants, so that types a scene does not use fold away; C++ has them all.
+// Which material types the code is compiled for. The shader defines these as the constants
+// it is compiled with for the scene, so that types it does not use fold away; C++ has them all.
 #ifndef PT_HAS_CONDUCTOR
 #define PT_HAS_CONDUCTOR true
 #define PT_HAS_DIELECTRIC true

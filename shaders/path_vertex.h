@@ -14,9 +14,9 @@
 // PT_SCENE_PARAM / PT_SCENE_ARG pass the PathScene in C++ and nothing in GLSL.
 //
 // Effects a scene does not use fold away in the shader: it defines the PT_HAS_* switches as
-// its specialization constants (C++ has them all, and tests the data). The shader variant
-// for scenes of Lambertian and mirror surfaces only defines PT_NO_BSDF_MATERIALS, and none of
-// bsdf.h's other materials, lights.h, texture.h and environment.h is compiled in.
+// the constants it is compiled with for the scene (C++ has them all, and tests the data). The
+// shader variant for scenes of Lambertian and mirror surfaces only defines PT_NO_BSDF_MATERIALS,
+// and none of bsdf.h's other materials, lights.h, texture.h and environment.h is compiled in.
 //
 // Floating-point operations are in the order the images of the renderer were made with:
 // backends that call these functions give the bits they gave before. Where a product is

@@ -16,20 +16,51 @@
 
 layout(local_size_x = kWorkgroupSize, local_size_y = kWorkgroupSize) in;
 
-// The effect set: what the scene does not use is compiled out (see host/render/prepare.h).
-layout(constant_id = PT_SPEC_DIFFUSE) const bool kDiffuse = true;
-layout(constant_id = PT_SPEC_MIRROR) const bool kMirror = true;
-layout(constant_id = PT_SPEC_NEE) const bool kNee = true;
-layout(constant_id = PT_SPEC_BSDF_EMISSION) const bool kBsdfEmission = true;
-layout(constant_id = PT_SPEC_MIS) const bool kMis = true;
-layout(constant_id = PT_SPEC_RR) const bool kRussianRoulette = true;
-layout(constant_id = PT_SPEC_INTERSECTION) const uint kIntersection = kSpecAtRunTime;
-layout(constant_id = PT_SPEC_SAMPLER) const uint kSampler = kSpecAtRunTime;
-layout(constant_id = PT_SPEC_LIGHT_BVH) const bool kLightBvh = true;
+// The effect set: what the scene does not use is compiled out. The host compiles this shader
+// for each scene with its effects as these definitions (PT_FX_SET and every PT_FX_*, see
+// host/vulkan/backend.cpp and host/render/prepare.h); without them, as the build checks it,
+// every effect is compiled in, and the intersection test and the sampler are read from the
+// parameters (kSpecAtRunTime).
+#ifndef PT_FX_SET
+#define PT_FX_DIFFUSE true
+#define PT_FX_MIRROR true
+#define PT_FX_NEE true
+#define PT_FX_BSDF_EMISSION true
+#define PT_FX_MIS true
+#define PT_FX_RR true
+#define PT_FX_INTERSECTION kSpecAtRunTime
+#define PT_FX_SAMPLER kSpecAtRunTime
+#define PT_FX_LIGHT_BVH true
+#define PT_FX_CONDUCTOR true
+#define PT_FX_DIELECTRIC true
+#define PT_FX_THIN_DIELECTRIC true
+#define PT_FX_DIFFUSE_TRANSMISSION true
+#define PT_FX_COATED_DIFFUSE true
+#define PT_FX_GLTF true
+#define PT_FX_SHADING_NORMALS true
+#define PT_FX_DELTA_LIGHTS true
+#define PT_FX_ENVIRONMENT true
+#define PT_FX_TWO_SIDED_EMITTERS true
+#define PT_FX_SPHERE_LIGHTS true
+#define PT_FX_TEXTURES true
+#define PT_FX_ALPHA true
+#define PT_FX_BUMP true
+#define PT_FX_TEXTURE_FEATURES kTextureUsesAll
+#define PT_FX_MEDIUM_KINDS 0xFFFFFFFFu
+#define PT_FX_ENVIRONMENT_IMAGE true
+#endif
+const bool kDiffuse = PT_FX_DIFFUSE;
+const bool kMirror = PT_FX_MIRROR;
+const bool kNee = PT_FX_NEE;
+const bool kBsdfEmission = PT_FX_BSDF_EMISSION;
+const bool kMis = PT_FX_MIS;
+const bool kRussianRoulette = PT_FX_RR;
+const uint kIntersection = PT_FX_INTERSECTION;
+const uint kSampler = PT_FX_SAMPLER;
+const bool kLightBvh = PT_FX_LIGHT_BVH;
 #ifdef PT_NO_BSDF_MATERIALS
 // The variant for scenes of diffuse and mirror surfaces without vertex normals (the host picks
-// it): nothing of bsdf.h is compiled in, which lavapipe's compiler takes a second over even
-// where specialization constants switch it off.
+// it): nothing of bsdf.h is compiled in, and no binding of the environment.
 const bool kConductor = false;
 const bool kDielectric = false;
 const bool kThinDielectric = false;
@@ -46,23 +77,23 @@ const bool kAlphaCutouts = false;
 const bool kBumpMaps = false;
 const bool kEnvironmentImage = false;
 #else
-layout(constant_id = PT_SPEC_CONDUCTOR) const bool kConductor = true;
-layout(constant_id = PT_SPEC_DIELECTRIC) const bool kDielectric = true;
-layout(constant_id = PT_SPEC_THIN_DIELECTRIC) const bool kThinDielectric = true;
-layout(constant_id = PT_SPEC_DIFFUSE_TRANSMISSION) const bool kDiffuseTransmission = true;
-layout(constant_id = PT_SPEC_COATED_DIFFUSE) const bool kCoatedDiffuse = true;
-layout(constant_id = PT_SPEC_GLTF) const bool kGltf = true;
-layout(constant_id = PT_SPEC_SHADING_NORMALS) const bool kShadingNormals = true;
-layout(constant_id = PT_SPEC_DELTA_LIGHTS) const bool kDeltaLights = true;
-layout(constant_id = PT_SPEC_ENVIRONMENT) const bool kEnvironment = true;
-layout(constant_id = PT_SPEC_TWO_SIDED_EMITTERS) const bool kTwoSidedEmitters = true;
-layout(constant_id = PT_SPEC_SPHERE_LIGHTS) const bool kSphereLights = true;
-layout(constant_id = PT_SPEC_TEXTURES) const bool kTextures = true;
-layout(constant_id = PT_SPEC_ALPHA) const bool kAlphaCutouts = true;
-layout(constant_id = PT_SPEC_BUMP) const bool kBumpMaps = true;
-layout(constant_id = PT_SPEC_TEXTURE_FEATURES) const uint kTextureFeatures = kTextureUsesAll;
-layout(constant_id = PT_SPEC_MEDIUM_KINDS) const uint kMediumKinds = 0xFFFFFFFFu;
-layout(constant_id = PT_SPEC_ENVIRONMENT_IMAGE) const bool kEnvironmentImage = true;
+const bool kConductor = PT_FX_CONDUCTOR;
+const bool kDielectric = PT_FX_DIELECTRIC;
+const bool kThinDielectric = PT_FX_THIN_DIELECTRIC;
+const bool kDiffuseTransmission = PT_FX_DIFFUSE_TRANSMISSION;
+const bool kCoatedDiffuse = PT_FX_COATED_DIFFUSE;
+const bool kGltf = PT_FX_GLTF;
+const bool kShadingNormals = PT_FX_SHADING_NORMALS;
+const bool kDeltaLights = PT_FX_DELTA_LIGHTS;
+const bool kEnvironment = PT_FX_ENVIRONMENT;
+const bool kTwoSidedEmitters = PT_FX_TWO_SIDED_EMITTERS;
+const bool kSphereLights = PT_FX_SPHERE_LIGHTS;
+const bool kTextures = PT_FX_TEXTURES;
+const bool kAlphaCutouts = PT_FX_ALPHA;
+const bool kBumpMaps = PT_FX_BUMP;
+const uint kTextureFeatures = PT_FX_TEXTURE_FEATURES;
+const uint kMediumKinds = PT_FX_MEDIUM_KINDS;
+const bool kEnvironmentImage = PT_FX_ENVIRONMENT_IMAGE;
 #endif
 // Some emitter is one of lights.h's (not a triangle).
 const bool kAnalyticLights = kDeltaLights || kEnvironment || kSphereLights;

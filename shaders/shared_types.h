@@ -403,7 +403,7 @@ struct MaterialTextures {
 PT_CONST uint kMaterialTextureTexels = 3u;
 PT_CONST uint kRemapRoughness = 1u;  // roughness textures give pbrt-v4's roughness, not alpha
 
-// What a scene's textures need (PT_SPEC_TEXTURE_FEATURES): the material parameters some used
+// What a scene's textures need (PT_FX_TEXTURE_FEATURES): the material parameters some used
 // material takes from a texture, and whether any texture is a program of several nodes or reads
 // an image. texture.h evaluates only these, so that a scene's shader holds no code for the rest
 // (lavapipe runs both sides of a branch that its lanes take differently).
@@ -572,39 +572,13 @@ PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v =
 #define PT_BINDING_LIGHT_BVH 17
 #define PT_BINDING_COUNT 18
 
-// Specialization constant ids: the effect set. An effect switched off is compiled out.
-#define PT_SPEC_DIFFUSE 0        // bool: Lambertian surfaces occur
-#define PT_SPEC_MIRROR 1         // bool: ideal mirrors occur
-#define PT_SPEC_NEE 2            // bool: sample emitters at diffuse vertices
-#define PT_SPEC_BSDF_EMISSION 3  // bool: count emission reached by BSDF-sampled rays
-#define PT_SPEC_MIS 4            // bool: weigh the two with the power heuristic
-#define PT_SPEC_RR 5             // bool: Russian roulette
-// Two choices between alternatives: the value of the parameter the scene chose, so that only
-// that alternative is compiled, or kSpecAtRunTime to compile both and read RenderParams.
-#define PT_SPEC_INTERSECTION 6  // uint: RenderParams::fastIntersection (0 watertight, 1 fast)
-#define PT_SPEC_SAMPLER 7       // uint: RenderParams::samplerType (independent or Sobol)
-// Not an effect: the traversal stack's size, rows of four entries (bvh.glsl), from the tree.
-#define PT_SPEC_STACK_ROWS 8  // uint: 1 to kBvhStackSize / 4
-// The material types beyond the seed's (bool each: some surface has that type).
-#define PT_SPEC_CONDUCTOR 9
-#define PT_SPEC_DIELECTRIC 10
-#define PT_SPEC_THIN_DIELECTRIC 11
-#define PT_SPEC_DIFFUSE_TRANSMISSION 12
-#define PT_SPEC_COATED_DIFFUSE 13
-#define PT_SPEC_SHADING_NORMALS 14     // bool: some mesh has vertex normals
-#define PT_SPEC_DELTA_LIGHTS 15        // bool: point, spot or distant lights occur
-#define PT_SPEC_ENVIRONMENT 16         // bool: an infinite light occurs
-#define PT_SPEC_TWO_SIDED_EMITTERS 17  // bool: some emissive triangle emits on both sides
-#define PT_SPEC_SPHERE_LIGHTS 18       // bool: some sphere area light is sampled by solid angle
-#define PT_SPEC_ENVIRONMENT_IMAGE 19   // bool: the infinite light is an image (environment.h)
-#define PT_SPEC_TEXTURES 20            // bool: some material parameter is a texture
-#define PT_SPEC_ALPHA 21               // bool: some material has an alpha cut-out
-#define PT_SPEC_BUMP 22                // bool: some material has a bump map
-#define PT_SPEC_TEXTURE_FEATURES 23    // uint: kTextureUses* bits of what the textures need
-#define PT_SPEC_MEDIUM_KINDS 24        // uint: bit 1 << kMedium* for each type of medium present
-#define PT_SPEC_LIGHT_BVH 25           // bool: emitters are chosen by the light BVH
-#define PT_SPEC_GLTF 26                // bool: some surface has glTF's material
-#define PT_SPEC_COUNT 27
+// The one specialization constant: the traversal stack's size, rows of four entries
+// (bvh.glsl), from the tree. The effect set is not specialized but compiled in: the host
+// compiles pathtrace.comp for each scene with its effects as PT_FX_* definitions.
+#define PT_SPEC_STACK_ROWS 0  // uint: 1 to kBvhStackSize / 4
+// The intersection test and the sampler as effects: the value of the parameter the scene
+// chose, so that only that alternative is compiled, or kSpecAtRunTime to compile both and
+// read RenderParams.
 PT_CONST uint kSpecAtRunTime = 0xFFFFFFFFu;
 
 // Workgroups of 8 x 8 pixels. Lavapipe runs eight invocations of a row as one vector whatever

@@ -47,7 +47,7 @@ inline TriangleUVs uvsAt(const TextureTables& tables, uint i) {
 #ifndef PT_TEXTURE_LOOP_TICK
 #define PT_TEXTURE_LOOP_TICK()
 #endif
-// The kTextureUses* bits of what to evaluate: the shader's specialization constant; the CPU
+// The kTextureUses* bits of what to evaluate: a constant of the shader's compilation; the CPU
 // evaluates what the data says.
 #ifndef PT_TEXTURE_FEATURES
 #define PT_TEXTURE_FEATURES kTextureUsesAll

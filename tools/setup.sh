@@ -9,7 +9,7 @@ packages=(
   libnanovdb-dev zlib1g-dev
   libgtest-dev clang libfuzzer-14-dev
   libembree-dev embree-tools libbenchmark-dev libhwy-dev
-  libvulkan-dev mesa-vulkan-drivers glslang-tools spirv-tools vulkan-validationlayers vulkan-tools
+  libvulkan-dev mesa-vulkan-drivers glslang-tools glslang-dev spirv-tools vulkan-validationlayers vulkan-tools
   glmark2-data gnuplot-nox python3
 )
 

@@ -11,11 +11,8 @@
 #include <cstring>
 
 #include "common/check.h"
-#include "pathtrace_base_spv.h"    // kPathtraceBaseSpv: the same without bsdf.h's materials
-#include "pathtrace_debug_spv.h"   // kPathtraceDebugSpv: the same shader with debugPrintfEXT
-#include "pathtrace_spv.h"         // kPathtraceSpv: SPIR-V compiled at build time
-#include "pathtrace_volume_spv.h"  // kPathtraceVolumeSpv: the volume integrator (media)
 #include "vulkan/context.h"
+#include "vulkan/glsl_compiler.h"
 #include "vulkan/gpu_bvh.h"
 #include "vulkan/resources.h"
 
@@ -25,13 +22,6 @@ namespace {
 using S = vk::PipelineStageFlagBits;
 using A = vk::AccessFlagBits;
 using U = vk::BufferUsageFlagBits;
-
-// The effect set as specialization constants, in PT_SPEC_* id order: booleans (VkBool32)
-// for the effects, the chosen value (or kSpecAtRunTime) for the two choices, then the
-// traversal stack's rows.
-struct SpecData {
-  uint32_t values[PT_SPEC_COUNT];
-};
 
 // The device buffers of one render, indexed by PT_BINDING_*, and the host-visible buffer the
 // accumulation and the counters are copied back through.
@@ -141,76 +131,19 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   return buffers;
 }
 
-// ---- Pipeline: shaders/pathtrace.comp specialised to the scene's effect set -----------------
+// ---- Pipeline: shaders/pathtrace.comp compiled for the scene's effect set -----------------
 
 ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& scene,
                                     const VulkanRenderOptions& options,
                                     const RenderBuffers& buffers) {
-  const EffectSet& fx = scene.effects;
-  const bool all = !options.specialize;
-  const RenderParams& params = scene.params;
-  const SpecData spec{{all || fx.diffuse,
-                       all || fx.mirror,
-                       all || fx.lightSampling,
-                       all || fx.bsdfEmission,
-                       all || fx.mis,
-                       all || fx.russianRoulette,
-                       all ? kSpecAtRunTime : params.fastIntersection,
-                       all ? kSpecAtRunTime : params.samplerType,
-                       buffers.stackRows,
-                       all || fx.conductor,
-                       all || fx.dielectric,
-                       all || fx.thinDielectric,
-                       all || fx.diffuseTransmission,
-                       all || fx.coatedDiffuse,
-                       all || fx.shadingNormals,
-                       all || fx.deltaLights,
-                       all || fx.environment,
-                       all || fx.twoSidedEmitters,
-                       all || fx.sphereLights,
-                       all || fx.environmentImage,
-                       all || fx.textures,
-                       all || fx.alphaCutouts,
-                       all || fx.bumpMaps,
-                       all ? kTextureUsesAll : fx.textureFeatures,
-                       all ? 0xFFFFFFFFu : fx.mediumKinds,
-                       all || fx.lightBvh,
-                       all || fx.gltf}};
-  static_assert(
-      PT_SPEC_DIFFUSE == 0 && PT_SPEC_MIRROR == 1 && PT_SPEC_NEE == 2 &&
-      PT_SPEC_BSDF_EMISSION == 3 && PT_SPEC_MIS == 4 && PT_SPEC_RR == 5 &&
-      PT_SPEC_INTERSECTION == 6 && PT_SPEC_SAMPLER == 7 && PT_SPEC_STACK_ROWS == 8 &&
-      PT_SPEC_CONDUCTOR == 9 && PT_SPEC_DIELECTRIC == 10 && PT_SPEC_THIN_DIELECTRIC == 11 &&
-      PT_SPEC_DIFFUSE_TRANSMISSION == 12 && PT_SPEC_COATED_DIFFUSE == 13 &&
-      PT_SPEC_SHADING_NORMALS == 14 && PT_SPEC_DELTA_LIGHTS == 15 && PT_SPEC_ENVIRONMENT == 16 &&
-      PT_SPEC_TWO_SIDED_EMITTERS == 17 && PT_SPEC_SPHERE_LIGHTS == 18 &&
-      PT_SPEC_ENVIRONMENT_IMAGE == 19 && PT_SPEC_TEXTURES == 20 && PT_SPEC_ALPHA == 21 &&
-      PT_SPEC_BUMP == 22 && PT_SPEC_TEXTURE_FEATURES == 23 && PT_SPEC_MEDIUM_KINDS == 24 &&
-      PT_SPEC_LIGHT_BVH == 25 && PT_SPEC_GLTF == 26 && PT_SPEC_COUNT == 27);
-  std::vector<vk::SpecializationMapEntry> entries;
-  for (uint32_t id = 0; id < PT_SPEC_COUNT; ++id) {
-    entries.emplace_back(id, uint32_t(id * sizeof(uint32_t)), sizeof(uint32_t));
-  }
-  const vk::SpecializationInfo specInfo(entries, vk::ArrayProxyNoTemporaries<const SpecData>(spec));
   std::vector<Binding> bound;
   for (size_t i = 0; i < buffers.bound.size(); ++i) {
     bound.push_back(Binding{&buffers.bound[i], buffers.texels[i]});
   }
-  // The variant without bsdf.h's materials, the analytic lights, the pixel filters other than
-  // the box and the thin lens where the scene needs none of them (the same image: it is the
-  // full shader with those switched off before compiling).
-  const Camera& camera = scene.params.camera;
-  const bool full = all || fx.hasBsdfMaterials() || fx.shadingNormals || fx.deltaLights ||
-                    fx.environment || fx.twoSidedEmitters || fx.sphereLights || fx.textures ||
-                    fx.alphaCutouts || fx.bumpMaps || camera.filterType != kFilterBox ||
-                    camera.lensRadius > 0.0f;
-  // Scenes with media take the volume integrator's variant (also under --debug-pixel, whose
-  // printing it leaves out).
-  const std::span<const uint32_t> spirv = fx.media ? std::span<const uint32_t>(kPathtraceVolumeSpv)
-                                          : options.context.debugPrintf
-                                              ? std::span<const uint32_t>(kPathtraceDebugSpv)
-                                          : full ? std::span<const uint32_t>(kPathtraceSpv)
-                                                 : std::span<const uint32_t>(kPathtraceBaseSpv);
+  const std::vector<uint32_t>& spirv =
+      compileShader("pathtrace.comp", pathtraceDefinitions(scene, options));
+  const vk::SpecializationMapEntry stackEntry(PT_SPEC_STACK_ROWS, 0, sizeof(uint32_t));
+  const vk::SpecializationInfo specInfo(1, &stackEntry, sizeof(uint32_t), &buffers.stackRows);
   return makeComputeProgram(ctx, spirv, bound, sizeof(PassConstants), &specInfo);
 }
 
@@ -365,6 +298,64 @@ uint32_t firstSamplesPerPass(size_t pixels, uint32_t warmUpLoopIterations, uint6
 
 }  // namespace
 
+std::string pathtraceDefinitions(const SceneData& scene, const VulkanRenderOptions& options) {
+  const EffectSet& fx = scene.effects;
+  const bool all = !options.specialize;
+  const RenderParams& params = scene.params;
+  std::string text = "#define PT_FX_SET\n";
+  const auto define = [&text](const char* name, const std::string& value) {
+    text += std::string("#define ") + name + " " + value + "\n";
+  };
+  const auto flag = [&](const char* name, bool on) { define(name, all || on ? "true" : "false"); };
+  const auto choice = [&](const char* name, uint32_t value) {
+    define(name, all ? "kSpecAtRunTime" : std::to_string(value) + "u");
+  };
+  flag("PT_FX_DIFFUSE", fx.diffuse);
+  flag("PT_FX_MIRROR", fx.mirror);
+  flag("PT_FX_NEE", fx.lightSampling);
+  flag("PT_FX_BSDF_EMISSION", fx.bsdfEmission);
+  flag("PT_FX_MIS", fx.mis);
+  flag("PT_FX_RR", fx.russianRoulette);
+  choice("PT_FX_INTERSECTION", params.fastIntersection);
+  choice("PT_FX_SAMPLER", params.samplerType);
+  flag("PT_FX_LIGHT_BVH", fx.lightBvh);
+  flag("PT_FX_CONDUCTOR", fx.conductor);
+  flag("PT_FX_DIELECTRIC", fx.dielectric);
+  flag("PT_FX_THIN_DIELECTRIC", fx.thinDielectric);
+  flag("PT_FX_DIFFUSE_TRANSMISSION", fx.diffuseTransmission);
+  flag("PT_FX_COATED_DIFFUSE", fx.coatedDiffuse);
+  flag("PT_FX_GLTF", fx.gltf);
+  flag("PT_FX_SHADING_NORMALS", fx.shadingNormals);
+  flag("PT_FX_DELTA_LIGHTS", fx.deltaLights);
+  flag("PT_FX_ENVIRONMENT", fx.environment);
+  flag("PT_FX_TWO_SIDED_EMITTERS", fx.twoSidedEmitters);
+  flag("PT_FX_SPHERE_LIGHTS", fx.sphereLights);
+  flag("PT_FX_TEXTURES", fx.textures);
+  flag("PT_FX_ALPHA", fx.alphaCutouts);
+  flag("PT_FX_BUMP", fx.bumpMaps);
+  define("PT_FX_TEXTURE_FEATURES",
+         all ? "kTextureUsesAll" : std::to_string(fx.textureFeatures) + "u");
+  define("PT_FX_MEDIUM_KINDS", all ? "0xFFFFFFFFu" : std::to_string(fx.mediumKinds) + "u");
+  flag("PT_FX_ENVIRONMENT_IMAGE", fx.environmentImage);
+  // Scenes with media take the volume integrator (also under --debug-pixel, whose printing it
+  // leaves out). Scenes of diffuse and mirror surfaces without any of bsdf.h's materials, the
+  // analytic lights, the pixel filters other than the box and the thin lens take the variant
+  // without those (PT_NO_BSDF_MATERIALS: the same image).
+  const Camera& camera = scene.params.camera;
+  const bool full = all || fx.hasBsdfMaterials() || fx.shadingNormals || fx.deltaLights ||
+                    fx.environment || fx.twoSidedEmitters || fx.sphereLights || fx.textures ||
+                    fx.alphaCutouts || fx.bumpMaps || camera.filterType != kFilterBox ||
+                    camera.lensRadius > 0.0f;
+  if (fx.media) {
+    text += "#define PT_VOLPATH\n";
+  } else if (options.context.debugPrintf) {
+    text += "#define PT_DEBUG_PRINTF\n";
+  } else if (!full) {
+    text += "#define PT_NO_BSDF_MATERIALS\n";
+  }
+  return text;
+}
+
 VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions& options,
                                Film& film) {
   const auto start = std::chrono::steady_clock::now();
@@ -502,17 +493,13 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
 }
 
 KeyValues vulkanImageSettings(const VulkanRenderOptions& options) {
-  // The shaders this build may run (which variant a scene takes follows from the scene).
-  const std::span<const uint32_t> spirv = options.context.debugPrintf
-                                              ? std::span<const uint32_t>(kPathtraceDebugSpv)
-                                              : std::span<const uint32_t>(kPathtraceSpv);
-  const std::span<const uint32_t> base(kPathtraceBaseSpv);
-  const std::span<const uint32_t> volume(kPathtraceVolumeSpv);
+  // The shaders this build may run: their sources (which variant a scene compiles follows
+  // from the scene), and whether they print (--debug-pixel).
+  const uint64_t sources = shaderSourcesHash();
+  const uint64_t shader = options.context.debugPrintf ? hashBytes("printf", 6, sources) : sources;
   return {{"samples_per_fold", std::to_string(vulkanBatchSize(options))},
           {"specialize", options.specialize ? "on" : "off"},
-          {"shader", hexHash(hashBytes(spirv.data(), spirv.size_bytes(),
-                                       hashBytes(base.data(), base.size_bytes(),
-                                                 hashBytes(volume.data(), volume.size_bytes()))))}};
+          {"shader", hexHash(shader)}};
 }
 
 uint32_t vulkanBatchSize(const VulkanRenderOptions& options) {

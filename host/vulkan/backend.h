@@ -49,6 +49,11 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
 // files: the batch size (samples per fold), specialisation, and a hash of the shader's SPIR-V.
 KeyValues vulkanImageSettings(const VulkanRenderOptions& options);
 
+// The preprocessor definitions pathtrace.comp is compiled with for the scene
+// (vulkan/glsl_compiler.h): its effects (PT_FX_*, every one; all on without
+// options.specialize) and the variant it takes (media, debug printing, or none of bsdf.h).
+std::string pathtraceDefinitions(const SceneData& scene, const VulkanRenderOptions& options);
+
 // Sample indices per batch (samplesPerFold): a render split where no batch is split sums to
 // the bits of one render.
 uint32_t vulkanBatchSize(const VulkanRenderOptions& options);
