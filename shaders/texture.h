@@ -10,6 +10,15 @@
 // Images are filtered over the ray's footprint (UVFootprint, from differentials.h) in their MIP
 // maps (host/scene/mip_pyramid.h) as pbrt-v4's MIPMap::Filter filters them, and the
 // checkerboard over the same footprint (docs/textures.md).
+//
+// One call site: the shader's compiler (lavapipe's, as GPU drivers') copies a function's body
+// into every place that calls it, and a texture lookup is large (the program, the filter, the
+// texel reads, the decoding). Where a lookup is made several times, for the texels of a
+// bilinear interpolation, the levels of a trilinear or EWA filter, the parameters of a
+// material or the displacements of a bump map, it is made in a loop around one call, so that
+// the shader holds one copy: a third of the code lavapipe compiled for a textured scene, and
+// that much less time creating its pipeline (docs/performance.md). The values and the order
+// of the operations are those of the calls written out.
 #ifndef PT_TEXTURE_H
 #define PT_TEXTURE_H
 
@@ -177,19 +186,15 @@ PT_INLINE vec3 levelBilerp(PT_TEXTURES_PARAM TextureNode node, ImageLevel level,
   int yi = int(fy);
   float dx = x - fx;
   float dy = y - fy;
-  vec4 c = (1.0f - dx) * (1.0f - dy) * levelTexel(PT_TEXTURES_ARG node, level, xi, yi) +
-           dx * (1.0f - dy) * levelTexel(PT_TEXTURES_ARG node, level, xi + 1, yi) +
-           (1.0f - dx) * dy * levelTexel(PT_TEXTURES_ARG node, level, xi, yi + 1) +
-           dx * dy * levelTexel(PT_TEXTURES_ARG node, level, xi + 1, yi + 1);
+  // The four texels through one call of levelTexel (see "One call site" above).
+  vec4 t[4];
+  for (int i = 0; i < 4; ++i) {
+    PT_TEXTURE_LOOP_TICK();
+    t[i] = levelTexel(PT_TEXTURES_ARG node, level, xi + (i & 1), yi + (i >> 1));
+  }
+  vec4 c = (1.0f - dx) * (1.0f - dy) * t[0] + dx * (1.0f - dy) * t[1] + (1.0f - dx) * dy * t[2] +
+           dx * dy * t[3];
   return bilerpValue(node, c);
-}
-
-// The nearest texel of a level to st (pbrt-v4's point filter: halves rounded away from zero).
-PT_INLINE vec3 levelPoint(PT_TEXTURES_PARAM TextureNode node, ImageLevel level, vec2 st) {
-  float x = safeTexelCoordinate(st.x * float(level.width) - 0.5f);
-  float y = safeTexelCoordinate(st.y * float(level.height) - 0.5f);
-  return texelValue(
-      node, levelTexel(PT_TEXTURES_ARG node, level, int(roundHalfAway(x)), int(roundHalfAway(y))));
 }
 
 // pbrt-v4's EWA weight at squared radius r2 in [0, 1) of the ellipse: its table of
@@ -247,41 +252,62 @@ PT_INLINE vec3 levelEwa(PT_TEXTURES_PARAM TextureNode node, int level, vec2 st, 
   return sumWeights > 0.0f ? sum / sumWeights : vec3(0.0f);
 }
 
+// One level's part of an image lookup (kLevel*): its texel (0, 0), the texel nearest to st,
+// the bilinear interpolation at st, or the EWA average over the ellipse of axes dst0, dst1.
+PT_CONST int kLevelCorner = 0;
+PT_CONST int kLevelNearest = 1;
+PT_CONST int kLevelBilinear = 2;
+PT_CONST int kLevelEwa = 3;
+PT_INLINE vec3 levelLookup(PT_TEXTURES_PARAM TextureNode node, int kind, int level, vec2 st,
+                           vec2 dst0, vec2 dst1) {
+  if (PT_TEXTURE_USES(kTextureUsesEwa) && kind == kLevelEwa) {
+    return levelEwa(PT_TEXTURES_ARG node, level, st, dst0, dst1);
+  }
+  ImageLevel l = imageLevel(PT_TEXTURES_ARG node, level);
+  if (kind == kLevelBilinear) return levelBilerp(PT_TEXTURES_ARG node, l, st);
+  int x = 0;
+  int y = 0;
+  if (kind == kLevelNearest) {
+    x = int(roundHalfAway(safeTexelCoordinate(st.x * float(l.width) - 0.5f)));
+    y = int(roundHalfAway(safeTexelCoordinate(st.y * float(l.height) - 0.5f)));
+  }
+  return texelValue(node, levelTexel(PT_TEXTURES_ARG node, l, x, y));
+}
+
 // The image's value at (s, t) (t = 1 at row 0, as pbrt-v4's ImageTexture flips t), filtered as
 // the node says over the footprint whose changes of (s, t) across the pixel are dstdx and dstdy
 // (pbrt-v4's MIPMap::Filter, given the derivatives before the flip as pbrt-v4 gives them):
 // point, bilinear and trilinear lookups in the level that the footprint's largest extent calls
 // for (level 0 at a footprint of zero), EWA over the ellipse the two span, in the levels its
 // shorter axis calls for, the longer one clamped to maxAnisotropy times the shorter.
-// pbrt-v4's "scale" and "invert" are applied last.
+// pbrt-v4's "scale" and "invert" are applied last. The filter decides which levels are read and
+// how; they are read through one call of levelLookup (see "One call site" above).
 PT_INLINE vec3 imageLookup(PT_TEXTURES_PARAM TextureNode node, vec2 st, vec2 dstdx, vec2 dstdy) {
   st.y = 1.0f - st.y;
   uint filterType = (node.flags >> 8u) & 0xFu;
   int count = imageLevelCount(node);
-  vec3 v;
+  int kind = kLevelBilinear;
+  int level = 0;
+  int levels = 1;  // 2: level and level + 1, weighed 1 - delta and delta
+  float delta = 0.0f;
+  vec2 dst0 = dstdx;
+  vec2 dst1 = dstdy;
   if (!PT_TEXTURE_USES(kTextureUsesEwa) || filterType != kTextureEwa) {
     float width = 2.0f * max(max(abs(dstdx.x), abs(dstdx.y)), max(abs(dstdy.x), abs(dstdy.y)));
-    float level = float(count - 1) + log2(max(width, 1e-8f));
-    if (level >= float(count - 1)) {
-      v = texelValue(node, levelTexel(PT_TEXTURES_ARG node,
-                                      imageLevel(PT_TEXTURES_ARG node, count - 1), 0, 0));
+    float lod = float(count - 1) + log2(max(width, 1e-8f));
+    if (lod >= float(count - 1)) {
+      kind = kLevelCorner;
+      level = count - 1;
     } else {
-      int iLevel = max(0, int(floor(level)));
-      ImageLevel l = imageLevel(PT_TEXTURES_ARG node, iLevel);
+      level = max(0, int(floor(lod)));
       if (filterType == kTexturePoint) {
-        v = levelPoint(PT_TEXTURES_ARG node, l, st);
-      } else if (filterType == kTextureTrilinear && iLevel > 0) {
-        float delta = level - float(iLevel);
-        v = (1.0f - delta) * levelBilerp(PT_TEXTURES_ARG node, l, st) +
-            delta *
-                levelBilerp(PT_TEXTURES_ARG node, imageLevel(PT_TEXTURES_ARG node, iLevel + 1), st);
-      } else {
-        v = levelBilerp(PT_TEXTURES_ARG node, l, st);
+        kind = kLevelNearest;
+      } else if (filterType == kTextureTrilinear && level > 0) {
+        levels = 2;
+        delta = lod - float(level);
       }
     }
   } else {
-    vec2 dst0 = dstdx;
-    vec2 dst1 = dstdy;
     if (dot(dst0, dst0) < dot(dst1, dst1)) {
       dst0 = dstdy;
       dst1 = dstdx;
@@ -293,16 +319,26 @@ PT_INLINE vec3 imageLookup(PT_TEXTURES_PARAM TextureNode node, vec2 st, vec2 dst
       dst1 *= scale;
       shorter *= scale;
     }
-    if (shorter == 0.0f) {
-      v = levelBilerp(PT_TEXTURES_ARG node, imageLevel(PT_TEXTURES_ARG node, 0), st);
-    } else {
+    if (shorter != 0.0f) {
       float lod = max(0.0f, float(count - 1) + log2(shorter));
-      int ilod = int(floor(lod));
-      float delta = lod - float(ilod);
-      v = (1.0f - delta) * levelEwa(PT_TEXTURES_ARG node, ilod, st, dst0, dst1) +
-          delta * levelEwa(PT_TEXTURES_ARG node, ilod + 1, st, dst0, dst1);
+      kind = kLevelEwa;
+      level = int(floor(lod));
+      levels = 2;
+      delta = lod - float(level);
     }
   }
+  vec3 first = vec3(0.0f);
+  vec3 second = vec3(0.0f);
+  for (int i = 0; i < levels; ++i) {
+    PT_TEXTURE_LOOP_TICK();
+    vec3 r = levelLookup(PT_TEXTURES_ARG node, kind, level + i, st, dst0, dst1);
+    if (i == 0) {
+      first = r;
+    } else {
+      second = r;
+    }
+  }
+  vec3 v = levels == 2 ? (1.0f - delta) * first + delta * second : first;
   v = node.value * v;
   if ((node.flags & kTextureInvert) != 0u) v = max(vec3(1.0f) - v, vec3(0.0f));
   return v;
@@ -349,18 +385,16 @@ PT_INLINE UVFootprint pointFootprint(vec2 uv) {
 // The value of the texture whose program starts at node `first`, at footprint c.
 PT_INLINE vec3 evalTextureAt(PT_TEXTURES_PARAM uint first, UVFootprint c) {
   TextureNode head = textureNodeAt(PT_TEXTURES_ARG first);
-  // The common case, one leaf, without the stack.
-  if (head.count == 1u || !PT_TEXTURE_USES(kTextureUsesPrograms)) {
-    if (PT_TEXTURE_USES(kTextureUsesImages) && head.type == kTextureImage) {
-      return imageLookup(PT_TEXTURES_ARG head, mapUV(head.mapping, c.uv),
-                         mapDerivative(head.mapping, c.duvdx),
-                         mapDerivative(head.mapping, c.duvdy));
-    }
+  // A constant leaf, the common case, without the stack; an image leaf through the program's
+  // loop, which holds the one call of imageLookup (see "One call site" above).
+  bool leaf = head.count == 1u || !PT_TEXTURE_USES(kTextureUsesPrograms);
+  if (leaf && !(PT_TEXTURE_USES(kTextureUsesImages) && head.type == kTextureImage)) {
     return head.value;
   }
   vec3 stack[kTextureStackSize];
   uint top = 0u;  // values on the stack
-  for (uint i = 0u; i < head.count; ++i) {
+  uint count = leaf ? 1u : head.count;
+  for (uint i = 0u; i < count; ++i) {
     PT_TEXTURE_LOOP_TICK();
     TextureNode node = i == 0u ? head : textureNodeAt(PT_TEXTURES_ARG first + i);
     vec3 v;
@@ -421,44 +455,57 @@ PT_INLINE bool anyTexture(MaterialTextures t) {
 // k). Parameters without a texture keep the host's values.
 PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextures t,
                                      UVFootprint uv) {
-  if (PT_TEXTURE_USES(kTextureUsesReflectance) && t.reflectance != kNoTexture) {
-    vec3 r = clamp(evalTextureAt(PT_TEXTURES_ARG t.reflectance, uv), vec3(0.0f), vec3(1.0f));
-    if (m.type == kMaterialConductor) {
-      // pbrt-v4's ConductorMaterial with "reflectance": eta 1, k = 2 sqrt(r) / sqrt(1 - r).
-      r = clamp(r, vec3(0.0f), vec3(0.9999f));
-      m.eta = vec3(1.0f);
-      m.k = 2.0f * sqrt(r) / sqrt(vec3(1.0f) - r);
-    } else if (m.type == kMaterialDiffuseTransmission) {
-      m.reflectance = clamp(t.scale * r, vec3(0.0f), vec3(1.0f));
+  bool remap = (t.flags & kRemapRoughness) != 0u;
+  // The parameters in this order, each texture evaluated by one call of evalTextureAt (see "One
+  // call site" above).
+  for (uint i = 0u; i < 8u; ++i) {
+    PT_TEXTURE_LOOP_TICK();
+    uint texture = i == 0u ? (PT_TEXTURE_USES(kTextureUsesReflectance) ? t.reflectance : kNoTexture)
+                   : i == 1u
+                       ? (PT_TEXTURE_USES(kTextureUsesTransmittance) ? t.transmittance : kNoTexture)
+                   : i == 2u ? (PT_TEXTURE_USES(kTextureUsesEtaK) ? t.eta : kNoTexture)
+                   : i == 3u ? (PT_TEXTURE_USES(kTextureUsesEtaK) ? t.k : kNoTexture)
+                   : i == 4u ? (PT_TEXTURE_USES(kTextureUsesRoughness) ? t.uRoughness : kNoTexture)
+                   : i == 5u ? (PT_TEXTURE_USES(kTextureUsesRoughness) ? t.vRoughness : kNoTexture)
+                   : i == 6u ? (PT_TEXTURE_USES(kTextureUsesMedium) ? t.thickness : kNoTexture)
+                             : (PT_TEXTURE_USES(kTextureUsesMedium) ? t.g : kNoTexture);
+    if (texture == kNoTexture) continue;
+    vec3 value = evalTextureAt(PT_TEXTURES_ARG texture, uv);
+    if (i == 0u) {
+      vec3 r = clamp(value, vec3(0.0f), vec3(1.0f));
+      if (m.type == kMaterialConductor) {
+        // pbrt-v4's ConductorMaterial with "reflectance": eta 1, k = 2 sqrt(r) / sqrt(1 - r).
+        r = clamp(r, vec3(0.0f), vec3(0.9999f));
+        m.eta = vec3(1.0f);
+        m.k = 2.0f * sqrt(r) / sqrt(vec3(1.0f) - r);
+      } else if (m.type == kMaterialDiffuseTransmission) {
+        m.reflectance = clamp(t.scale * r, vec3(0.0f), vec3(1.0f));
+      } else {
+        m.reflectance = r;
+      }
+    } else if (i == 1u) {
+      vec3 r = clamp(value, vec3(0.0f), vec3(1.0f));
+      m.transmittance =
+          m.type == kMaterialDiffuseTransmission ? clamp(t.scale * r, vec3(0.0f), vec3(1.0f)) : r;
+    } else if (i == 2u) {
+      m.eta = value;
+    } else if (i == 3u) {
+      m.k = value;
+    } else if (i == 4u) {
+      float r = max(value.x, 0.0f);
+      m.alphaX = remap ? sqrt(r) : r;
+    } else if (i == 5u) {
+      float r = max(value.x, 0.0f);
+      m.alphaY = remap ? sqrt(r) : r;
+    } else if (i == 6u) {
+      // coateddiffuse's medium: pbrt-v4 keeps the thickness at least the smallest normal float
+      // and clamps g to [-1, 1]; we keep g inside (-1, 1), where Henyey-Greenstein is not a
+      // delta.
+      m.thickness = max(value.x, 1.17549435e-38f);
     } else {
-      m.reflectance = r;
+      m.g = clamp(value.x, -0.999f, 0.999f);
     }
   }
-  if (PT_TEXTURE_USES(kTextureUsesTransmittance) && t.transmittance != kNoTexture) {
-    vec3 r = clamp(evalTextureAt(PT_TEXTURES_ARG t.transmittance, uv), vec3(0.0f), vec3(1.0f));
-    m.transmittance =
-        m.type == kMaterialDiffuseTransmission ? clamp(t.scale * r, vec3(0.0f), vec3(1.0f)) : r;
-  }
-  if (PT_TEXTURE_USES(kTextureUsesEtaK) && t.eta != kNoTexture)
-    m.eta = evalTextureAt(PT_TEXTURES_ARG t.eta, uv);
-  if (PT_TEXTURE_USES(kTextureUsesEtaK) && t.k != kNoTexture)
-    m.k = evalTextureAt(PT_TEXTURES_ARG t.k, uv);
-  bool remap = (t.flags & kRemapRoughness) != 0u;
-  if (PT_TEXTURE_USES(kTextureUsesRoughness) && t.uRoughness != kNoTexture) {
-    float r = max(evalFloatTextureAt(PT_TEXTURES_ARG t.uRoughness, uv), 0.0f);
-    m.alphaX = remap ? sqrt(r) : r;
-  }
-  if (PT_TEXTURE_USES(kTextureUsesRoughness) && t.vRoughness != kNoTexture) {
-    float r = max(evalFloatTextureAt(PT_TEXTURES_ARG t.vRoughness, uv), 0.0f);
-    m.alphaY = remap ? sqrt(r) : r;
-  }
-  // coateddiffuse's medium: pbrt-v4 keeps the thickness at least the smallest normal float and
-  // clamps g to [-1, 1]; we keep g inside (-1, 1), where Henyey-Greenstein is not a delta.
-  if (PT_TEXTURE_USES(kTextureUsesMedium) && t.thickness != kNoTexture) {
-    m.thickness = max(evalFloatTextureAt(PT_TEXTURES_ARG t.thickness, uv), 1.17549435e-38f);
-  }
-  if (PT_TEXTURE_USES(kTextureUsesMedium) && t.g != kNoTexture)
-    m.g = clamp(evalFloatTextureAt(PT_TEXTURES_ARG t.g, uv), -0.999f, 0.999f);
   return m;
 }
 
@@ -544,12 +591,25 @@ PT_INLINE vec3 bumpedNormal(PT_TEXTURES_PARAM uint displacement, TriangleDerivat
   if (du == 0.0f) du = 0.0005f;
   float dv = 0.5f * (abs(uv.duvdx.y) + abs(uv.duvdy.y));
   if (dv == 0.0f) dv = 0.0005f;
-  float displace = evalFloatTextureAt(PT_TEXTURES_ARG displacement, uv);
-  UVFootprint shifted = uv;
-  shifted.uv = uv.uv + vec2(du, 0.0f);
-  float uDisplace = evalFloatTextureAt(PT_TEXTURES_ARG displacement, shifted);
-  shifted.uv = uv.uv + vec2(0.0f, dv);
-  float vDisplace = evalFloatTextureAt(PT_TEXTURES_ARG displacement, shifted);
+  // The displacement at uv, a step along u and a step along v, by one call of evalTextureAt
+  // (see "One call site" above).
+  float displace = 0.0f;
+  float uDisplace = 0.0f;
+  float vDisplace = 0.0f;
+  for (int i = 0; i < 3; ++i) {
+    PT_TEXTURE_LOOP_TICK();
+    UVFootprint at = uv;
+    if (i == 1) at.uv = uv.uv + vec2(du, 0.0f);
+    if (i == 2) at.uv = uv.uv + vec2(0.0f, dv);
+    float value = evalFloatTextureAt(PT_TEXTURES_ARG displacement, at);
+    if (i == 0) {
+      displace = value;
+    } else if (i == 1) {
+      uDisplace = value;
+    } else {
+      vDisplace = value;
+    }
+  }
   if (uDisplace == displace && vDisplace == displace) return ns;
   vec3 dpdu = d.dpdu;
   vec3 dpdv = d.dpdv;
