@@ -133,9 +133,8 @@ uint bdptMaxDepth(const SceneData& scene) {
   return std::min(scene.params.maxDepth, kBdptMaxDepth);
 }
 
-void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
-                const BdptStrategy& strategy, uint64_t& rays,
-                const std::function<void(const BdptContribution&)>& sink) {
+void bdptSubpaths(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex, BdptPath& camera,
+                  BdptPath& light, uint64_t& rays) {
   const RenderParams& params = scene.params;
   const uint maxDepth = bdptMaxDepth(scene);
   const PathScene ps = scene.pathScene();
@@ -145,7 +144,6 @@ void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
 
   // The camera subpath: the camera ray through a point of the pixel (and of the lens), then
   // the random walk, up to maxDepth + 2 vertices.
-  BdptPath camera;
   const CameraSample cs = cameraSampleOf(params.camera, sobol, pixel, sampleIndex, seed);
   camera.v[0] = bdptCameraVertex(params.camera, cs.lensOffset, vec3(1.0f),
                                  VertexKey{pixel, sampleIndex, kDimPixel});
@@ -155,7 +153,6 @@ void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
                  /*radiance=*/true, pixel, sampleIndex, rays);
 
   // The light subpath: a light's emission, then the random walk, up to maxDepth + 1 vertices.
-  BdptPath light;
   light.count = 0;
   {
     const VertexKey key{pixel, sampleIndex, bdptLightDim(0)};
@@ -169,6 +166,19 @@ void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
       bdptCorrectInfiniteStart(ps, light, start.pdfPos);
     }
   }
+}
+
+void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
+                const BdptStrategy& strategy, uint64_t& rays,
+                const std::function<void(const BdptContribution&)>& sink) {
+  BdptPath camera;
+  BdptPath light;
+  bdptSubpaths(scene, imagePixel, sampleIndex, camera, light, rays);
+  const RenderParams& params = scene.params;
+  const PathScene ps = scene.pathScene();
+  const uvec2 pixel = imagePixel + uvec2(params.camera.cropX, params.camera.cropY);
+  const bool sobol = params.samplerType == kSamplerSobol;
+  const uint maxDepth = bdptMaxDepth(scene);
 
   // Every strategy (s, t) of depth s + t - 2 <= maxDepth: its contribution, shadow ray and
   // MIS weight.
@@ -182,11 +192,12 @@ void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
       vec2 uChoose(0.0f), uLight(0.0f);
       if (s == 1) {
         const BounceRandom u =
-            bounceRandomSimd(sobol, pixel, sampleIndex, bdptCameraDim(t - 1), seed);
+            bounceRandomSimd(sobol, pixel, sampleIndex, bdptCameraDim(t - 1), params.seed);
         uChoose = u.lightChoose;
         uLight = u.lightPoint;
       } else if (t == 1 && params.camera.lensRadius > 0.0f) {
-        uLight = random2(sobol, pixel, sampleIndex, bdptLightDim(s - 1) + kDimLightPoint, seed);
+        uLight =
+            random2(sobol, pixel, sampleIndex, bdptLightDim(s - 1) + kDimLightPoint, params.seed);
       }
       const BdptConnection c = bdptConnect(ps, light, camera, s, t, uChoose, uLight);
       if (!c.found) continue;

@@ -9,6 +9,7 @@
 #include <functional>
 #include <string>
 
+#include "bdpt_vertex.h"
 #include "cpu/integrator.h"
 #include "image/image.h"
 #include "render/prepare.h"
@@ -36,6 +37,11 @@ struct BdptContribution {
   bool splat = false;
   vec2 filmPoint{0.0f};
 };
+
+// Traces the camera and light subpaths of pixel sample (pixel, sampleIndex) of the image (the
+// crop's pixel). `rays` counts the rays traced. Exposed for tests of the MIS weights.
+void bdptSubpaths(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, BdptPath& camera,
+                  BdptPath& light, uint64_t& rays);
 
 // Traces the two subpaths of pixel sample (pixel, sampleIndex) of the image (the crop's pixel)
 // and hands every connection that contributes to `sink` (those of `strategy` alone, where it
