@@ -389,6 +389,19 @@ TEST(BdptCli, ChosenRefusedAndChecked) {
     s.replace(s.find(from), from.size(), "Integrator \"bdpt\" \"integer maxdepth\" -1");
     std::ofstream(bad) << s;
   }
+  {
+    std::ifstream in(bad);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string s = text.str();
+    const std::string negative = "maxdepth\" -1";
+    s.replace(s.find(negative), negative.size(), "maxdepth\" 3");
+    std::ofstream(dir / "good.pbrt") << s;
+  }
+  const Scene good = loadScene(dir / "good.pbrt");
+  EXPECT_EQ(good.integrator.integrator, kIntegratorBdpt);
+  EXPECT_EQ(good.integrator.maxDepth, 3);
+
   const test::PtResult negative =
       test::runPt("render " + bad.string() + " --backend cpu --out " + (dir / "d.exr").string());
   EXPECT_EQ(negative.status, 2);
