@@ -964,23 +964,28 @@ PT_INLINE bool bsdfHasSpecular(Material m) {
   return false;  // diffuse, diffuse transmission (mirror: the integrators' own)
 }
 
-// f(wo, wi) without delta lobes; `rng` feeds the coated material's estimate.
-PT_INLINE vec3 bsdfF(Material m, vec3 wo, vec3 wi, RandomStream rng) {
+// f(wo, wi) without delta lobes; `rng` feeds the coated material's estimate. `radiance`: the
+// path carries radiance from the camera (pbrt-v4's TransportMode::Radiance), else importance
+// from a light (bidirectional methods' light subpaths), which refraction does not scale.
+PT_INLINE vec3 bsdfFTransport(Material m, vec3 wo, vec3 wi, bool radiance, RandomStream rng) {
   if (wo.z == 0.0f) return vec3(0.0f);
   if (PT_HAS_CONDUCTOR && m.type == kMaterialConductor) {
     return conductorF(distributionOf(m), m.eta, m.k, wo, wi);
   }
   if (PT_HAS_DIELECTRIC && m.type == kMaterialDielectric) {
-    return dielectricF(distributionOf(m), m.eta.x, wo, wi, true);
+    return dielectricF(distributionOf(m), m.eta.x, wo, wi, radiance);
   }
   if (PT_HAS_DIFFUSE_TRANSMISSION && m.type == kMaterialDiffuseTransmission) {
     return diffuseTransmissionF(m.reflectance, m.transmittance, wo, wi);
   }
   if (PT_HAS_COATED_DIFFUSE && m.type == kMaterialCoatedDiffuse) {
-    return coatedDiffuseF(coatedDiffuseOf(m), wo, wi, true, rng);
+    return coatedDiffuseF(coatedDiffuseOf(m), wo, wi, radiance, rng);
   }
   if (PT_HAS_GLTF && m.type == kMaterialGltf) return gltfF(gltfSurfaceOf(m), wo, wi);
   return vec3(0.0f);  // thin dielectric: delta lobes only
+}
+PT_INLINE vec3 bsdfF(Material m, vec3 wo, vec3 wi, RandomStream rng) {
+  return bsdfFTransport(m, wo, wi, true, rng);
 }
 
 // The density of sampling wi (non-delta lobes); an estimate for the coated material.
@@ -1002,14 +1007,16 @@ PT_INLINE float bsdfPdf(Material m, vec3 wo, vec3 wi, RandomStream rng) {
   return 0.0f;
 }
 
-// Samples wi for wo with uc (choice of lobe) and u (direction); radiance transport.
-PT_INLINE BsdfSample bsdfSample(Material m, vec3 wo, float uc, vec2 u, RandomStream rng) {
+// Samples wi for wo with uc (choice of lobe) and u (direction); radiance or importance
+// transport, as bsdfFTransport.
+PT_INLINE BsdfSample bsdfSampleTransport(Material m, vec3 wo, float uc, vec2 u, bool radiance,
+                                         RandomStream rng) {
   if (wo.z == 0.0f) return noBsdfSample();
   if (PT_HAS_CONDUCTOR && m.type == kMaterialConductor) {
     return conductorSample(distributionOf(m), m.eta, m.k, wo, u);
   }
   if (PT_HAS_DIELECTRIC && m.type == kMaterialDielectric) {
-    return dielectricSample(distributionOf(m), m.eta.x, wo, uc, u, true, kSampleAll);
+    return dielectricSample(distributionOf(m), m.eta.x, wo, uc, u, radiance, kSampleAll);
   }
   if (PT_HAS_THIN_DIELECTRIC && m.type == kMaterialThinDielectric) {
     return thinDielectricSample(m.eta.x, wo, uc);
@@ -1018,10 +1025,14 @@ PT_INLINE BsdfSample bsdfSample(Material m, vec3 wo, float uc, vec2 u, RandomStr
     return diffuseTransmissionSample(m.reflectance, m.transmittance, wo, uc, u);
   }
   if (PT_HAS_COATED_DIFFUSE && m.type == kMaterialCoatedDiffuse) {
-    return coatedDiffuseSample(coatedDiffuseOf(m), wo, uc, u, true, rng);
+    return coatedDiffuseSample(coatedDiffuseOf(m), wo, uc, u, radiance, rng);
   }
   if (PT_HAS_GLTF && m.type == kMaterialGltf) return gltfSample(gltfSurfaceOf(m), wo, uc, u);
   return noBsdfSample();
+}
+// Radiance transport, what path tracing samples.
+PT_INLINE BsdfSample bsdfSample(Material m, vec3 wo, float uc, vec2 u, RandomStream rng) {
+  return bsdfSampleTransport(m, wo, uc, u, true, rng);
 }
 
 // ---- Shading frame ------------------------------------------------------------------------

@@ -105,6 +105,10 @@ KeyValues imageSettings(const SceneData& data, const RenderSettings& settings,
                                            data.mediumInterfaces.size() * sizeof(MediumInterface),
                                            hashBytes(cameraMedium.data(), sizeof(uint32_t)))))));
   }
+  // The integrator where it is not the path tracer (states written before others stay valid).
+  if (data.integrator != kIntegratorPath) {
+    s.emplace_back("integrator", std::string(nameOf(kIntegratorNames, data.integrator)));
+  }
   // The light BVH only where the render uses it: the power and uniform samplers differ in the
   // emitter table, which the states already compare, and states written before it stay valid.
   if (!data.lightBvh.empty()) {

@@ -19,6 +19,7 @@
 #include "cli/progress.h"
 #include "common/check.h"
 #include "common/named_values.h"
+#include "cpu/bdpt.h"
 #include "cpu/integrator.h"
 #include "image/film_state.h"
 #include "image/image.h"
@@ -151,6 +152,26 @@ int runRender(const RenderArgs& args) {
       settings.width.value_or(scene.camera.width), settings.height.value_or(scene.camera.height),
       args.scene + (settings.width || settings.height ? ": with --width/--height, " : ": "));
   const SceneData data = prepareScene(std::move(scene), settings);
+
+  // The bidirectional path tracer: on the CPU, for what it renders (cpu/bdpt.h).
+  const std::optional<BdptStrategy> bdptStrategy = parseBdptStrategy(args.overrides.strategy);
+  if (data.integrator == kIntegratorBdpt) {
+    if (args.backend != "cpu") {
+      throw InputError(args.scene +
+                       ": the bdpt integrator runs on the CPU only: its GPU version is not there "
+                       "yet (render with --backend cpu, or --integrator path)");
+    }
+    checkBdptScene(data, args.scene);
+    if (!args.debugPixel.empty()) throw InputError("--debug-pixel: the path integrator's only");
+    if (bdptMaxDepth(data) < data.params.maxDepth) {
+      std::fprintf(stderr,
+                   "warning: %s: maximum depth %u is above the bdpt integrator's limit: %u\n",
+                   args.scene.c_str(), data.params.maxDepth, bdptMaxDepth(data));
+    }
+  } else if (bdptStrategy) {
+    throw InputError("--strategy " + args.overrides.strategy +
+                     ": one strategy of the bdpt integrator (give --integrator bdpt)");
+  }
 
   const Camera& cam = data.params.camera;
   int debugX = -1, debugY = -1;
@@ -290,6 +311,7 @@ int runRender(const RenderArgs& args) {
     options.progress = [&progress](double f) { progress.update(f); };
     options.stop = &interrupt.stopFlag();
     options.checkpoint = checkpointDue;
+    if (bdptStrategy) options.bdptStrategy = *bdptStrategy;
     const CpuRenderStats cpu = renderCpu(data, options, state.film);
     stats = cpu;
     backendInfo = "backend=cpu threads=" + std::to_string(cpu.threads);
@@ -334,10 +356,12 @@ int runRender(const RenderArgs& args) {
   }
 
   std::printf(
-      "%s resolution=%ux%u spp=%u seconds=%.3f Mrays/s=%.3f effects=%s triangles=%zu "
+      "%s integrator=%s resolution=%ux%u spp=%u seconds=%.3f Mrays/s=%.3f effects=%s "
+      "triangles=%zu "
       "load_s=%.3f bvh_builder=%s bvh_nodes=%zu bvh_build_s=%.4f bvh_sah_cost=%.2f "
       "peak_rss_mib=%.0f invalid_samples=%llu\n",
-      backendInfo.c_str(), cam.width, cam.height, spp, stats.seconds,
+      backendInfo.c_str(), std::string(nameOf(kIntegratorNames, data.integrator)).c_str(),
+      cam.width, cam.height, spp, stats.seconds,
       stats.seconds > 0.0 ? double(stats.rays) / stats.seconds * 1e-6 : 0.0, effects.c_str(),
       data.bvh.triangles.size(), loadSeconds,
       std::string(nameOf(kBuilderNames, settings.builder)).c_str(), data.bvh.nodes.size(),
@@ -420,9 +444,20 @@ void addOverrideOptions(CLI::App* cmd, SceneOverrides& o) {
          "Maximum triangles per BVH leaf (default: " + std::to_string(kDefaultLeafSizeCpu) +
              " on the CPU, " + std::to_string(kDefaultLeafSizeVulkan) + " with Vulkan)")
       ->check(CLI::Range(1, 64));
+  cmd->add_option("--integrator", o.integrator,
+                  "Light transport: " + describeNames(kIntegratorNames) + "; default: the scene's")
+      ->check(CLI::IsMember(namesOf(kIntegratorNames)));
   cmd->add_option("--strategy", o.strategy,
-                  "Direct light: " + describeNames(kStrategyNames) + "; default: the scene's")
-      ->check(CLI::IsMember(namesOf(kStrategyNames)));
+                  "Direct light: " + describeNames(kStrategyNames) +
+                      "; default: the scene's. With --integrator bdpt, S,T renders strategy "
+                      "(S light vertices, T camera vertices) alone, without its MIS weight")
+      ->check(CLI::Validator(
+          [](std::string& value) -> std::string {
+            if (valueNamed(kStrategyNames, value) || parseBdptStrategy(value)) return {};
+            return "expected " + quotedNames(kStrategyNames) +
+                   " or S,T (S >= 0, T >= 1, not 1,1), not " + value;
+          },
+          "STRATEGY"));
   cmd->add_option("--rr", o.roulette, "Russian roulette: on or off; default: the scene's")
       ->check(CLI::IsMember(namesOf(kRouletteNames)));
   cmd->add_option("--builder", o.builder, "BVH builder: " + describeNames(kBuilderNames))

@@ -16,7 +16,8 @@ struct SceneOverrides {
   std::optional<uint32_t> seed;
   std::optional<int> leafSize;  // unset: the backend's default (kDefaultLeafSize*)
   // Names from the tables; empty: the scene's (strategy, roulette, sampler) or the default.
-  std::string strategy, roulette, sampler, lightSampler;
+  // `strategy` may also be "S,T": one strategy of the bdpt integrator (cpu/bdpt.h).
+  std::string integrator, strategy, roulette, sampler, lightSampler;
   std::string builder{nameOf(kBuilderNames, kDefaultBuilder)};
   std::string intersection{nameOf(kIntersectionNames, false)};
 
@@ -30,6 +31,7 @@ struct SceneOverrides {
     s.maxDepth = maxDepth;
     s.maxLeafSize =
         leafSize.value_or(backend == "cpu" ? kDefaultLeafSizeCpu : kDefaultLeafSizeVulkan);
+    s.integrator = valueNamed(kIntegratorNames, integrator);
     s.strategy = valueNamed(kStrategyNames, strategy);
     s.russianRoulette = valueNamed(kRouletteNames, roulette);
     s.sampler = valueNamed(kSamplerNames, sampler);

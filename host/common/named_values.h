@@ -81,6 +81,15 @@ inline constexpr NameTable<uint, 3> kStrategyNames{{
     {"bsdf", kStrategyBsdf, "BSDF sampling only, no shadow rays"},
 }};
 
+// The light transport algorithms (pbrt-v4's Integrator types of the same names).
+inline constexpr uint kIntegratorPath = 0;  // path tracing: light and BSDF sampling, MIS
+inline constexpr uint kIntegratorBdpt = 1;  // bidirectional path tracing (CPU only, docs/bdpt.md)
+
+inline constexpr NameTable<uint, 2> kIntegratorNames{{
+    {"path", kIntegratorPath, "path tracing with light and BSDF sampling"},
+    {"bdpt", kIntegratorBdpt, "bidirectional path tracing (CPU)"},
+}};
+
 inline constexpr NameTable<uint, 3> kLightSamplerNames{{
     {"bvh", kLightSamplerBvh, "pbrt-v4's light BVH: by importance at the shading point"},
     {"power", kLightSamplerPower, "by power"},

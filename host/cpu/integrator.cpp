@@ -19,6 +19,7 @@
 
 #include "bvh/traverse.h"
 #include "common/check.h"
+#include "cpu/bdpt.h"
 #include "cpu/bounce_random.h"
 #include "cpu/integrator_lanes.h"
 #include "cpu/volpath.h"
@@ -27,15 +28,6 @@
 
 namespace pt {
 namespace {
-
-// The CPUs this process may run on: what Slurm, taskset or a container allotted, which can be
-// fewer than the machine has (std::thread::hardware_concurrency counts those).
-int availableCpus() {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  if (sched_getaffinity(0, sizeof(set), &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
-  return int(std::max(1u, std::thread::hardware_concurrency()));
-}
 
 // Whether anything lies on a shadow ray's segment t in [0, 1) whose light sample drew uLight,
 // cut-outs passed by where the scene has them.
@@ -47,6 +39,13 @@ bool occluded(const SceneData& scene, const Ray& ray, Intersection test, vec2 uL
 }
 
 }  // namespace
+
+int availableCpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
+  return int(std::max(1u, std::thread::hardware_concurrency()));
+}
 
 std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Intersection test,
                                   uvec2 pixel, uint32_t sampleIndex, uint depth, float tMax) {
@@ -191,6 +190,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
 }
 
 CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film) {
+  if (scene.integrator == kIntegratorBdpt) return renderBdpt(scene, options, film);
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
   const auto callStart = std::chrono::steady_clock::now();
@@ -279,14 +279,7 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
         film.add(x, y, sample);
       });
       traced[size_t(tile)] = 1;
-      const int done = tilesDone.fetch_add(1) + 1;
-      if (options.progress) {
-        std::unique_lock lock(progressMutex, std::try_to_lock);
-        if (lock.owns_lock()) {
-          options.progress((double(passIndex) + double(done) / double(tileCount)) /
-                           double(options.spp));
-        }
-      }
+      reportTileProgress(options, progressMutex, passIndex, tilesDone.fetch_add(1) + 1, tileCount);
     }
   };
   auto worker = [&](int thread) {
@@ -338,15 +331,30 @@ CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options
   }
   releaseWorkers();
   totalRays += rays;
+  finishCpuRenderStats(options, film, totalRays, start, callStart, stats);
+  return stats;
+}
+
+void reportTileProgress(const CpuRenderOptions& options, std::mutex& progressMutex, int passIndex,
+                        int tilesDone, int tileCount) {
+  if (!options.progress) return;
+  std::unique_lock lock(progressMutex, std::try_to_lock);
+  if (lock.owns_lock()) {
+    options.progress((double(passIndex) + double(tilesDone) / double(tileCount)) /
+                     double(options.spp));
+  }
+}
+
+void finishCpuRenderStats(const CpuRenderOptions& options, const Film& film, uint64_t rays,
+                          std::chrono::steady_clock::time_point start,
+                          std::chrono::steady_clock::time_point callStart, CpuRenderStats& stats) {
   stats.stopped = stats.samplesDone < options.spp;
   if (options.progress && !stats.stopped) options.progress(1.0);
-
-  stats.rays = totalRays;
+  stats.rays = rays;
   stats.invalidSamples = film.totalInvalid();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.wallSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - callStart).count();
-  return stats;
 }
 
 }  // namespace pt

@@ -9,7 +9,9 @@
 // computed once as it would compute them.)
 #pragma once
 
+#include <chrono>
 #include <cstdint>
+#include <mutex>
 
 #include "bvh/traverse.h"
 #include "image/image.h"
@@ -18,13 +20,27 @@
 
 namespace pt {
 
+// One strategy of bidirectional path tracing rendered alone, without its MIS weight (pbrt-v4's
+// visualizestrategies, for debugging; cpu/bdpt.h): s light vertices joined to t camera vertices.
+// Unset (-1): all of them, weighed.
+struct BdptStrategy {
+  int s = -1;
+  int t = -1;
+  bool all() const { return s < 0; }
+};
+
 struct CpuRenderOptions : RenderOptions {
   int threads = 0;  // 0: every CPU this process may run on (its affinity mask)
+  BdptStrategy bdptStrategy;  // scenes rendered with kIntegratorBdpt
 };
 
 struct CpuRenderStats : RenderStats {
   int threads = 0;  // threads used
 };
+
+// The CPUs this process may run on: what Slurm, taskset or a container allotted, which can be
+// fewer than the machine has (std::thread::hardware_concurrency counts those).
+int availableCpus();
 
 // The pinhole's ray through film point (x, y) in [0, filmWidth) x [0, filmHeight), row 0 at
 // the top (the whole film's coordinates; no filter, no lens).
@@ -72,7 +88,20 @@ void printLightSample(const SceneData& scene, uint depth, const LightSample& ls,
 
 // Renders into film (which must have the camera's resolution), adding spp samples per pixel
 // in passes of one sample index each; stopped early (options.stop), it adds whole passes
-// only, stats.samplesDone of them. Uses every CPU the process may run on unless told.
+// only, stats.samplesDone of them. Uses every CPU the process may run on unless told. A scene
+// whose integrator is kIntegratorBdpt is rendered by renderBdpt (cpu/bdpt.h).
 CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film);
+
+// Reports progress from the thread that has just finished a tile (tilesDone of tileCount in
+// pass passIndex), unless another thread is reporting (progressMutex).
+void reportTileProgress(const CpuRenderOptions& options, std::mutex& progressMutex, int passIndex,
+                        int tilesDone, int tileCount);
+
+// The end of a CPU render: whether it stopped early (stats.samplesDone of options.spp), the
+// last progress report, the rays traced, the film's invalid samples, the render's time since
+// `start` and the call's since `callStart`.
+void finishCpuRenderStats(const CpuRenderOptions& options, const Film& film, uint64_t rays,
+                          std::chrono::steady_clock::time_point start,
+                          std::chrono::steady_clock::time_point callStart, CpuRenderStats& stats);
 
 }  // namespace pt

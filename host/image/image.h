@@ -146,6 +146,20 @@ struct Film {
     }
   }
 
+  // Adds light that reaches pixel (x, y) other than through the pixel's own samples (the light
+  // tracing of bidirectional methods: pbrt-v4's splats) to its sum alone, so that the pixel's
+  // mean divides it by the samples added, as pbrt-v4 scales its splats by 1 / spp. A
+  // non-finite value is not added; it counts as an invalid sample of the pixel.
+  void addSplat(int x, int y, glm::vec3 radiance) {
+    PT_CHECK(x >= 0 && x < width && y >= 0 && y < height, "film pixel out of range");
+    const size_t i = size_t(y) * size_t(width) + size_t(x);
+    if (std::isfinite(radiance.x) && std::isfinite(radiance.y) && std::isfinite(radiance.z)) {
+      addExact(i, radiance);
+    } else {
+      ++invalidCount[i];
+    }
+  }
+
   // Adds a batch of pixel i's samples (row-major index), summed elsewhere in float: the sum
   // of its `valid` finite samples and the number of `invalid` ones (the Vulkan backend's
   // fold). A non-finite sum (float overflow of finite samples) counts them all as invalid.

@@ -251,6 +251,7 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   const int height = settings.height.value_or(scene.camera.height);
   const IntegratorSettings& integ = scene.integrator;
   data.spp = settings.spp.value_or(integ.spp);
+  data.integrator = settings.integrator.value_or(integ.integrator);
   data.materials = scene.materials;
   data.normals = std::move(scene.normals);
   PT_CHECK(data.normals.empty() || data.normals.size() == scene.triangles.size());
@@ -359,9 +360,10 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   p.samplerType = settings.sampler.value_or(integ.sampler);
   p.russianRoulette = settings.russianRoulette.value_or(integ.russianRoulette) ? 1u : 0u;
   if (data.effects.environmentImage) {
-    // The compensated distribution only where BSDF sampling covers what it leaves out (MIS).
+    // The compensated distribution only where BSDF sampling covers what it leaves out (the
+    // path tracer's MIS; BDPT's light subpaths start from the light's whole distribution).
     const bool compensated =
-        p.strategy == kStrategyMis &&
+        p.strategy == kStrategyMis && data.integrator == kIntegratorPath &&
         settings.environmentCompensation.value_or(kEnvironmentCompensationDefault);
     data.environmentTexels =
         buildEnvironmentTexels(scene.environment->image, scene.environment->mapping, compensated);

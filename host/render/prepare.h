@@ -43,7 +43,8 @@ struct RenderSettings {
   std::optional<int> spp;
   std::optional<uint32_t> seed;
   std::optional<int> maxDepth;
-  std::optional<uint> strategy;  // kStrategy*
+  std::optional<uint> integrator;  // kIntegrator*
+  std::optional<uint> strategy;    // kStrategy*
   std::optional<bool> russianRoulette;
   std::optional<uint> sampler;  // kSampler*
   std::optional<uint> lightSampler;  // kLightSampler*
@@ -169,6 +170,7 @@ struct SceneData {
   std::vector<uint32_t> lightBvhWords;
   RenderParams params{};
   int spp = 0;
+  uint integrator = kIntegratorPath;  // kIntegrator* (common/named_values.h)
   EffectSet effects;
   vec3 shift{0.0f};        // subtracted from every coordinate of a scene far from the origin
   LazyCpuSceneCopies cpu;  // of bvh; through cpuCopies() and wideBvh()

@@ -228,9 +228,15 @@ CameraDesc readCamera(const JsonNode& node) {
 }
 
 IntegratorSettings readIntegrator(const JsonNode& node) {
-  node.checkKeys({"spp", "maxDepth", "seed", "russianRoulette", "rrStartDepth", "strategy",
-                  "sampler", "lightSampler"});
   IntegratorSettings s;
+  // "integrator": "bdpt" names the algorithm alone.
+  if (node.json().is_string()) {
+    s.integrator = readChoice(node, kIntegratorNames, "integrator");
+    return s;
+  }
+  node.checkKeys({"type", "spp", "maxDepth", "seed", "russianRoulette", "rrStartDepth", "strategy",
+                  "sampler", "lightSampler"});
+  if (auto n = node.find("type")) s.integrator = readChoice(*n, kIntegratorNames, "type");
   if (auto n = node.find("spp")) s.spp = static_cast<int>(n->integer(1, kIntMax));
   if (auto n = node.find("maxDepth")) s.maxDepth = static_cast<int>(n->integer(0, kIntMax));
   if (auto n = node.find("seed")) s.seed = static_cast<uint>(n->integer(0, 0xFFFFFFFFll));

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/named_values.h"
 #include "common/shared.h"
 #include "image/image.h"
 
@@ -53,6 +54,7 @@ struct CameraDesc {
 
 // Integrator settings from the scene's "integrator" object (command-line flags override).
 struct IntegratorSettings {
+  uint integrator = kIntegratorPath;  // common/named_values.h's kIntegrator*
   int spp = 16;
   int maxDepth = 64;  // maximum number of scattering events on a path
   uint seed = 0;

@@ -240,11 +240,23 @@ void Builder::options(Statement& s) {
     }
     p.string("randomization");  // which scrambling: the noise's pattern, not the image
   } else if (d == "Integrator") {
-    if (type != "path" && type != "volpath") {
+    const bool known = type == "path" || type == "volpath" || type == "bdpt";
+    if (!known) {
       warnOnce("Integrator", s.location,
                "Integrator " + singleQuoted(type) +
                    " is rendered with the path tracer (\"path\": light and BSDF sampling with "
                    "MIS)");
+    }
+    scene_.integrator.integrator = type == "bdpt" ? kIntegratorBdpt : kIntegratorPath;
+    if (type == "bdpt") {
+      // pbrt-v4's debugging outputs: --strategy renders one strategy alone instead.
+      for (const char* name : {"visualizestrategies", "visualizeweights"}) {
+        if (auto v = p.boolean(name); v && *v) {
+          warnOnce(name, s.location,
+                   std::string("Integrator \"bdpt\": \"") + name +
+                       "\" ignored (render one strategy with --strategy S,T)");
+        }
+      }
     }
     if (auto v = p.integer("maxdepth")) {
       if (*v < 0) fail(p.find("maxdepth")->location, "maxdepth must not be negative");
@@ -264,7 +276,7 @@ void Builder::options(Statement& s) {
       }
       scene_.integrator.lightSampler = *sampler;
     }
-    if (type != "path" && type != "volpath") p.markAllUsed();
+    if (!known) p.markAllUsed();
   } else if (d == "Accelerator") {
     p.markAllUsed();  // the BVH is this renderer's own: nothing to take from the file
   }
