@@ -34,7 +34,8 @@ PT_INLINE float cameraLensArea(PT_IN(Camera) cam) {
 // Where a ray seen by the camera meets its film: the film point (the whole film's coordinates,
 // as generateCameraRay's) of the ray that leaves the lens at lensOffset (from the camera's
 // position) along unit direction d, and the cosine of d with the view direction.
-// found: the ray comes from the front and its film point lies in the rendered pixels.
+// found: the ray comes from the front and its film point lies where the rendered pixels' filters
+// reach (their sample bounds).
 struct CameraFilmHit {
   bool found;
   vec2 filmPoint;
@@ -54,8 +55,12 @@ PT_INLINE CameraFilmHit cameraFilmHit(PT_IN(Camera) cam, vec3 lensOffset, vec3 d
   float v = dot(q, cam.up) / cam.tanHalfFovY;
   h.filmPoint =
       vec2((u + 1.0f) * 0.5f * float(cam.filmWidth), (1.0f - v) * 0.5f * float(cam.filmHeight));
-  vec2 low = vec2(float(cam.cropX), float(cam.cropY));
-  vec2 high = low + vec2(float(cam.width), float(cam.height));
+  // pbrt-v4's Film::SampleBounds: the rendered pixels, widened by the filter's radius less
+  // half a pixel, where their camera rays go and where a splat still reaches one of them (the
+  // rendered pixels themselves for the box of radius 1/2).
+  vec2 margin = vec2(cam.filterRadiusX, cam.filterRadiusY) - 0.5f;
+  vec2 low = vec2(float(cam.cropX), float(cam.cropY)) - margin;
+  vec2 high = vec2(float(cam.cropX + cam.width), float(cam.cropY + cam.height)) + margin;
   h.found = h.filmPoint.x >= low.x && h.filmPoint.y >= low.y && h.filmPoint.x < high.x &&
             h.filmPoint.y < high.y;
   return h;
@@ -71,6 +76,9 @@ PT_INLINE float cameraImportance(PT_IN(Camera) cam, PT_IN(CameraFilmHit) h) {
 
 // The solid-angle density with which the camera's rays take direction d (pbrt-v4's PDF_We's
 // pdfDir): film points uniform over the rendered pixels, 1 / (A cos^3); 0 where it sees none.
+// As pbrt-v4's, it is that wherever cameraFilmHit finds the film, in the sample bounds: a
+// filter wider than a pixel takes the camera's rays a little past the rendered pixels, which
+// the density (used for MIS weights alone) ignores.
 PT_INLINE float cameraDirectionPdf(PT_IN(Camera) cam, vec3 lensOffset, vec3 d) {
   CameraFilmHit h = cameraFilmHit(cam, lensOffset, d);
   if (!h.found) return 0.0f;

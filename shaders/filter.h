@@ -205,8 +205,8 @@ PT_INLINE float finishMitchellAxis(MitchellAxis a) {
   return a.negative ? -t : t;
 }
 
-// The sign of Mitchell1D at t (its value times 6, whose sign it is).
-PT_INLINE float mitchellSign(PT_IN(Camera) cam, float t) {
+// Mitchell1D(t) times 6, for |t| <= 2.
+PT_INLINE float mitchellValue6(PT_IN(Camera) cam, float t) {
   float a = abs(t);
   float b = cam.filterB;
   float c = cam.filterC;
@@ -215,7 +215,40 @@ PT_INLINE float mitchellSign(PT_IN(Camera) cam, float t) {
   float farValue =
       (((-b - 6.0f * c) * a + (6.0f * b + 30.0f * c)) * a + (-12.0f * b - 48.0f * c)) * a +
       (8.0f * b + 24.0f * c);
-  return (a <= 1.0f ? nearValue : farValue) < 0.0f ? -1.0f : 1.0f;
+  return a <= 1.0f ? nearValue : farValue;
+}
+
+// The sign of Mitchell1D at t (its value times 6, whose sign it is).
+PT_INLINE float mitchellSign(PT_IN(Camera) cam, float t) {
+  return mitchellValue6(cam, t) < 0.0f ? -1.0f : 1.0f;
+}
+
+// ---- The filter's value ----------------------------------------------------------------
+
+// The value of pixel filter `cam.filterType` at `offset` from a pixel's centre (pbrt-v4's
+// Filter::Evaluate), each filter times a constant of its own: box 1 on [-r, r]^2; triangle
+// (rx - |x|)(ry - |y|); gaussian per axis (2k / sqrt(pi)) exp(-(kx)^2) less its value at the
+// radius (the derivative of gaussianFilterCdf); mitchell 6 Mitchell1D(2x / r) per axis. 0
+// beyond the radius. Where a bidirectional method splats light at a film point, each pixel
+// takes it weighed by this at (point - the pixel's centre) over the filter's integral in the
+// same scale (filterIntegral, host/scene/camera_filter.h), as pbrt-v4's RGBFilm::AddSplat and
+// GetPixelRGB do; the camera's own samples need only sampleFilm.
+PT_INLINE float filterValue(PT_IN(Camera) cam, vec2 offset) {
+  vec2 radius = vec2(cam.filterRadiusX, cam.filterRadiusY);
+  vec2 a = abs(offset);
+  if (a.x > radius.x || a.y > radius.y) return 0.0f;
+  if (cam.filterType == kFilterTriangle) return (radius.x - a.x) * (radius.y - a.y);
+  if (cam.filterType == kFilterGaussian) {
+    float k = cam.filterScale;
+    float peak = 2.0f * k / sqrt(kPi);
+    vec2 g = vec2(peak * exp(-(k * a.x) * (k * a.x)) - cam.filterExpX,
+                  peak * exp(-(k * a.y) * (k * a.y)) - cam.filterExpY);
+    return max(g.x, 0.0f) * max(g.y, 0.0f);
+  }
+  if (cam.filterType == kFilterMitchell) {
+    return mitchellValue6(cam, 2.0f * a.x / radius.x) * mitchellValue6(cam, 2.0f * a.y / radius.y);
+  }
+  return 1.0f;
 }
 
 // ---- The filter's sample ---------------------------------------------------------------

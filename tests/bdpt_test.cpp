@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -18,15 +20,19 @@
 #include "cpu/bdpt.h"
 #include "cpu/integrator.h"
 #include "render/prepare.h"
+#include "scene/camera_filter.h"
 #include "scene/load_scene.h"
 #include "test_util.h"
 
 namespace pt {
 namespace {
 
-// A scene of configs/ at a small size, rendered with the given integrator and depth.
-SceneData bdptTestScene(const std::string& config, int size, int maxDepth, uint integrator) {
+// A scene of configs/ at a small size, rendered with the given integrator and depth (and pixel
+// filter, where one is given).
+SceneData bdptTestScene(const std::string& config, int size, int maxDepth, uint integrator,
+                        const std::optional<PixelFilterDesc>& filter = std::nullopt) {
   Scene scene = loadScene(test::kConfigs / config);
+  if (filter) scene.camera.filter = *filter;
   RenderSettings settings;
   settings.width = size;
   settings.height = size;
@@ -37,23 +43,42 @@ SceneData bdptTestScene(const std::string& config, int size, int maxDepth, uint 
 
 // The image cut into square blocks, each estimate the block's summed pixel values: per pixel
 // sample (every one an independent draw of the whole estimator), the sum of what it adds to
-// each block, and over the samples the mean and variance of those sums.
+// each block, and over the samples the mean and variance of those sums. With `stripes`, each
+// block has two more estimates, its pixels summed with the signs of alternate columns,
+// (-1)^x, and of alternate rows, (-1)^y: the image's finest detail, which a pixel filter
+// blurs (a step between two pixels adds twice its height times the share of the filter past
+// the pixel's edge to the stripes of a block that it crosses).
 struct BdptBlockStats {
-  int blockSize = 0, blocksX = 0, blocksY = 0;
+  int blockSize = 0, blocksX = 0, blocksY = 0, layers = 1;
   double samples = 0.0;
-  std::vector<double> sum, sumSquares;  // per block, and the whole image last
+  std::vector<double> sum, sumSquares;  // per block (and stripe layer), the whole image last
   std::map<int, double> current;        // this sample's adds, by block
 
-  BdptBlockStats(int width, int height, int block)
+  BdptBlockStats(int width, int height, int block, bool stripes = false)
       : blockSize(block),
         blocksX((width + block - 1) / block),
-        blocksY((height + block - 1) / block) {
-    sum.assign(size_t(blocksX * blocksY + 1), 0.0);
+        blocksY((height + block - 1) / block),
+        layers(stripes ? 3 : 1) {
+    sum.assign(size_t(blocks() + 1), 0.0);
     sumSquares = sum;
   }
-  int blocks() const { return blocksX * blocksY; }
+  // The estimates before the whole image's.
+  int blocks() const { return blocksX * blocksY * layers; }
+  std::string name(int k) const {
+    if (k == blocks()) return "image";
+    const int layer = k / (blocksX * blocksY);
+    return std::string(layer == 0   ? "block "
+                       : layer == 1 ? "column stripes of block "
+                                    : "row stripes of block ") +
+           std::to_string(k % (blocksX * blocksY));
+  }
   void add(int x, int y, double v) {
-    current[(y / blockSize) * blocksX + x / blockSize] += v;
+    const int b = (y / blockSize) * blocksX + x / blockSize;
+    current[b] += v;
+    if (layers == 3) {
+      current[blocksX * blocksY + b] += (x & 1) != 0 ? -v : v;
+      current[2 * blocksX * blocksY + b] += (y & 1) != 0 ? -v : v;
+    }
     current[blocks()] += v;
   }
   void endSample() {
@@ -74,44 +99,65 @@ struct BdptBlockStats {
   }
 };
 
-// Adds a BDPT contribution of pixel (x, y) (a splat: where it lands) to stats, channel-summed.
-void addBdptContribution(const Camera& cam, int x, int y, const BdptContribution& c, vec3 value,
-                         BdptBlockStats& stats) {
+// How the tests spread a splat: as the renderer does (BdptSplatter), or (a deliberate error,
+// for the test that the checks catch it) whole into the one pixel it lands in, as a box of one
+// pixel would, whatever the filter.
+enum class BdptSplats { kFilter, kOnePixel };
+
+// Adds a BDPT contribution of pixel (x, y) (a splat: where it lands, spread by `splats`) to
+// stats, channel-summed.
+void addBdptContribution(const BdptSplatter& splatter, int x, int y, const BdptContribution& c,
+                         vec3 value, BdptBlockStats& stats,
+                         BdptSplats splats = BdptSplats::kFilter) {
   const double v = double(value.x) + double(value.y) + double(value.z);
   if (!c.splat) {
     stats.add(x, y, v);
     return;
   }
+  if (splats == BdptSplats::kFilter) {
+    splatter.forPixels(c.filmPoint, [&](int sx, int sy, float w) { stats.add(sx, sy, v * w); });
+    return;
+  }
+  const Camera& cam = splatter.cam;
   const int fx = int(std::floor(c.filmPoint.x)) - int(cam.cropX);
   const int fy = int(std::floor(c.filmPoint.y)) - int(cam.cropY);
   if (fx >= 0 && fy >= 0 && fx < int(cam.width) && fy < int(cam.height)) stats.add(fx, fy, v);
 }
 
-// Asserts that two independent estimates agree in every block and in the whole image: within
+// The blocks (and the whole image, last) where two independent estimates disagree: by more than
 // kSigmas standard errors of their difference (4.5: a chance below 1e-5 per block that a
-// correct renderer fails).
+// correct renderer fails). `report` adds a test failure for each.
 constexpr double kBdptSigmas = 4.5;
-void expectBlocksAgree(const BdptBlockStats& a, const BdptBlockStats& b, double pixels,
-                       const std::string& what) {
+int blocksThatDisagree(const BdptBlockStats& a, const BdptBlockStats& b, double pixels,
+                       const std::string& what, bool report) {
   int failed = 0;
   for (int k = 0; k <= a.blocks(); ++k) {
     const double diff = a.estimate(k, pixels) - b.estimate(k, pixels);
     const double se = std::hypot(a.standardError(k, pixels), b.standardError(k, pixels));
     if (!(std::abs(diff) <= kBdptSigmas * se)) {
       ++failed;
-      ADD_FAILURE() << what << ": " << (k == a.blocks() ? "image" : "block " + std::to_string(k))
-                    << " " << a.estimate(k, pixels) << " vs " << b.estimate(k, pixels)
-                    << ", standard error " << se;
+      if (!report) continue;
+      ADD_FAILURE() << what << ": " << a.name(k) << " " << a.estimate(k, pixels) << " vs "
+                    << b.estimate(k, pixels) << ", standard error " << se;
     }
   }
-  EXPECT_EQ(failed, 0) << what;
+  return failed;
 }
 
-// The path tracer's and BDPT's block estimates of a scene.
+// Asserts that two independent estimates agree in every block and in the whole image.
+void expectBlocksAgree(const BdptBlockStats& a, const BdptBlockStats& b, double pixels,
+                       const std::string& what) {
+  EXPECT_EQ(blocksThatDisagree(a, b, pixels, what, /*report=*/true), 0) << what;
+}
+
+// The path tracer's and BDPT's block estimates of a scene (with pixel filter `filter`, where
+// one is given; BDPT's splats spread by `splats`).
 void renderBothWays(const std::string& config, int size, int maxDepth, int sppPath, int sppBdpt,
-                    BdptBlockStats& path, BdptBlockStats& bdpt) {
-  const SceneData pt = bdptTestScene(config, size, maxDepth, kIntegratorPath);
-  const SceneData bd = bdptTestScene(config, size, maxDepth, kIntegratorBdpt);
+                    BdptBlockStats& path, BdptBlockStats& bdpt,
+                    const std::optional<PixelFilterDesc>& filter = std::nullopt,
+                    BdptSplats splats = BdptSplats::kFilter) {
+  const SceneData pt = bdptTestScene(config, size, maxDepth, kIntegratorPath, filter);
+  const SceneData bd = bdptTestScene(config, size, maxDepth, kIntegratorBdpt, filter);
   uint64_t rays = 0;
   for (int s = 0; s < sppPath; ++s) {
     for (int y = 0; y < size; ++y) {
@@ -122,12 +168,12 @@ void renderBothWays(const std::string& config, int size, int maxDepth, int sppPa
       }
     }
   }
-  const Camera& cam = bd.params.camera;
+  const BdptSplatter splatter(bd.params.camera);
   for (int s = 0; s < sppBdpt; ++s) {
     for (int y = 0; y < size; ++y) {
       for (int x = 0; x < size; ++x) {
         bdptSample(bd, uvec2(x, y), uint(s), BdptStrategy{}, rays, [&](const BdptContribution& c) {
-          addBdptContribution(cam, x, y, c, c.L * c.weight, bdpt);
+          addBdptContribution(splatter, x, y, c, c.L * c.weight, bdpt, splats);
         });
         bdpt.endSample();
       }
@@ -153,16 +199,21 @@ TEST(BdptConverges, GlossyMaterialsMatchThePathTracer) {
 // pbrt's check: each strategy alone, without its weight, estimates the light of its depth,
 // which all strategies of that depth together estimate weighed (a diffuse scene: every strategy
 // samples every path). Both come of the same samples: the bound is the spread of their
-// difference.
-TEST(BdptStrategies, EachAloneMatchesItsDepthWeighed) {
+// difference. Returns the number of blocks (and images) that fail it, each reported where
+// `report`.
+int strategiesThatDisagree(const std::optional<PixelFilterDesc>& filter, BdptSplats splats, int spp,
+                           bool stripes, bool report) {
+  constexpr int blockSize = 8;
   constexpr int kSize = 16;
-  const SceneData data = bdptTestScene("cornell-box.json", kSize, 3, kIntegratorBdpt);
-  const Camera& cam = data.params.camera;
+  const SceneData data = bdptTestScene("cornell-box.json", kSize, 3, kIntegratorBdpt, filter);
+  const BdptSplatter splatter(data.params.camera);
   const int strategies[][2] = {{0, 3}, {1, 2}, {2, 1}, {0, 4}, {1, 3}, {2, 2}, {3, 1}};
-  std::vector<BdptBlockStats> diffs(std::size(strategies), BdptBlockStats(kSize, kSize, 8));
-  std::vector<BdptBlockStats> alone(std::size(strategies), BdptBlockStats(kSize, kSize, 8));
+  std::vector<BdptBlockStats> diffs(std::size(strategies),
+                                    BdptBlockStats(kSize, kSize, blockSize, stripes));
+  std::vector<BdptBlockStats> alone(std::size(strategies),
+                                    BdptBlockStats(kSize, kSize, blockSize, stripes));
   uint64_t rays = 0;
-  for (int s = 0; s < 96; ++s) {
+  for (int s = 0; s < spp; ++s) {
     for (int y = 0; y < kSize; ++y) {
       for (int x = 0; x < kSize; ++x) {
         bdptSample(data, uvec2(x, y), uint(s), BdptStrategy{}, rays,
@@ -171,10 +222,10 @@ TEST(BdptStrategies, EachAloneMatchesItsDepthWeighed) {
                        const int depth = strategies[k][0] + strategies[k][1];
                        if (c.s + c.t != depth) continue;
                        // The weighed depth, less the strategy unweighed.
-                       addBdptContribution(cam, x, y, c, c.L * c.weight, diffs[k]);
+                       addBdptContribution(splatter, x, y, c, c.L * c.weight, diffs[k], splats);
                        if (c.s == strategies[k][0] && c.t == strategies[k][1]) {
-                         addBdptContribution(cam, x, y, c, -c.L, diffs[k]);
-                         addBdptContribution(cam, x, y, c, c.L, alone[k]);
+                         addBdptContribution(splatter, x, y, c, -c.L, diffs[k], splats);
+                         addBdptContribution(splatter, x, y, c, c.L, alone[k], splats);
                        }
                      }
                    });
@@ -184,17 +235,29 @@ TEST(BdptStrategies, EachAloneMatchesItsDepthWeighed) {
     }
   }
   const double pixels = kSize * kSize;
+  int failed = 0;
   for (size_t k = 0; k < std::size(strategies); ++k) {
     const std::string name =
         std::to_string(strategies[k][0]) + "," + std::to_string(strategies[k][1]);
     EXPECT_GT(alone[k].estimate(alone[k].blocks(), pixels), 0.0) << name << " finds light";
     for (int b = 0; b <= diffs[k].blocks(); ++b) {
-      EXPECT_LE(std::abs(diffs[k].estimate(b, pixels)),
-                kBdptSigmas * diffs[k].standardError(b, pixels))
-          << "strategy " << name
-          << (b == diffs[k].blocks() ? " image" : " block " + std::to_string(b));
+      if (std::abs(diffs[k].estimate(b, pixels)) <=
+          kBdptSigmas * diffs[k].standardError(b, pixels)) {
+        continue;
+      }
+      ++failed;
+      if (!report) continue;
+      ADD_FAILURE() << "strategy " << name << " " << diffs[k].name(b) << ": "
+                    << diffs[k].estimate(b, pixels) << ", standard error "
+                    << diffs[k].standardError(b, pixels);
     }
   }
+  return failed;
+}
+
+TEST(BdptStrategies, EachAloneMatchesItsDepthWeighed) {
+  EXPECT_EQ(strategiesThatDisagree(std::nullopt, BdptSplats::kFilter, 96, false, /*report=*/true),
+            0);
 }
 
 // ---- The MIS weights of one path's strategies ---------------------------------------------
@@ -343,6 +406,97 @@ TEST(BdptRender, SameImageWithOneAndTwoThreads) {
     total += double(a.pixels[i].x);
   }
   EXPECT_GT(total, 0.0);
+}
+
+// ---- Pixel filters -------------------------------------------------------------------------
+
+// pbrt-v4's filter of type `type` with its defaults (gaussian: radius 1.5, sigma 0.5; triangle
+// and mitchell: radius 2).
+PixelFilterDesc bdptFilter(uint type) {
+  return defaultFilter(type);
+}
+
+// filterIntegral is the integral of filterValue: a midpoint sum over a 400 x 400 grid of the
+// filter's square (its kinks on the grid lines), for default and other parameters.
+TEST(BdptFilters, FilterIntegralIsTheIntegralOfItsValue) {
+  auto make = [](uint type, float rx, float ry) {
+    PixelFilterDesc f = defaultFilter(type);
+    f.radiusX = rx;
+    f.radiusY = ry;
+    return f;
+  };
+  std::vector<PixelFilterDesc> filters = {
+      defaultFilter(kFilterBox),      make(kFilterBox, 1.5f, 0.75f),
+      defaultFilter(kFilterTriangle), make(kFilterTriangle, 1.0f, 1.5f),
+      defaultFilter(kFilterGaussian), make(kFilterGaussian, 2.0f, 1.0f),
+      defaultFilter(kFilterMitchell), make(kFilterMitchell, 1.5f, 2.0f)};
+  filters[5].sigma = 0.8f;
+  filters[7].b = 0.0f;
+  filters[7].c = 0.5f;
+  for (const PixelFilterDesc& f : filters) {
+    Camera cam{};
+    setFilterConstants(cam, f, "test");
+    constexpr int kSteps = 400;
+    const double hx = 2.0 * f.radiusX / kSteps, hy = 2.0 * f.radiusY / kSteps;
+    double sum = 0.0;
+    for (int j = 0; j < kSteps; ++j) {
+      for (int i = 0; i < kSteps; ++i) {
+        const vec2 p(float(-f.radiusX + (i + 0.5) * hx), float(-f.radiusY + (j + 0.5) * hy));
+        sum += double(filterValue(cam, p)) * hx * hy;
+      }
+    }
+    EXPECT_NEAR(sum / filterIntegral(cam), 1.0, 2e-4)
+        << "filter " << f.type << " radius " << f.radiusX << " x " << f.radiusY;
+    EXPECT_EQ(filterValue(cam, vec2(f.radiusX * 1.01f, 0.0f)), 0.0f);
+  }
+}
+
+// BDPT with pbrt-v4's default gaussian (and the triangle, and mitchell's negative lobes)
+// converges to the path tracer's image with the same filter: the camera's strategies sample
+// the filter as the path tracer does, light tracing's splats spread over the pixels the filter
+// reaches.
+void expectFilteredConverges(const std::string& config, uint filterType, const std::string& what) {
+  constexpr int kSize = 24;
+  BdptBlockStats path(kSize, kSize, 8), bdpt(kSize, kSize, 8);
+  renderBothWays(config, kSize, 4, 256, 128, path, bdpt, bdptFilter(filterType));
+  expectBlocksAgree(path, bdpt, kSize * kSize, what);
+}
+
+TEST(BdptFilters, GaussianCornellBoxMatchesThePathTracer) {
+  expectFilteredConverges("cornell-box.json", kFilterGaussian, "cornell-box, gaussian");
+}
+TEST(BdptFilters, TriangleCornellBoxMatchesThePathTracer) {
+  expectFilteredConverges("cornell-box.json", kFilterTriangle, "cornell-box, triangle");
+}
+TEST(BdptFilters, MitchellCornellBoxMatchesThePathTracer) {
+  expectFilteredConverges("cornell-box.json", kFilterMitchell, "cornell-box, mitchell");
+}
+// The glass sphere's caustic on the floor: light tracing (t = 1) carries much of it.
+TEST(BdptFilters, GaussianGlossyMatchesThePathTracer) {
+  expectFilteredConverges("cornell-materials.json", kFilterGaussian, "cornell-materials, gaussian");
+}
+
+// Each strategy alone, light tracing's (2,1) and (3,1) among them, equals its depth weighed,
+// under the gaussian and the triangle, in the blocks and their stripes.
+TEST(BdptFilters, StrategiesAloneMatchTheirDepthWeighed) {
+  EXPECT_EQ(strategiesThatDisagree(bdptFilter(kFilterGaussian), BdptSplats::kFilter, 384, true,
+                                   /*report=*/true),
+            0);
+  EXPECT_EQ(strategiesThatDisagree(bdptFilter(kFilterTriangle), BdptSplats::kFilter, 384, true,
+                                   /*report=*/true),
+            0);
+}
+
+// The strategy check sees the filter: splats put whole into the one pixel they land in (a box's
+// behaviour) under the gaussian fail it, in the stripes of the blocks (the camera's strategies
+// blur the image as the filter does, such splats do not).
+TEST(BdptFilters, TheStrategyCheckCatchesOnePixelSplats) {
+  EXPECT_GT(strategiesThatDisagree(bdptFilter(kFilterGaussian), BdptSplats::kOnePixel, 384, true,
+                                   /*report=*/false),
+            0);
+  EXPECT_GT(strategiesThatDisagree(bdptFilter(kFilterTriangle), BdptSplats::kOnePixel, 384, true,
+                                   /*report=*/false),
+            0);
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "bvh/traverse.h"
 #include "common/check.h"
 #include "cpu/bounce_random.h"
+#include "scene/camera_filter.h"
 
 namespace pt {
 namespace {
@@ -87,26 +88,6 @@ void bdptRandomWalk(const SceneData& scene, const PathScene& ps, BdptPath& path,
   }
 }
 
-// The film pixels (image coordinates) that a splat at filmPoint lands on, with the box filter's
-// weight 1 / (4 rx ry): those whose filter [c - r, c + r) about their centre c holds it.
-template <typename F>
-void forSplatPixels(const Camera& cam, vec2 filmPoint, F&& f) {
-  const float rx = cam.filterRadiusX;
-  const float ry = cam.filterRadiusY;
-  const float weight = 1.0f / (4.0f * rx * ry);
-  const int x0 = int(std::floor(filmPoint.x - rx - 0.5f)) + 1;
-  const int x1 = int(std::floor(filmPoint.x + rx - 0.5f));
-  const int y0 = int(std::floor(filmPoint.y - ry - 0.5f)) + 1;
-  const int y1 = int(std::floor(filmPoint.y + ry - 0.5f));
-  for (int y = y0; y <= y1; ++y) {
-    for (int x = x0; x <= x1; ++x) {
-      const int ix = x - int(cam.cropX);
-      const int iy = y - int(cam.cropY);
-      if (ix >= 0 && iy >= 0 && ix < int(cam.width) && iy < int(cam.height)) f(ix, iy, weight);
-    }
-  }
-}
-
 }  // namespace
 
 std::optional<BdptStrategy> parseBdptStrategy(const std::string& text) {
@@ -124,17 +105,20 @@ void checkBdptScene(const SceneData& scene, const std::string& what) {
   };
   if (scene.effects.media || scene.params.mediaPresent != 0u) refuse("participating media");
   if (scene.effects.sphereLights) refuse("sphere lights");
-  if (scene.params.camera.filterType != kFilterBox) {
-    refuse("pixel filters other than the box (give the scene a box filter)");
-  }
 }
 
 uint bdptMaxDepth(const SceneData& scene) {
   return std::min(scene.params.maxDepth, kBdptMaxDepth);
 }
 
-void bdptSubpaths(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex, BdptPath& camera,
-                  BdptPath& light, uint64_t& rays) {
+BdptSplatter::BdptSplatter(const Camera& camera)
+    : cam(camera),
+      box(camera.filterType == kFilterBox),
+      boxWeight(1.0f / (4.0f * camera.filterRadiusX * camera.filterRadiusY)),
+      inverseIntegral(static_cast<float>(1.0 / filterIntegral(camera))) {}
+
+float bdptSubpaths(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex, BdptPath& camera,
+                   BdptPath& light, uint64_t& rays) {
   const RenderParams& params = scene.params;
   const uint maxDepth = bdptMaxDepth(scene);
   const PathScene ps = scene.pathScene();
@@ -166,6 +150,7 @@ void bdptSubpaths(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex
       bdptCorrectInfiniteStart(ps, light, start.pdfPos);
     }
   }
+  return cs.weight;
 }
 
 void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
@@ -173,7 +158,7 @@ void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
                 const std::function<void(const BdptContribution&)>& sink) {
   BdptPath camera;
   BdptPath light;
-  bdptSubpaths(scene, imagePixel, sampleIndex, camera, light, rays);
+  const float filterWeight = bdptSubpaths(scene, imagePixel, sampleIndex, camera, light, rays);
   const RenderParams& params = scene.params;
   const PathScene ps = scene.pathScene();
   const uvec2 pixel = imagePixel + uvec2(params.camera.cropX, params.camera.cropY);
@@ -208,7 +193,10 @@ void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
       BdptContribution out;
       out.s = int(s);
       out.t = int(t);
-      out.L = c.L;
+      // The camera's strategies carry its sample's filter weight (filter.h: 1 but for
+      // mitchell's negative lobes), as the path tracer's samples do; splats take the filter's
+      // value where they land instead (BdptSplatter).
+      out.L = t == 1 ? c.L : c.L * filterWeight;
       out.weight = strategy.all() ? bdptMisWeight(ps, light, camera, c.sampled, s, t) : 1.0f;
       out.splat = t == 1;
       out.filmPoint = c.filmPoint;
@@ -221,6 +209,7 @@ CpuRenderStats renderBdpt(const SceneData& scene, const CpuRenderOptions& option
   const BdptStrategy& strategy = options.bdptStrategy;
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
+  const BdptSplatter splatter(cam);
   const auto callStart = std::chrono::steady_clock::now();
   scene.cpuCopies();  // built here on a first render: set-up, not render time
   const auto start = std::chrono::steady_clock::now();
@@ -275,7 +264,7 @@ CpuRenderStats renderBdpt(const SceneData& scene, const CpuRenderOptions& option
                            L += value;
                            return;
                          }
-                         forSplatPixels(cam, c.filmPoint, [&](int sx, int sy, float w) {
+                         splatter.forPixels(c.filmPoint, [&](int sx, int sy, float w) {
                            tileSplats.push_back(Splat{sx, sy, value * w});
                          });
                        });

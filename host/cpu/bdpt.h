@@ -5,6 +5,7 @@
 // and how the image is scheduled and written. docs/bdpt.md says what it does and does not do.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -20,8 +21,7 @@ namespace pt {
 std::optional<BdptStrategy> parseBdptStrategy(const std::string& text);
 
 // Throws InputError naming `what` (the scene file) where the scene asks for what the
-// bidirectional path tracer does not do yet: participating media, sphere lights, a pixel
-// filter other than the box.
+// bidirectional path tracer does not do yet: participating media, sphere lights.
 void checkBdptScene(const SceneData& scene, const std::string& what);
 
 // The maximum depth BDPT renders with: the scene's, at most kBdptMaxDepth.
@@ -38,10 +38,61 @@ struct BdptContribution {
   vec2 filmPoint{0.0f};
 };
 
+// How a light-tracing splat at a film point spreads over the image's pixels (pbrt-v4's
+// RGBFilm::AddSplat and GetPixelRGB): every pixel whose filter reaches the point takes it
+// weighed by the filter's value at (point - the pixel's centre) over the filter's integral
+// (filter.h's filterValue, camera_filter.h's filterIntegral). The box keeps the half-open
+// square [c - r, c + r) about each centre c, so that a point on the border between pixels
+// lands in one of them, with the weight 1 / (4 rx ry).
+struct BdptSplatter {
+  explicit BdptSplatter(const Camera& camera);
+
+  // Calls f(x, y, weight) for each pixel (image coordinates) that takes a splat at filmPoint
+  // (the whole film's coordinates).
+  template <typename F>
+  void forPixels(vec2 filmPoint, F&& f) const {
+    const float rx = cam.filterRadiusX;
+    const float ry = cam.filterRadiusY;
+    int x0, x1, y0, y1;  // film pixels, inclusive
+    if (box) {
+      x0 = int(std::floor(filmPoint.x - rx - 0.5f)) + 1;
+      x1 = int(std::floor(filmPoint.x + rx - 0.5f));
+      y0 = int(std::floor(filmPoint.y - ry - 0.5f)) + 1;
+      y1 = int(std::floor(filmPoint.y + ry - 0.5f));
+    } else {
+      x0 = int(std::ceil(filmPoint.x - rx - 0.5f));
+      x1 = int(std::floor(filmPoint.x + rx - 0.5f));
+      y0 = int(std::ceil(filmPoint.y - ry - 0.5f));
+      y1 = int(std::floor(filmPoint.y + ry - 0.5f));
+    }
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        const int ix = x - int(cam.cropX);
+        const int iy = y - int(cam.cropY);
+        if (ix < 0 || iy < 0 || ix >= int(cam.width) || iy >= int(cam.height)) continue;
+        if (box) {
+          f(ix, iy, boxWeight);
+          continue;
+        }
+        const float w =
+            filterValue(cam, filmPoint - vec2(float(x) + 0.5f, float(y) + 0.5f)) * inverseIntegral;
+        if (w != 0.0f) f(ix, iy, w);
+      }
+    }
+  }
+
+  const Camera& cam;
+  bool box;
+  float boxWeight;        // 1 / (4 rx ry), as float
+  float inverseIntegral;  // 1 / filterIntegral
+};
+
 // Traces the camera and light subpaths of pixel sample (pixel, sampleIndex) of the image (the
-// crop's pixel). `rays` counts the rays traced. Exposed for tests of the MIS weights.
-void bdptSubpaths(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, BdptPath& camera,
-                  BdptPath& light, uint64_t& rays);
+// crop's pixel); returns the camera sample's filter weight (filter.h's FilmSample::weight),
+// which the camera subpath's strategies carry. `rays` counts the rays traced. Exposed for tests
+// of the MIS weights.
+float bdptSubpaths(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, BdptPath& camera,
+                   BdptPath& light, uint64_t& rays);
 
 // Traces the two subpaths of pixel sample (pixel, sampleIndex) of the image (the crop's pixel)
 // and hands every connection that contributes to `sink` (those of `strategy` alone, where it

@@ -192,4 +192,21 @@ void setFilterConstants(Camera& camera, const PixelFilterDesc& filter, const std
   }
 }
 
+double filterIntegral(const Camera& camera) {
+  const double rx = camera.filterRadiusX, ry = camera.filterRadiusY;
+  switch (camera.filterType) {
+    case kFilterTriangle:
+      return rx * rx * ry * ry;
+    case kFilterGaussian: {
+      const double k = camera.filterScale;
+      return (2.0 * std::erf(k * rx) - 2.0 * rx * double(camera.filterExpX)) *
+             (2.0 * std::erf(k * ry) - 2.0 * ry * double(camera.filterExpY));
+    }
+    case kFilterMitchell:
+      return 9.0 * rx * ry;
+    default:
+      return 4.0 * rx * ry;
+  }
+}
+
 }  // namespace pt

@@ -23,4 +23,11 @@ PixelFilterDesc defaultFilter(uint type);
 // InputError (naming `where`) for parameters no sampler can follow. Exposed for tests.
 void setFilterConstants(Camera& camera, const PixelFilterDesc& filter, const std::string& where);
 
+// The integral over the plane of filter.h's filterValue for the camera's filter, in closed
+// form from its constants: box 4 rx ry, triangle rx^2 ry^2, gaussian per axis
+// 2 erf(k r) - 2 r filterExp, mitchell 9 rx ry (Mitchell1D integrates to 1 over [-2, 2]
+// whatever B and C; times 6, over x = t r / 2). Splats are divided by it (pbrt-v4's
+// filterIntegral).
+double filterIntegral(const Camera& camera);
+
 }  // namespace pt
