@@ -550,11 +550,22 @@ TEST(BdptCli, ChosenRefusedAndChecked) {
     std::string s = text.str();
     const std::string negative = "maxdepth\" -1";
     s.replace(s.find(negative), negative.size(), "maxdepth\" 3");
+    // pbrt-v4's default filter, as most of its files have it.
+    const std::string box = "PixelFilter \"box\"";
+    ASSERT_NE(s.find(box), std::string::npos);
+    s.replace(s.find(box), box.size(), "PixelFilter \"gaussian\"");
     std::ofstream(dir / "good.pbrt") << s;
   }
   const Scene good = loadScene(dir / "good.pbrt");
   EXPECT_EQ(good.integrator.integrator, kIntegratorBdpt);
   EXPECT_EQ(good.integrator.maxDepth, 3);
+  // The file alone chooses BDPT, which renders it with its gaussian filter.
+  const test::PtResult gaussian = test::runPt(
+      "render " + (dir / "good.pbrt").string() +
+      " --backend cpu --spp 2 --width 16 --height 16 --out " + (dir / "g.exr").string());
+  EXPECT_EQ(gaussian.status, 0) << gaussian.err;
+  EXPECT_NE(gaussian.out.find("integrator=bdpt"), std::string::npos) << gaussian.out;
+  EXPECT_NE(gaussian.out.find("invalid_samples=0"), std::string::npos) << gaussian.out;
 
   const test::PtResult negative =
       test::runPt("render " + bad.string() + " --backend cpu --out " + (dir / "d.exr").string());
