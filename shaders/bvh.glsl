@@ -214,6 +214,9 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
     ref = 0u;
   }
   uint bestPrimitive = kNoPrimitive;  // kNoPrimitive until a hit is found
+  // The traversal loop is inside a second loop only with PT_HIT_FILTER, and is indented as the
+  // one loop it is without; the formatter cannot read the two at once.
+  // clang-format off
 #ifdef PT_HIT_FILTER
   // A closer hit that the includer's filter judges (PT_HIT_FILTERED: an alpha cut-out) is
   // judged outside the traversal loop: lavapipe runs both sides of a branch, so a filter in the
@@ -363,6 +366,7 @@ bool traverse(RayData r, uint rootRef, int triangleTexels, float tMax, bool anyH
     if (first == end && ref == 0u && stackSize == 0u) break;
   }
 #endif
+  // clang-format on
   bool found = bestPrimitive != kNoPrimitive;
   // Ended by a break: a hit found for any-hit, a test to redo exactly, or nothing left. (A
   // flag set at each break would not do: the compiler folds it to true, having seen no other

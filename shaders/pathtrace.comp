@@ -276,7 +276,8 @@ LightBvhNode loadLightBvhNode(uint i) {
                       uintBitsToFloat(c.z), c.w, d.x, d.y, d.z, d.w);
 }
 uint lightBvhWord(uint i) {
-  return texelFetch(lightBvhTexels, int(kLightBvhTexels * params.lightBvhNodes + (i >> 2u)))[i & 3u];
+  return texelFetch(lightBvhTexels,
+                    int(kLightBvhTexels * params.lightBvhNodes + (i >> 2u)))[i & 3u];
 }
 uint loadEmitterLeaf(uint emitter) {
   return lightBvhWord(emitter);
@@ -501,9 +502,9 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   // The shading point: material (textures resolved), hit point from the barycentrics (more
   // accurate than origin + t * direction), normals, how it scatters.
   Triangle tri = loadTriangle(hit.triangle);
-  SurfacePoint s = surfacePointAt(
-      hit.triangle, tri, hitBarycentrics(path.origin, path.direction, tri), -path.direction,
-      path.state.rd);
+  SurfacePoint s =
+      surfacePointAt(hit.triangle, tri, hitBarycentrics(path.origin, path.direction, tri),
+                     -path.direction, path.state.rd);
 #ifdef PT_DEBUG_PRINTF
   if (gDebug) {
     debugPrintfEXT(

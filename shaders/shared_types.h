@@ -356,19 +356,19 @@ PT_CONST uint kTextureInvert = 0x10000u;
 PT_CONST uint kTextureFloat = 0x20000u;  // the texture is a float texture (image lookups)
 
 struct TextureNode {
-  vec3 value;      // 12 bytes: constant: its value; image: pbrt-v4's "scale" (all three)
-  uint type;       //  4 bytes: kTexture*
-  vec4 mapping;    // 16 bytes: image, checkerboard: (uscale, vscale, udelta, vdelta), so that
-                   //           (s, t) = (uscale u + udelta, vscale v + vdelta)
-  uint texels;     //  4 bytes: image: its first word in the image buffer
-  uint width;      //  4 bytes: image: texels per row
-  uint height;     //  4 bytes: image: rows (row 0 at the top, where t = 1)
-  uint flags;      //  4 bytes: image: format, wrap, filter, float channel, invert (above)
-  uint decode;     //  4 bytes: image, kTexel8: the first word of its 256 decoded byte values
-  uint count;      //  4 bytes: a texture's first node: the nodes of its program
-  uint levels;     //  4 bytes: image: the first word of its MIP map's table, whose word k is
-                   //           the first word of level k's texels (level 0 is width x height,
-                   //           powers of two; level k halves them, down to 1)
+  vec3 value;           // 12 bytes: constant: its value; image: pbrt-v4's "scale" (all three)
+  uint type;            //  4 bytes: kTexture*
+  vec4 mapping;         // 16 bytes: image, checkerboard: (uscale, vscale, udelta, vdelta), so that
+                        //           (s, t) = (uscale u + udelta, vscale v + vdelta)
+  uint texels;          //  4 bytes: image: its first word in the image buffer
+  uint width;           //  4 bytes: image: texels per row
+  uint height;          //  4 bytes: image: rows (row 0 at the top, where t = 1)
+  uint flags;           //  4 bytes: image: format, wrap, filter, float channel, invert (above)
+  uint decode;          //  4 bytes: image, kTexel8: the first word of its 256 decoded byte values
+  uint count;           //  4 bytes: a texture's first node: the nodes of its program
+  uint levels;          //  4 bytes: image: the first word of its MIP map's table, whose word k is
+                        //           the first word of level k's texels (level 0 is width x height,
+                        //           powers of two; level k halves them, down to 1)
   float maxAnisotropy;  // 4 bytes: image, kTextureEwa: pbrt-v4's "maxanisotropy"
 };                      // 64 bytes
 PT_CONST uint kTextureNodeTexels = 4u;
@@ -409,12 +409,12 @@ PT_CONST uint kRemapRoughness = 1u;  // roughness textures give pbrt-v4's roughn
 // (lavapipe runs both sides of a branch that its lanes take differently).
 PT_CONST uint kTextureUsesReflectance = 1u << 0u;
 PT_CONST uint kTextureUsesTransmittance = 1u << 1u;
-PT_CONST uint kTextureUsesRoughness = 1u << 2u;  // uRoughness or vRoughness
-PT_CONST uint kTextureUsesEtaK = 1u << 3u;       // a conductor's eta or k
-PT_CONST uint kTextureUsesMedium = 1u << 4u;     // coateddiffuse's thickness or g
-PT_CONST uint kTextureUsesPrograms = 1u << 8u;   // a texture of more than one node
-PT_CONST uint kTextureUsesImages = 1u << 9u;     // an image lookup
-PT_CONST uint kTextureUsesEwa = 1u << 10u;       // an image filtered by kTextureEwa
+PT_CONST uint kTextureUsesRoughness = 1u << 2u;    // uRoughness or vRoughness
+PT_CONST uint kTextureUsesEtaK = 1u << 3u;         // a conductor's eta or k
+PT_CONST uint kTextureUsesMedium = 1u << 4u;       // coateddiffuse's thickness or g
+PT_CONST uint kTextureUsesPrograms = 1u << 8u;     // a texture of more than one node
+PT_CONST uint kTextureUsesImages = 1u << 9u;       // an image lookup
+PT_CONST uint kTextureUsesEwa = 1u << 10u;         // an image filtered by kTextureEwa
 PT_CONST uint kTextureUsesFootprints = 1u << 11u;  // filtering over the ray's footprint (paths
                                                    // carry differentials: differentials.h)
 PT_CONST uint kTextureUsesAll = 0xFFFFFFFFu;

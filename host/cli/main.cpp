@@ -42,7 +42,7 @@ struct RenderArgs {
   bool strict = false;      // pbrt-v4 and glTF files: warnings are errors
   std::string camera;       // glTF files: the camera, by index or name
   std::string environment;  // glTF files: an environment image
-  std::string debugPixel;  // "X,Y"
+  std::string debugPixel;   // "X,Y"
   SceneOverrides overrides;
   std::optional<int> spp;
   int threads = 0;

@@ -30,7 +30,7 @@ struct BdptStrategy {
 };
 
 struct CpuRenderOptions : RenderOptions {
-  int threads = 0;  // 0: every CPU this process may run on (its affinity mask)
+  int threads = 0;            // 0: every CPU this process may run on (its affinity mask)
   BdptStrategy bdptStrategy;  // scenes rendered with kIntegratorBdpt
 };
 

@@ -46,7 +46,7 @@ struct RenderSettings {
   std::optional<uint> integrator;  // kIntegrator*
   std::optional<uint> strategy;    // kStrategy*
   std::optional<bool> russianRoulette;
-  std::optional<uint> sampler;  // kSampler*
+  std::optional<uint> sampler;       // kSampler*
   std::optional<uint> lightSampler;  // kLightSampler*
   int maxLeafSize = kDefaultLeafSizeCpu;
   BvhBuilder builder = kDefaultBuilder;

@@ -61,7 +61,7 @@ struct IntegratorSettings {
   bool russianRoulette = true;
   int rrStartDepth = 3;  // Russian roulette from this many scattering events on
   uint strategy = kStrategyMis;
-  uint sampler = kSamplerSobol;  // see docs/accuracy.md for what it buys
+  uint sampler = kSamplerSobol;          // see docs/accuracy.md for what it buys
   uint lightSampler = kLightSamplerBvh;  // pbrt-v4's default
 };
 
