@@ -4,7 +4,7 @@
 #include <cstring>
 
 #include "common/check.h"
-#include "raycast_spv.h"  // kRaycastSpv: shaders/raycast.comp
+#include "vulkan/glsl_compiler.h"
 #include "vulkan/gpu_bvh.h"
 #include "vulkan/resources.h"
 
@@ -46,7 +46,7 @@ std::vector<RayResult> traceRaysVulkan(const Bvh& bvh, const std::vector<RayQuer
   const vk::SpecializationMapEntry stackEntry(PT_SPEC_STACK_ROWS, 0, sizeof(uint32_t));
   const vk::SpecializationInfo spec(1, &stackEntry, sizeof(stackRows), &stackRows);
   const ComputeProgram program =
-      makeComputeProgram(ctx, kRaycastSpv, bound, sizeof(uint32_t), &spec);
+      makeComputeProgram(ctx, compileShader("raycast.comp", ""), bound, sizeof(uint32_t), &spec);
 
   const uint64_t groups = (queries.size() + kRaycastWorkgroupSize - 1) / kRaycastWorkgroupSize;
   PT_CHECK(groups <= ctx.limits.maxComputeWorkGroupCount[0], "too many rays for one dispatch");
