@@ -22,6 +22,7 @@
 #include "cpu/bdpt.h"
 #include "cpu/bounce_random.h"
 #include "cpu/integrator_lanes.h"
+#include "cpu/sppm.h"
 #include "cpu/volpath.h"
 #include "filter.h"
 #include "path_vertex.h"
@@ -198,6 +199,7 @@ vec3 sampleRadianceUntil(const SceneData& scene, uvec2 imagePixel, uint32_t samp
 
 CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film) {
   if (scene.integrator == kIntegratorBdpt) return renderBdpt(scene, options, film);
+  if (scene.integrator == kIntegratorSppm) return renderSppm(scene, options, film);
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
   const auto callStart = std::chrono::steady_clock::now();
