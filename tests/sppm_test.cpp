@@ -156,6 +156,20 @@ TEST(SppmPixelUpdate, MatchesTheFormula) {
   EXPECT_NEAR(L.x, 2.0 + tau.x / (4.0 * 100.0 * M_PI * r * r), 1e-5);
 }
 
+TEST(SppmPhotons, CountOnlyPathsTheDepthAllows) {
+  // A photon's first hit is direct light; later hits count where the camera path's events up
+  // to the visible point and the photon's hits make at most maxDepth scattering events.
+  SppmVisiblePoint vp{};
+  vp.depth = 1;  // seen directly
+  EXPECT_FALSE(sppmPhotonCounts(vp, 0, 5));
+  EXPECT_TRUE(sppmPhotonCounts(vp, 1, 5));
+  EXPECT_TRUE(sppmPhotonCounts(vp, 4, 5));
+  EXPECT_FALSE(sppmPhotonCounts(vp, 5, 5));
+  vp.depth = 3;  // seen through two specular events
+  EXPECT_TRUE(sppmPhotonCounts(vp, 2, 5));
+  EXPECT_FALSE(sppmPhotonCounts(vp, 3, 5));
+}
+
 TEST(SppmPixelUpdate, RenderedRadiiFollowThePhotonCounts) {
   // After a render, each pixel's N is 2/3 of the photons it kept, and its radius follows
   // from N alone where every iteration brought photons: r^2 = r0^2 prod N_k+1 / (N_k + M_k)

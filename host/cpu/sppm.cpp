@@ -82,7 +82,9 @@ void sppmTracePhoton(const SceneData& scene, const PathScene& ps, const SppmGrid
     if (depth > 0u) {
       grid.forWithin(s.p, [&](uint32_t i) {
         SppmPixel& px = pixels[i];
-        px.addPhoton(sppmPhotonFlux(ps, px.vp, beta, -ray.direction));
+        if (sppmPhotonCounts(px.vp, depth, maxDepth)) {
+          px.addPhoton(sppmPhotonFlux(ps, px.vp, beta, -ray.direction));
+        }
       });
     }
     BdptVertex v = bdptSurfaceVertex(s, tri.emitter, key, beta, 0.0f, prev);
@@ -146,7 +148,7 @@ CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& option
         const PathEnd visiblePoint = [&px, maxDepth](const SurfacePoint& s, const VertexKey& key,
                                                      uint depth, vec3 beta) {
           if (!sppmTakesVisiblePoint(s, depth, maxDepth)) return false;
-          px.vp = SppmVisiblePoint{s, key, beta};
+          px.vp = SppmVisiblePoint{s, key, beta, depth};
           px.hasVp = true;
           return true;
         };
