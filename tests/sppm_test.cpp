@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -213,6 +214,28 @@ TEST(SppmRender, SameBitsWithOneAndTwoThreadsAndAgain) {
       std::memcmp(two.pixels.data(), reseeded.pixels.data(), two.pixels.size() * sizeof(vec3)), 0);
 }
 
+TEST(SppmRender, AStopEndsAfterAWholeIteration) {
+  // Stopped as its second iteration starts, the render holds the image of one iteration, bit
+  // for bit.
+  const SceneData scene = sppmTestScene(12, 3, kIntegratorSppm, 15.0f, 2000);
+  const Image one = renderImage(scene, 1);
+  Film film(12, 12);
+  std::atomic<bool> stop{false};
+  CpuRenderOptions options;
+  options.spp = 5;
+  options.threads = 2;
+  options.stop = &stop;
+  options.progress = [&](double done) {
+    if (done > 0.0) stop = true;
+  };
+  const CpuRenderStats stats = renderSppm(scene, options, film);
+  EXPECT_TRUE(stats.stopped);
+  EXPECT_EQ(stats.samplesDone, 1);
+  const Image stopped = film.resolve();
+  EXPECT_EQ(std::memcmp(one.pixels.data(), stopped.pixels.data(), one.pixels.size() * sizeof(vec3)),
+            0);
+}
+
 TEST(SppmConverges, CornellBoxApproachesThePathTracer) {
   // A 16x16 Cornell box of depth 3: the path tracer's image at 4096 samples per pixel is the
   // reference. SPPM's error falls as iterations add up (its radii shrink, its photons grow),
@@ -280,6 +303,15 @@ TEST(SppmCli, ChosenRefusedAndChecked) {
   refused((test::kConfigs / "fog-beam.json").string() + " --backend cpu --integrator sppm" + small +
               (dir / "d.exr").string(),
           "fog-beam.json: the sppm integrator does not render participating media");
+  refused(box + " --backend cpu --integrator sppm --samples 0:1 --out " + (dir / "h.exr").string() +
+              " --checkpoint " + (dir / "h.ptstate").string(),
+          "--checkpoint: the sppm integrator's pixels depend on every iteration before");
+  const test::PtResult converge =
+      test::runPt("converge " + box + " --backend cpu --integrator sppm --reference " +
+                  (dir / "ref.exr").string() + " --csv " + (dir / "c.csv").string());
+  EXPECT_EQ(converge.status, 2);
+  EXPECT_NE(converge.err.find("the sppm integrator's iterations cannot"), std::string::npos)
+      << converge.err;
 
   // JSON: the type with its parameters, and bad ones named by file and field.
   const auto good = withIntegrator(
