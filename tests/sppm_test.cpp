@@ -306,6 +306,8 @@ TEST(SppmCli, ChosenRefusedAndChecked) {
   refused(box + " --backend cpu --integrator sppm --samples 0:1 --out " + (dir / "h.exr").string() +
               " --checkpoint " + (dir / "h.ptstate").string(),
           "--checkpoint: the sppm integrator's pixels depend on every iteration before");
+  refused(box + " --backend cpu --sppm-radius 3" + small + (dir / "i.exr").string(),
+          "--sppm-radius: a parameter of the sppm integrator (give --integrator sppm)");
   const test::PtResult converge =
       test::runPt("converge " + box + " --backend cpu --integrator sppm --reference " +
                   (dir / "ref.exr").string() + " --csv " + (dir / "c.csv").string());

@@ -179,6 +179,11 @@ int runRender(const RenderArgs& args) {
     throw InputError("--strategy " + args.overrides.strategy +
                      ": one strategy of the bdpt integrator (give --integrator bdpt)");
   }
+  if (data.integrator != kIntegratorSppm &&
+      (args.overrides.sppmRadius || args.overrides.sppmPhotons)) {
+    throw InputError(std::string(args.overrides.sppmRadius ? "--sppm-radius" : "--sppm-photons") +
+                     ": a parameter of the sppm integrator (give --integrator sppm)");
+  }
   // Photon mapping's iterations build on each other: one run.
   if (data.integrator == kIntegratorSppm) {
     const char* option = !states.empty() ? (args.resume.empty() ? "--checkpoint" : "--resume")
