@@ -198,18 +198,25 @@ PT_INLINE bool bdptTwoSided(PT_IN(BdptVertex) v) {
   return PT_HAS_TWO_SIDED_EMITTERS && v.s.material.twoSided != 0u;
 }
 
-// The BSDF at surface vertex v from wo to wi (world space; zero for a mirror's delta lobe),
-// for radiance (a camera subpath's vertex) or importance (a light subpath's).
-PT_INLINE vec3 bdptBsdfF(PT_SCENE_PARAM PT_IN(BdptVertex) v, vec3 wo, vec3 wi, bool radiance) {
-  if (v.s.scatter == kScatterMirror) return vec3(0.0f);
-  if (v.s.scatter == kScatterBsdf) {
+// The BSDF at shading point s (its random streams at key) from wo to wi (world space; zero for
+// a mirror's delta lobe), for radiance (a camera subpath's vertex, a photon map's visible point)
+// or importance (a light subpath's, a photon's).
+PT_INLINE vec3 surfaceBsdfF(PT_SCENE_PARAM PT_IN(SurfacePoint) s, VertexKey key, vec3 wo, vec3 wi,
+                            bool radiance) {
+  if (s.scatter == kScatterMirror) return vec3(0.0f);
+  if (s.scatter == kScatterBsdf) {
     return bsdfFTransport(
-        v.s.material, toLocal(v.s.frame, wo), toLocal(v.s.frame, wi), radiance,
-        makeRandomStream(v.key.pixel, v.key.sampleIndex, v.key.dim, PT_PARAMS.seed, kStreamEval));
+        s.material, toLocal(s.frame, wo), toLocal(s.frame, wi), radiance,
+        makeRandomStream(key.pixel, key.sampleIndex, key.dim, PT_PARAMS.seed, kStreamEval));
   }
   // Lambertian about the shading normal, on wo's side of it.
-  bool sameSide = dot(wo, v.ns) * dot(wi, v.ns) > 0.0f;
-  return sameSide ? v.s.material.reflectance * kInvPi : vec3(0.0f);
+  bool sameSide = dot(wo, s.ns) * dot(wi, s.ns) > 0.0f;
+  return sameSide ? s.material.reflectance * kInvPi : vec3(0.0f);
+}
+
+// The BSDF at surface vertex v from wo to wi (surfaceBsdfF).
+PT_INLINE vec3 bdptBsdfF(PT_SCENE_PARAM PT_IN(BdptVertex) v, vec3 wo, vec3 wi, bool radiance) {
+  return surfaceBsdfF(PT_SCENE_ARG v.s, v.key, wo, wi, radiance);
 }
 
 // The solid-angle density with which the BSDF at surface vertex v samples wi given wo.

@@ -363,6 +363,15 @@ MediumInterface loadMediumInterface(uint primitive) {
 #define PT_MEDIUM_KINDS kMediumKinds
 #include "volume_vertex.h"
 #endif
+#ifdef PT_CHECK_LIGHT_PATHS
+// The headers of bidirectional path tracing and photon mapping, which no shader calls yet
+// (docs/bdpt.md, docs/sppm.md): the build compiles them here, every effect on, so that they
+// stay GLSL.
+#include "bdpt_camera.h"
+#include "bdpt_vertex.h"
+#include "bdpt_connect.h"
+#include "sppm_vertex.h"
+#endif
 
 // A ray whose first traversal gave up at an edge function of exactly zero (traceRayWith in
 // bvh.glsl), traced again with the exact test once the bounce is done (main): a shadow ray,

@@ -588,7 +588,7 @@ TEST(PbrtCamera, DefaultsAndOptionsAsPbrtV4) {
   scene = load(
       "Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 24 \"float iso\" 100\n"
       "Sampler \"halton\" \"integer pixelsamples\" 64 \"integer seed\" 7\n"
-      "Integrator \"sppm\" \"integer maxdepth\" 12\nPixelFilter \"gaussian\"\n"
+      "Integrator \"lightpath\" \"integer maxdepth\" 12\nPixelFilter \"gaussian\"\n"
       "Camera \"perspective\" \"float lensradius\" 0.1 \"float focaldistance\" 5\n"
       "WorldBegin\n" +
       std::string(kTriangle));
@@ -602,9 +602,10 @@ TEST(PbrtCamera, DefaultsAndOptionsAsPbrtV4) {
   EXPECT_EQ(scene.camera.focalDistance, 5.0f);
   std::string joined;
   for (const std::string& w : scene.warnings) joined += w + "\n";
-  EXPECT_EQ(joined,
-            "scene.pbrt:3: Integrator 'sppm' is rendered with the path tracer (\"path\": light "
-            "and BSDF sampling with MIS)\n");
+  EXPECT_EQ(
+      joined,
+      "scene.pbrt:3: Integrator 'lightpath' is rendered with the path tracer (\"path\": light "
+      "and BSDF sampling with MIS)\n");
   EXPECT_EQ(scene.integrator.integrator, kIntegratorPath);
   scene = load(std::string(kUnmirrored) + kTriangle + "Shape \"sphere\" \"float radiuss\" 1\n");
   EXPECT_EQ(scene.warnings.at(1),

@@ -32,6 +32,11 @@ int runConvergeCommand(const ConvergeArgs& args) {
   // The same overrides as `pt render`.
   const RenderSettings settings = args.overrides.toSettings(args.backend);
   const SceneData data = prepareScene(std::move(scene), settings);
+  if (data.integrator == kIntegratorSppm) {
+    throw InputError(args.scene +
+                     ": converge adds samples to a render, which the sppm integrator's "
+                     "iterations cannot (render each count with pt render instead)");
+  }
   const Camera& cam = data.params.camera;
 
   const Image reference = readImage(args.reference);

@@ -21,6 +21,7 @@
 #include "common/named_values.h"
 #include "cpu/bdpt.h"
 #include "cpu/integrator.h"
+#include "cpu/sppm.h"
 #include "image/film_state.h"
 #include "image/image.h"
 #include "render/prepare.h"
@@ -144,6 +145,7 @@ int runRender(const RenderArgs& args) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
+  args.overrides.applySppm(scene);
   RenderSettings settings = args.overrides.toSettings(args.backend);
   settings.spp = args.spp;  // unset: the scene's
   // A film too large for memory is refused before the BVH build and the device start-up, with
@@ -153,16 +155,21 @@ int runRender(const RenderArgs& args) {
       args.scene + (settings.width || settings.height ? ": with --width/--height, " : ": "));
   const SceneData data = prepareScene(std::move(scene), settings);
 
-  // The bidirectional path tracer: on the CPU, for what it renders (cpu/bdpt.h).
+  // The integrators of the CPU reference alone, for what they render: bidirectional path
+  // tracing (cpu/bdpt.h) and photon mapping (cpu/sppm.h), whose photons start as BDPT's light
+  // subpaths.
   const std::optional<BdptStrategy> bdptStrategy = parseBdptStrategy(args.overrides.strategy);
-  if (data.integrator == kIntegratorBdpt) {
+  const std::string integrator(nameOf(kIntegratorNames, data.integrator));
+  if (data.integrator != kIntegratorPath) {
     if (args.backend != "cpu") {
-      throw InputError(args.scene +
-                       ": the bdpt integrator runs on the CPU only: its GPU version is not there "
-                       "yet (render with --backend cpu, or --integrator path)");
+      throw InputError(args.scene + ": the " + integrator +
+                       " integrator runs on the CPU only: its GPU version is not there yet "
+                       "(render with --backend cpu, or --integrator path)");
     }
-    checkBdptScene(data, args.scene);
+    checkBdptScene(data, args.scene, integrator);
     if (!args.debugPixel.empty()) throw InputError("--debug-pixel: the path integrator's only");
+  }
+  if (data.integrator == kIntegratorBdpt) {
     if (bdptMaxDepth(data) < data.params.maxDepth) {
       std::fprintf(stderr,
                    "warning: %s: maximum depth %u is above the bdpt integrator's limit: %u\n",
@@ -171,6 +178,24 @@ int runRender(const RenderArgs& args) {
   } else if (bdptStrategy) {
     throw InputError("--strategy " + args.overrides.strategy +
                      ": one strategy of the bdpt integrator (give --integrator bdpt)");
+  }
+  if (data.integrator != kIntegratorSppm &&
+      (args.overrides.sppmRadius || args.overrides.sppmPhotons)) {
+    throw InputError(std::string(args.overrides.sppmRadius ? "--sppm-radius" : "--sppm-photons") +
+                     ": a parameter of the sppm integrator (give --integrator sppm)");
+  }
+  // Photon mapping's iterations build on each other: one run.
+  if (data.integrator == kIntegratorSppm) {
+    const char* option = !states.empty() ? (args.resume.empty() ? "--checkpoint" : "--resume")
+                         : sliceArg      ? "--samples"
+                         : task          ? "--task-index"
+                                         : nullptr;
+    if (option) {
+      throw InputError(std::string(option) +
+                       ": the sppm integrator's pixels depend on every iteration before, so its "
+                       "render cannot be checkpointed, resumed, split or merged (render it in "
+                       "one run)");
+    }
   }
 
   const Camera& cam = data.params.camera;
@@ -355,13 +380,20 @@ int runRender(const RenderArgs& args) {
     for (const auto& path : images) writeImage(image, path);
   }
 
+  // Photon mapping's estimate is consistent (it converges as its radii shrink), not unbiased.
+  std::string integratorInfo = integrator;
+  if (data.integrator == kIntegratorSppm) {
+    char radius[32];
+    std::snprintf(radius, sizeof radius, "%g", double(data.sppm.radius));
+    integratorInfo += " estimator=consistent(biased) photons_per_iteration=" +
+                      std::to_string(sppmPhotonsPerIteration(data)) + " radius=" + radius;
+  }
   std::printf(
       "%s integrator=%s resolution=%ux%u spp=%u seconds=%.3f Mrays/s=%.3f effects=%s "
       "triangles=%zu "
       "load_s=%.3f bvh_builder=%s bvh_nodes=%zu bvh_build_s=%.4f bvh_sah_cost=%.2f "
       "peak_rss_mib=%.0f invalid_samples=%llu\n",
-      backendInfo.c_str(), std::string(nameOf(kIntegratorNames, data.integrator)).c_str(),
-      cam.width, cam.height, spp, stats.seconds,
+      backendInfo.c_str(), integratorInfo.c_str(), cam.width, cam.height, spp, stats.seconds,
       stats.seconds > 0.0 ? double(stats.rays) / stats.seconds * 1e-6 : 0.0, effects.c_str(),
       data.bvh.triangles.size(), loadSeconds,
       std::string(nameOf(kBuilderNames, settings.builder)).c_str(), data.bvh.nodes.size(),
@@ -474,6 +506,14 @@ void addOverrideOptions(CLI::App* cmd, SceneOverrides& o) {
                   "How light sampling chooses a light: " + describeNames(kLightSamplerNames) +
                       "; default: the scene's (pbrt-v4's: bvh)")
       ->check(CLI::IsMember(namesOf(kLightSamplerNames)));
+  cmd->add_option("--sppm-radius", o.sppmRadius,
+                  "The sppm integrator's initial search radius, in scene units (default: the "
+                  "scene's, else pbrt-v4's 1)")
+      ->check(kPositive);
+  cmd->add_option("--sppm-photons", o.sppmPhotons,
+                  "Photons per iteration of the sppm integrator (default: the scene's, else one "
+                  "per pixel)")
+      ->check(CLI::Range(int64_t(1), kSppmMaxPhotonsPerIteration));
 }
 
 }  // namespace

@@ -20,6 +20,14 @@ struct SceneOverrides {
   std::string integrator, strategy, roulette, sampler, lightSampler;
   std::string builder{nameOf(kBuilderNames, kDefaultBuilder)};
   std::string intersection{nameOf(kIntersectionNames, false)};
+  std::optional<float> sppmRadius;  // the sppm integrator's parameters; unset: the scene's
+  std::optional<int64_t> sppmPhotons;
+
+  // Sets the scene's sppm parameters that were given.
+  void applySppm(Scene& scene) const {
+    if (sppmRadius) scene.integrator.sppm.radius = *sppmRadius;
+    if (sppmPhotons) scene.integrator.sppm.photonsPerIteration = *sppmPhotons;
+  }
 
   // The names were validated against the same tables when the command line was parsed.
   // `backend`: "cpu" or "vulkan", for the defaults that differ between them.

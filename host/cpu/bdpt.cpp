@@ -98,9 +98,10 @@ std::optional<BdptStrategy> parseBdptStrategy(const std::string& text) {
   return BdptStrategy{s, t};
 }
 
-void checkBdptScene(const SceneData& scene, const std::string& what) {
+void checkBdptScene(const SceneData& scene, const std::string& what,
+                    const std::string& integrator) {
   auto refuse = [&](const std::string& why) {
-    throw InputError(what + ": the bdpt integrator does not render " + why +
+    throw InputError(what + ": the " + integrator + " integrator does not render " + why +
                      " yet (use the path integrator)");
   };
   if (scene.effects.media || scene.params.mediaPresent != 0u) refuse("participating media");

@@ -21,8 +21,10 @@ namespace pt {
 std::optional<BdptStrategy> parseBdptStrategy(const std::string& text);
 
 // Throws InputError naming `what` (the scene file) where the scene asks for what the
-// bidirectional path tracer does not do yet: participating media, sphere lights.
-void checkBdptScene(const SceneData& scene, const std::string& what);
+// integrators that trace light subpaths (bdpt, and sppm's photons: `integrator`) do not do yet:
+// participating media, sphere lights.
+void checkBdptScene(const SceneData& scene, const std::string& what,
+                    const std::string& integrator = "bdpt");
 
 // The maximum depth BDPT renders with: the scene's, at most kBdptMaxDepth.
 uint bdptMaxDepth(const SceneData& scene);

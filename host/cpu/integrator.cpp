@@ -22,6 +22,7 @@
 #include "cpu/bdpt.h"
 #include "cpu/bounce_random.h"
 #include "cpu/integrator_lanes.h"
+#include "cpu/sppm.h"
 #include "cpu/volpath.h"
 #include "filter.h"
 #include "path_vertex.h"
@@ -110,6 +111,11 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
   if (scene.params.mediaPresent != 0u) {
     return sampleRadianceVolume(scene, imagePixel, sampleIndex, rays, debugPrint);
   }
+  return sampleRadianceUntil(scene, imagePixel, sampleIndex, rays, nullptr, debugPrint);
+}
+
+vec3 sampleRadianceUntil(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
+                         uint64_t& rays, const PathEnd* end, bool debugPrint) {
   const RenderParams& params = scene.params;
   const PathScene ps = scene.pathScene();  // the arrays path_vertex.h reads
   // The film's pixel, which the random numbers and the camera ray are of: a crop renders its
@@ -124,6 +130,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
   const CameraSample camera = cameraSampleOf(params.camera, sobol, pixel, sampleIndex, seed);
   Ray ray{camera.origin, camera.direction};
   PathState path = cameraPathState(ps, camera);  // L, beta, etaScale, bsdfPdf, specularBounce
+  bool ending = false;                           // `end` has asked: the path's last ray
 
   for (uint depth = 0;;) {
     // Find the closest surface along the ray.
@@ -150,10 +157,11 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
     // Add emitted light found by this ray, weighed against light sampling (MIS).
     addEmissionFound(ps, path, tri, s, hit->t, ray.origin);
 
-    // Stop after maxDepth scattering events.
-    if (depth == params.maxDepth) break;
+    // Stop after maxDepth scattering events (or where `end` asked).
+    if (depth == params.maxDepth || ending) break;
     const VertexKey key{pixel, sampleIndex, kDimFirstBounce + kDimsPerBounce * depth};
     ++depth;
+    if (end != nullptr) ending = (*end)(s, key, depth, path.beta * camera.weight);
     // This event's random numbers, all four dimensions at once (the shader draws each where
     // it is used: the same numbers).
     const BounceRandom u = bounceRandomSimd(sobol, pixel, sampleIndex, key.dim, seed);
@@ -191,6 +199,7 @@ vec3 sampleRadiance(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInd
 
 CpuRenderStats renderCpu(const SceneData& scene, const CpuRenderOptions& options, Film& film) {
   if (scene.integrator == kIntegratorBdpt) return renderBdpt(scene, options, film);
+  if (scene.integrator == kIntegratorSppm) return renderSppm(scene, options, film);
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
   const auto callStart = std::chrono::steady_clock::now();

@@ -11,10 +11,12 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 
 #include "bvh/traverse.h"
 #include "image/image.h"
+#include "path_vertex.h"
 #include "render/prepare.h"
 #include "render/render_options.h"
 
@@ -53,6 +55,19 @@ Ray cameraRay(const Camera& camera, vec2 filmPoint);
 // --debug-pixel format.
 vec3 sampleRadiance(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
                     bool debugPrint = false);
+
+// Asked at each scattering vertex of a path (shading point s, its random numbers' key, after
+// `depth` scattering events counting this one, beta: the path's throughput up to s times the
+// camera sample's weight), before its light sample: true makes the path's next ray its last,
+// which adds the emission it finds (weighed against the light sample, MIS) and ends the path.
+using PathEnd =
+    std::function<bool(const SurfacePoint& s, const VertexKey& key, uint depth, vec3 beta)>;
+
+// sampleRadiance's path on a surface-only scene, ended early where `end` (unless null) asks:
+// stochastic progressive photon mapping's camera paths (cpu/sppm.h), which end past their
+// visible point.
+vec3 sampleRadianceUntil(const SceneData& scene, uvec2 pixel, uint32_t sampleIndex, uint64_t& rays,
+                         const PathEnd* end, bool debugPrint = false);
 
 // The closest surface along a path's ray after `depth` scattering events, and on a shadow ray's
 // segment t in [0, 1) whose light sample drew uLight; alpha cut-outs passed by. A path ray is

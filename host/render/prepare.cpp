@@ -252,6 +252,7 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   const IntegratorSettings& integ = scene.integrator;
   data.spp = settings.spp.value_or(integ.spp);
   data.integrator = settings.integrator.value_or(integ.integrator);
+  data.sppm = integ.sppm;
   data.materials = scene.materials;
   data.normals = std::move(scene.normals);
   PT_CHECK(data.normals.empty() || data.normals.size() == scene.triangles.size());

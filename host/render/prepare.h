@@ -171,6 +171,7 @@ struct SceneData {
   RenderParams params{};
   int spp = 0;
   uint integrator = kIntegratorPath;  // kIntegrator* (common/named_values.h)
+  SppmSettings sppm;                  // kIntegratorSppm's parameters
   EffectSet effects;
   vec3 shift{0.0f};        // subtracted from every coordinate of a scene far from the origin
   LazyCpuSceneCopies cpu;  // of bvh; through cpuCopies() and wideBvh()

@@ -232,13 +232,32 @@ IntegratorSettings readIntegrator(const JsonNode& node) {
   // "integrator": "bdpt" names the algorithm alone.
   if (node.json().is_string()) {
     s.integrator = readChoice(node, kIntegratorNames, "integrator");
+    if (s.integrator == kIntegratorSppm) s.maxDepth = kSppmDefaultMaxDepth;
     return s;
   }
   node.checkKeys({"type", "spp", "maxDepth", "seed", "russianRoulette", "rrStartDepth", "strategy",
-                  "sampler", "lightSampler"});
+                  "sampler", "lightSampler", "radius", "photonsperiteration"});
   if (auto n = node.find("type")) s.integrator = readChoice(*n, kIntegratorNames, "type");
   if (auto n = node.find("spp")) s.spp = static_cast<int>(n->integer(1, kIntMax));
+  if (s.integrator == kIntegratorSppm) s.maxDepth = kSppmDefaultMaxDepth;
   if (auto n = node.find("maxDepth")) s.maxDepth = static_cast<int>(n->integer(0, kIntMax));
+  // Photon mapping's parameters, by pbrt-v4's names: for it alone.
+  for (const char* key : {"radius", "photonsperiteration"}) {
+    if (auto n = node.find(key); n && s.integrator != kIntegratorSppm) {
+      n->fail("is a parameter of the sppm integrator (\"type\": \"sppm\")");
+    }
+  }
+  if (auto n = node.find("radius")) {
+    const double r = n->floatNumber();
+    if (!(r > 0.0)) n->fail("the initial search radius must be positive, got " + n->describe());
+    s.sppm.radius = static_cast<float>(r);
+  }
+  if (auto n = node.find("photonsperiteration")) {
+    s.sppm.photonsPerIteration = n->integer(-1, kSppmMaxPhotonsPerIteration);
+    if (s.sppm.photonsPerIteration == 0) {
+      n->fail("must be positive, or -1 for one photon per pixel of the image");
+    }
+  }
   if (auto n = node.find("seed")) s.seed = static_cast<uint>(n->integer(0, 0xFFFFFFFFll));
   if (auto n = node.find("russianRoulette")) s.russianRoulette = n->boolean();
   if (auto n = node.find("rrStartDepth")) {

@@ -53,6 +53,17 @@ struct CameraDesc {
 };
 
 // Integrator settings from the scene's "integrator" object (command-line flags override).
+// Stochastic progressive photon mapping's own parameters (pbrt-v4's SPPMIntegrator, docs/sppm.md).
+// pbrt-v4's defaults: maxdepth 5 (where the scene gives none) and the largest photon count one
+// iteration traces (photons are numbered by 32-bit integers).
+inline constexpr int kSppmDefaultMaxDepth = 5;
+inline constexpr int64_t kSppmMaxPhotonsPerIteration = 0xFFFFFFFFll;
+
+struct SppmSettings {
+  float radius = 1.0f;               // the initial search radius, in scene units
+  int64_t photonsPerIteration = -1;  // photons traced per iteration; -1: the image's pixel count
+};
+
 struct IntegratorSettings {
   uint integrator = kIntegratorPath;  // common/named_values.h's kIntegrator*
   int spp = 16;
@@ -63,6 +74,7 @@ struct IntegratorSettings {
   uint strategy = kStrategyMis;
   uint sampler = kSamplerSobol;          // see docs/accuracy.md for what it buys
   uint lightSampler = kLightSamplerBvh;  // pbrt-v4's default
+  SppmSettings sppm;                     // kIntegratorSppm
 };
 
 // An infinite light whose radiance is an image over the directions (shaders/environment.h):

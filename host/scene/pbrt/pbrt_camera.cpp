@@ -240,14 +240,35 @@ void Builder::options(Statement& s) {
     }
     p.string("randomization");  // which scrambling: the noise's pattern, not the image
   } else if (d == "Integrator") {
-    const bool known = type == "path" || type == "volpath" || type == "bdpt";
+    const bool known = type == "path" || type == "volpath" || type == "bdpt" || type == "sppm";
     if (!known) {
       warnOnce("Integrator", s.location,
                "Integrator " + singleQuoted(type) +
                    " is rendered with the path tracer (\"path\": light and BSDF sampling with "
                    "MIS)");
     }
-    scene_.integrator.integrator = type == "bdpt" ? kIntegratorBdpt : kIntegratorPath;
+    scene_.integrator.integrator = type == "bdpt"   ? kIntegratorBdpt
+                                   : type == "sppm" ? kIntegratorSppm
+                                                    : kIntegratorPath;
+    if (type == "sppm") {
+      // pbrt-v4's SPPMIntegrator::Create: its own parameters and its seed.
+      SppmSettings& sppm = scene_.integrator.sppm;
+      if (auto v = p.bounded("radius", 0.0, true, INFINITY, true, "a positive radius")) {
+        sppm.radius = static_cast<float>(*v);
+      }
+      if (auto v = p.integer("photonsperiteration")) {
+        if (*v == 0 || *v < -1) {
+          fail(p.find("photonsperiteration")->location,
+               "photonsperiteration must be positive, or -1 for one photon per pixel, got " +
+                   std::to_string(*v));
+        }
+        sppm.photonsPerIteration = *v;
+      }
+      if (auto v = p.integer("seed")) {
+        if (*v < 0) fail(p.find("seed")->location, "seed must not be negative");
+        scene_.integrator.seed = static_cast<uint>(*v);
+      }
+    }
     if (type == "bdpt") {
       // pbrt-v4's debugging outputs: --strategy renders one strategy alone instead.
       for (const char* name : {"visualizestrategies", "visualizeweights"}) {

@@ -1,0 +1,217 @@
+// The CPU reference's stochastic progressive photon mapping: the outline of pbrt-v4's
+// SPPMIntegrator::Render over shaders/sppm_vertex.h's steps. The camera paths are the path tracer's
+// (sampleRadianceUntil), ended past their visible point; the photons start as BDPT's light
+// subpaths do (sampleBdptLightStart) and scatter by bdptScatter for importance. What is this
+// file's own is the schedule: the passes of an iteration across threads, the pixels' state, and
+// the exact sums that make the image independent of the order photons arrive in.
+#include "cpu/sppm.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "bdpt_vertex.h"
+#include "bvh/workers.h"
+#include "common/check.h"
+#include "cpu/bounce_random.h"
+#include "cpu/sppm_grid.h"
+#include "image/exact_sum.h"
+#include "sppm_vertex.h"
+
+namespace pt {
+namespace {
+
+// One pixel's state across iterations, and what the iteration under way gathers for it.
+struct SppmPixel {
+  SppmPixelState state;
+  vec3 ldSum{0.0f};   // the direct light of the iterations done, summed
+  vec3 ldPass{0.0f};  // this iteration's
+  SppmVisiblePoint vp;
+  bool hasVp = false;
+  // The photons' flux this iteration, summed exactly (any order, the same bits), and their
+  // count; `lock` guards both.
+  std::array<ExactSum, 3> phi;
+  uint32_t m = 0;
+  bool invalid = false;  // a photon brought NaN or infinite flux: the pixel's estimate is invalid
+  std::atomic_flag lock;
+
+  void addPhoton(vec3 flux) {
+    while (lock.test_and_set(std::memory_order_acquire)) {
+    }
+    if (std::isfinite(flux.x) && std::isfinite(flux.y) && std::isfinite(flux.z)) {
+      for (int c = 0; c < 3; ++c) phi[size_t(c)].add(flux[c]);
+    } else {
+      invalid = true;
+    }
+    ++m;
+    lock.clear(std::memory_order_release);
+  }
+};
+
+// Traces photon `photon` of iteration `iteration` (pbrt-v4's photon path): a light chosen by
+// power and its emission (sampleBdptLightStart), then up to maxDepth surface hits, each after
+// the first adding its flux to the visible points within their radius, each scattered by the
+// BSDF for importance and continued by Russian roulette.
+void sppmTracePhoton(const SceneData& scene, const PathScene& ps, const SppmGrid& grid,
+                     std::vector<SppmPixel>& pixels, uint photon, uint iteration, uint maxDepth,
+                     uint64_t& rays) {
+  const RenderParams& params = scene.params;
+  const bool sobol = params.samplerType == kSamplerSobol;
+  const Intersection test =
+      params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
+  const VertexKey start = sppmPhotonKey(photon, iteration, 0u);
+  const BounceRandom u0 = bounceRandomSimd(sobol, start.pixel, iteration, start.dim, params.seed);
+  const BdptLightStart light =
+      sampleBdptLightStart(ps, u0.lightChoose, u0.lightPoint, u0.bsdf, start);
+  if (!light.found) return;
+  vec3 beta = light.beta;
+  Ray ray{light.origin, light.direction};
+  BdptVertex prev = light.vertex;
+  for (uint depth = 0; depth < maxDepth; ++depth) {
+    const VertexKey key = sppmPhotonKey(photon, iteration, depth + 1u);
+    ++rays;
+    const std::optional<Hit> hit = closestSurface(scene, ray, test, key.pixel, iteration, key.dim);
+    if (!hit) break;
+    const Triangle& tri = scene.bvh.triangles[hit->triangle];
+    const SurfacePoint s = surfacePointAt(ps, hit->triangle, tri, hit->barycentrics, -ray.direction,
+                                          noRayDifferential());
+    // The first hit is direct light, which the camera paths' light samples count.
+    if (depth > 0u) {
+      grid.forWithin(s.p, [&](uint32_t i) {
+        SppmPixel& px = pixels[i];
+        if (sppmPhotonCounts(px.vp, depth, maxDepth)) {
+          px.addPhoton(sppmPhotonFlux(ps, px.vp, beta, -ray.direction));
+        }
+      });
+    }
+    BdptVertex v = bdptSurfaceVertex(s, tri.emitter, key, beta, 0.0f, prev);
+    const BounceRandom u = bounceRandomSimd(sobol, key.pixel, iteration, key.dim, params.seed);
+    vec3 betaNew = beta;
+    float pdf;
+    vec3 wi;
+    if (!bdptScatter(ps, v, prev, u.roulette.y, u.bsdf, /*radiance=*/false, betaNew, pdf, wi)) {
+      break;
+    }
+    if (!sppmPhotonSurvives(beta, betaNew, u.roulette.x)) break;
+    prev = v;
+    ray = Ray{nextRayOrigin(s, wi), wi};
+  }
+}
+
+}  // namespace
+
+uint32_t sppmPhotonsPerIteration(const SceneData& scene) {
+  const int64_t n = scene.sppm.photonsPerIteration;
+  if (n > 0) return uint32_t(n);
+  return uint32_t(scene.params.camera.width) * uint32_t(scene.params.camera.height);
+}
+
+CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& options, Film& film,
+                          std::vector<SppmPixelReport>* report) {
+  const Camera& cam = scene.params.camera;
+  PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
+  PT_CHECK(options.firstSample == 0u, "SPPM's iterations cannot start midway");
+  PT_CHECK(scene.params.mediaPresent == 0u, "SPPM renders no media (checkBdptScene)");
+  const auto callStart = std::chrono::steady_clock::now();
+  scene.cpuCopies();  // built here on a first render: set-up, not render time
+  const auto start = std::chrono::steady_clock::now();
+  CpuRenderStats stats;
+  stats.threads = options.threads > 0 ? options.threads : availableCpus();
+  Workers workers(stats.threads);
+
+  const PathScene ps = scene.pathScene();
+  const uint maxDepth = scene.params.maxDepth;
+  const uint32_t photons = sppmPhotonsPerIteration(scene);
+  const size_t pixelCount = film.pixelCount();
+  std::vector<SppmPixel> pixels(pixelCount);
+  for (SppmPixel& px : pixels) px.state = sppmStartPixel(scene.sppm.radius);
+  std::vector<vec3> points(pixelCount);
+  std::vector<float> radii(pixelCount);
+  std::vector<char> present(pixelCount);
+  std::atomic<uint64_t> totalRays{0};
+  auto stopRequested = [&] {
+    return options.stop && options.stop->load(std::memory_order_relaxed);
+  };
+
+  int done = 0;
+  for (int iteration = 0; iteration < options.spp && !stopRequested(); ++iteration) {
+    // The camera pass: each pixel's path (the path tracer's, with its random numbers of
+    // sample index `iteration`) to its visible point, and the direct light on the way.
+    workers.forChunks(pixelCount, 64, [&](size_t begin, size_t end) {
+      uint64_t rays = 0;
+      for (size_t i = begin; i < end && !stopRequested(); ++i) {
+        SppmPixel& px = pixels[i];
+        px.hasVp = false;
+        const PathEnd visiblePoint = [&px, maxDepth](const SurfacePoint& s, const VertexKey& key,
+                                                     uint depth, vec3 beta) {
+          if (!sppmTakesVisiblePoint(s, depth, maxDepth)) return false;
+          px.vp = SppmVisiblePoint{s, key, beta, depth};
+          px.hasVp = true;
+          return true;
+        };
+        const uvec2 pixel(uint32_t(i % size_t(film.width)), uint32_t(i / size_t(film.width)));
+        px.ldPass = sampleRadianceUntil(scene, pixel, uint32_t(iteration), rays, &visiblePoint);
+      }
+      totalRays += rays;
+    });
+    if (stopRequested()) break;
+
+    // The grid over the visible points that carry light to their pixel.
+    for (size_t i = 0; i < pixelCount; ++i) {
+      const SppmPixel& px = pixels[i];
+      present[i] = px.hasVp && px.vp.beta != vec3(0.0f);
+      points[i] = px.vp.s.p;
+      radii[i] = px.state.radius;
+    }
+    const SppmGrid grid(points, radii, present);
+
+    // The photon pass.
+    workers.forChunks(photons, 256, [&](size_t begin, size_t end) {
+      uint64_t rays = 0;
+      for (size_t p = begin; p < end && !stopRequested(); ++p) {
+        sppmTracePhoton(scene, ps, grid, pixels, uint(p), uint(iteration), maxDepth, rays);
+      }
+      totalRays += rays;
+    });
+    if (stopRequested()) break;
+
+    // Every pixel's update from the photons it gathered.
+    for (SppmPixel& px : pixels) {
+      const vec3 phi(float(px.phi[0].toDouble()), float(px.phi[1].toDouble()),
+                     float(px.phi[2].toDouble()));
+      px.state = sppmUpdatePixel(px.state, phi, px.m);
+      px.ldSum += px.ldPass;
+      px.phi = {};
+      px.m = 0;
+    }
+    done = iteration + 1;
+    if (options.progress) options.progress(double(done) / double(options.spp));
+  }
+
+  // Each pixel's estimate, as its one sample.
+  if (done > 0) {
+    for (size_t i = 0; i < pixelCount; ++i) {
+      const SppmPixel& px = pixels[i];
+      // (A pixel that took invalid flux is counted as an invalid sample by the film.)
+      const vec3 L = px.invalid
+                         ? vec3(NAN)
+                         : sppmPixelRadiance(px.ldSum, px.state, float(done), float(photons));
+      film.add(int(i % size_t(film.width)), int(i / size_t(film.width)), L);
+    }
+  }
+  if (report) {
+    report->resize(pixelCount);
+    for (size_t i = 0; i < pixelCount; ++i) {
+      const SppmPixel& px = pixels[i];
+      (*report)[i] = SppmPixelReport{px.state.radius, px.state.n, px.state.tau, px.ldSum};
+    }
+  }
+  stats.samplesDone = done;
+  finishCpuRenderStats(options, film, totalRays, start, callStart, stats);
+  return stats;
+}
+
+}  // namespace pt
