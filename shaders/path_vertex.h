@@ -307,6 +307,7 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
     ns = interpolatedNormal(normals, b, ng);
     n = dot(ns, wo) >= 0.0f ? ns : -ns;
   }
+  bool vertexNormals = shadingNormals;
   bool bumped = PT_HAS_BUMP_MAPS && textured && textures.displacement != kNoTexture;
   // The vertex normals' changes along u and v: for a bump map and for the differentials of
   // specular bounces.
@@ -329,11 +330,13 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
       n = dot(ns, wo) >= 0.0f ? ns : -ns;
     }
   }
-  // A normal map (glTF's normalTexture) replaces it (texture.h).
+  // A normal map (glTF's normalTexture) replaces it (texture.h), in the frame of the vertices'
+  // tangents where the mesh has them.
   if (PT_HAS_TEXTURES && PT_TEXTURE_USES(kTextureUsesNormalMap) && textured &&
       textures.normalMap != kNoTexture) {
+    vec4 tangent = vertexNormals ? interpolatedTangent(normals, b) : vec4(0.0f);
     ns = normalMappedNormal(PT_SCENE_TEXTURES textures.normalMap, textures.normalScale, derivatives,
-                            uv, ns);
+                            tangent, uv, ns);
     shadingNormals = true;
     n = dot(ns, wo) >= 0.0f ? ns : -ns;
   }

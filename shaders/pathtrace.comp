@@ -254,10 +254,11 @@ Material loadMaterial(uint i) {
 #ifndef PT_NO_BSDF_MATERIALS
 TriangleNormals loadNormals(uint primitive) {
   int at = int(3u * primitive);
-  vec4 a = uintBitsToFloat(texelFetch(normalTexels, at));
-  vec4 b = uintBitsToFloat(texelFetch(normalTexels, at + 1));
-  vec4 c = uintBitsToFloat(texelFetch(normalTexels, at + 2));
-  return TriangleNormals(a.xyz, a.w, b.xyz, b.w, c.xyz, c.w);
+  uvec4 a = texelFetch(normalTexels, at);
+  uvec4 b = texelFetch(normalTexels, at + 1);
+  uvec4 c = texelFetch(normalTexels, at + 2);
+  return TriangleNormals(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
+                         uintBitsToFloat(c.xyz), c.w);
 }
 #endif
 

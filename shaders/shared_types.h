@@ -144,14 +144,16 @@ PT_CONST uint kMaterialTexels = 6u;  // 16-byte texels per Material (the GPU rea
 
 // The vertex normals of one triangle, for shading normals, in the scene's load order (indexed by
 // Triangle::primitive). Unit length, in world space. Uploaded only where some mesh has normals.
+// With them, the vertices' tangents where the mesh gives them (glTF's TANGENT, for normal
+// maps), each packed in a word (texture.h's packTangent; zero: none).
 struct TriangleNormals {
-  vec3 n0;          // 12 bytes: at v0
-  float reserved0;  //  4 bytes: zero
-  vec3 n1;          // 12 bytes: at v1
-  float reserved1;  //  4 bytes
-  vec3 n2;          // 12 bytes: at v2
-  float reserved2;  //  4 bytes
-};                  // 48 bytes
+  vec3 n0;        // 12 bytes: at v0
+  uint tangent0;  //  4 bytes: at v0, packed
+  vec3 n1;        // 12 bytes: at v1
+  uint tangent1;  //  4 bytes
+  vec3 n2;        // 12 bytes: at v2
+  uint tangent2;  //  4 bytes
+};                // 48 bytes
 
 // One entry of the emitter alias table (Walker 1977, Vose 1991): emitter i is picked with
 // probability pmf; sampling draws a slot uniformly and keeps it with probability

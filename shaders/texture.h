@@ -659,19 +659,62 @@ PT_INLINE vec3 bumpedNormal(PT_TEXTURES_PARAM uint displacement, TriangleDerivat
 
 // ---- Normal maps -------------------------------------------------------------------------
 
+// A vertex's tangent (glTF's TANGENT: a direction and the sign w of its bitangent) in one word
+// (TriangleNormals::tangent*): bit 31 set (zero is no tangent), bit 30 for w < 0, and the
+// direction's octahedral coordinates in 15 bits each (bits 15-29 and 0-14; within 2e-4
+// radians).
+#ifdef __cplusplus
+inline uint packTangent(vec3 t, float w) {
+  float l1 = abs(t.x) + abs(t.y) + abs(t.z);
+  if (!(l1 > 0.0f) || !(l1 < 3.0e38f)) return 0u;
+  vec3 o = t / l1;
+  float x = o.x, y = o.y;
+  if (o.z < 0.0f) {
+    x = (1.0f - abs(o.y)) * (o.x >= 0.0f ? 1.0f : -1.0f);
+    y = (1.0f - abs(o.x)) * (o.y >= 0.0f ? 1.0f : -1.0f);
+  }
+  const auto quantize = [](float v) { return uint(clamp(v, -1.0f, 1.0f) * 16383.0f + 16383.5f); };
+  return 0x80000000u | (w < 0.0f ? 0x40000000u : 0u) | quantize(x) << 15u | quantize(y);
+}
+#endif
+// The direction of a packed tangent (unit; zero where there is none).
+PT_INLINE vec3 unpackTangent(uint packed) {
+  if (packed == 0u) return vec3(0.0f);
+  float x = float((packed >> 15u) & 0x7FFFu) / 16383.0f - 1.0f;
+  float y = float(packed & 0x7FFFu) / 16383.0f - 1.0f;
+  vec3 t = vec3(x, y, 1.0f - abs(x) - abs(y));
+  if (t.z < 0.0f) {
+    t.x = (1.0f - abs(y)) * (x >= 0.0f ? 1.0f : -1.0f);
+    t.y = (1.0f - abs(x)) * (y >= 0.0f ? 1.0f : -1.0f);
+  }
+  return normalize(t);
+}
+// A triangle's tangent at barycentrics b (the vertices' interpolated, not made unit) and, in w,
+// the sign of its bitangent (v0's); w = 0 where the triangle has no tangents.
+PT_INLINE vec4 interpolatedTangent(TriangleNormals t, vec3 b) {
+  if (t.tangent0 == 0u) return vec4(0.0f);
+  vec3 d = b.x * unpackTangent(t.tangent0) + b.y * unpackTangent(t.tangent1) +
+           b.z * unpackTangent(t.tangent2);
+  return vec4(d, (t.tangent0 & 0x40000000u) != 0u ? -1.0f : 1.0f);
+}
+
 // The shading normal that a tangent-space normal map (glTF's normalTexture) gives a triangle
 // (its derivatives d, the hit's footprint uv) whose normal there is ns (the vertex normals'
 // or the geometric one): the map's RGB c at uv is the normal (2 c - 1) in the frame of the
-// tangent T (dp/du made perpendicular to ns), the bitangent B = ns x T, turned to dp/dv's side
-// where the texture coordinates are mirrored, and ns; its x and y times `scale`. The green
-// channel points up the image (along +t, glTF's -v), as glTF's normal maps are stored. Where
-// the frame or the normal is degenerate, ns is kept.
+// tangent T, the bitangent B and ns; its x and y times `scale`. T is the vertices' tangent
+// where the mesh has them (vertexTangent, interpolatedTangent's: w its bitangent's sign; w = 0
+// for none), else dp/du, made perpendicular to ns; B = ns x T times w, or turned to dp/dv's
+// side. The green channel points up the image (along +t, glTF's -v), as glTF's normal maps
+// are stored. Where the frame or the normal is degenerate, ns is kept.
 PT_INLINE vec3 normalMappedNormal(PT_TEXTURES_PARAM uint normalMap, float scale,
-                                  TriangleDerivatives d, UVFootprint uv, vec3 ns) {
+                                  TriangleDerivatives d, vec4 vertexTangent, UVFootprint uv,
+                                  vec3 ns) {
   vec3 c = evalTextureAt(PT_TEXTURES_ARG normalMap, uv);
   vec3 local = 2.0f * c - vec3(1.0f);
   local = vec3(local.x * scale, local.y * scale, local.z);
-  vec3 tangent = d.dpdu - dot(d.dpdu, ns) * ns;
+  bool given = vertexTangent.w != 0.0f;
+  vec3 along = given ? vec3(vertexTangent.x, vertexTangent.y, vertexTangent.z) : d.dpdu;
+  vec3 tangent = along - dot(along, ns) * ns;
   float t2 = dot(tangent, tangent);
   vec3 bitangent;
   if (!(t2 > 0.0f) || !(t2 < 3.0e38f)) {
@@ -679,7 +722,11 @@ PT_INLINE vec3 normalMappedNormal(PT_TEXTURES_PARAM uint normalMap, float scale,
   } else {
     tangent = tangent / sqrt(t2);
     bitangent = cross(ns, tangent);
-    if (dot(bitangent, d.dpdv) < 0.0f) bitangent = -bitangent;
+    if (given) {
+      bitangent = vertexTangent.w * bitangent;
+    } else if (dot(bitangent, d.dpdv) < 0.0f) {
+      bitangent = -bitangent;
+    }
   }
   vec3 n = local.x * tangent + local.y * bitangent + local.z * ns;
   float len2 = dot(n, n);

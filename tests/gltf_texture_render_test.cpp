@@ -69,16 +69,22 @@ int addMaterial(GltfBuilder& b, const json& material) {
 
 // A square of side 2 in the z = 0 plane facing +z, its texture coordinates glTF's (v down the
 // square: the image upright as the camera on +z sees it), placed by `node` (its mesh set here).
-int addSquare(GltfBuilder& b, int material, json node = json::object()) {
+// With `tangent` (w not 0), every vertex has that TANGENT.
+int addSquare(GltfBuilder& b, int material, json node = json::object(),
+              glm::vec4 tangent = glm::vec4(0.0f)) {
   const int p = b.floats({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, "VEC3", 3);
   const int n = b.floats({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3", 3);
   const int uv = b.floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
   const std::vector<std::uint16_t> idx = {0, 1, 2, 0, 2, 3};
   const int i = b.accessor(b.view(idx), GltfBuilder::kUShort, idx.size(), "SCALAR");
+  json attributes = {{"POSITION", p}, {"NORMAL", n}, {"TEXCOORD_0", uv}};
+  if (tangent.w != 0.0f) {
+    std::vector<float> t;
+    for (int k = 0; k < 4; ++k) t.insert(t.end(), {tangent.x, tangent.y, tangent.z, tangent.w});
+    attributes["TANGENT"] = b.floats(t, "VEC4", 4);
+  }
   node["mesh"] =
-      b.mesh(json::array({{{"attributes", {{"POSITION", p}, {"NORMAL", n}, {"TEXCOORD_0", uv}}},
-                           {"indices", i},
-                           {"material", material}}}));
+      b.mesh(json::array({{{"attributes", attributes}, {"indices", i}, {"material", material}}}));
   return b.node(node);
 }
 
@@ -100,21 +106,25 @@ int addCamera(GltfBuilder& b, double distance, double yfov) {
   return b.node({{"camera", 0}, {"translation", {0, 0, distance}}});
 }
 
+// The rotation (a quaternion, glTF's x, y, z, w) that takes unit `from` onto the direction `to`:
+// about from x to by the angle between them.
+json rotationTaking(glm::dvec3 from, glm::dvec3 to) {
+  to = glm::normalize(to);
+  glm::dvec3 axis = glm::cross(from, to);
+  const double s = glm::length(axis);
+  axis = s > 0 ? axis / s : glm::dvec3(1, 0, 0);
+  const double half = std::atan2(s, glm::dot(from, to)) / 2;
+  return {axis.x * std::sin(half), axis.y * std::sin(half), axis.z * std::sin(half),
+          std::cos(half)};
+}
+
 // A directional light shining along `direction` (its node's -z turned onto it).
 int addDirectionalLight(GltfBuilder& b, glm::dvec3 direction, double intensity) {
   b.doc["extensionsUsed"] = json::array({"KHR_lights_punctual"});
   b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
       json::array({{{"type", "directional"}, {"intensity", intensity}}});
-  // The rotation taking -z onto the direction: about (-z) x d by the angle between them.
-  const glm::dvec3 from(0, 0, -1), to = glm::normalize(direction);
-  glm::dvec3 axis = glm::cross(from, to);
-  const double s = glm::length(axis), c = glm::dot(from, to);
-  axis = s > 0 ? axis / s : glm::dvec3(1, 0, 0);
-  const double half = std::atan2(s, c) / 2;
   return b.node({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}},
-                 {"rotation",
-                  {axis.x * std::sin(half), axis.y * std::sin(half), axis.z * std::sin(half),
-                   std::cos(half)}}});
+                 {"rotation", rotationTaking(glm::dvec3(0, 0, -1), direction)}});
 }
 
 Image renderCpuImage(const GltfBuilder& b, int size, int spp, RenderSettings settings = {}) {
@@ -276,11 +286,13 @@ TEST(GltfTextures, NormalMapFrame) {
   node.type = kTextureConstant;
   node.count = 1;
   const vec3 ns(0.0f, 0.0f, 1.0f);
+  vec4 vertexTangent(0.0f);  // none: the frame of dp/du and dp/dv
   const auto mapped = [&](vec3 c, float scale, TriangleDerivatives der) {
     node.value = c;
     TextureTables tables;
     tables.nodes = &node;
-    return normalMappedNormal(tables, 0u, scale, der, pointFootprint(vec2(0.0f)), ns);
+    return normalMappedNormal(tables, 0u, scale, der, vertexTangent, pointFootprint(vec2(0.0f)),
+                              ns);
   };
   const vec3 same = mapped(vec3(0.5f, 0.5f, 1.0f), 1.0f, d);
   EXPECT_NEAR(glm::length(same - ns), 0.0f, 1e-7f);
@@ -296,6 +308,38 @@ TEST(GltfTextures, NormalMapFrame) {
   mirrored.dpdv = vec3(0.0f, -1.0f, 0.0f);
   const vec3 flipped = mapped(vec3(0.5f, 0.5f + 0.5f * s, 0.5f + 0.5f * c), 1.0f, mirrored);
   EXPECT_NEAR(glm::length(flipped - vec3(0.0f, -s, c)), 0.0f, 1e-6f);
+  // A vertex tangent along +y (not perpendicular to the normal: made so) replaces dp/du; the
+  // bitangent is N x T = -x times w.
+  vertexTangent = vec4(0.0f, 2.0f, -0.5f, 1.0f);
+  const vec3 alongT = mapped(vec3(0.5f + 0.5f * s, 0.5f, 0.5f + 0.5f * c), 1.0f, d);
+  EXPECT_NEAR(glm::length(alongT - vec3(0.0f, s, c)), 0.0f, 1e-6f);
+  const vec3 alongB = mapped(vec3(0.5f, 0.5f + 0.5f * s, 0.5f + 0.5f * c), 1.0f, d);
+  EXPECT_NEAR(glm::length(alongB - vec3(-s, 0.0f, c)), 0.0f, 1e-6f);
+  vertexTangent.w = -1.0f;
+  const vec3 alongMinusB = mapped(vec3(0.5f, 0.5f + 0.5f * s, 0.5f + 0.5f * c), 1.0f, d);
+  EXPECT_NEAR(glm::length(alongMinusB - vec3(s, 0.0f, c)), 0.0f, 1e-6f);
+}
+
+// Tangents packed in a word (TriangleNormals::tangent*) come back within 2e-4 radians, with
+// their bitangent's sign; zero is no tangent.
+TEST(GltfTextures, PackedTangentsRoundTrip) {
+  for (int i = 0; i < 200; ++i) {
+    const float a = 0.37f * float(i), z = -1.0f + 2.0f * (float(i) + 0.5f) / 200.0f;
+    const float r = std::sqrt(1.0f - z * z);
+    const vec3 t(r * std::cos(a), r * std::sin(a), z);
+    const float w = i % 2 == 0 ? 1.0f : -1.0f;
+    const uint packed = packTangent(3.0f * t, w);
+    ASSERT_NE(packed, 0u);
+    EXPECT_LT(glm::length(unpackTangent(packed) - t), 2e-4f) << i;  // the chord: the angle
+    TriangleNormals n{};
+    n.tangent0 = n.tangent1 = n.tangent2 = packed;
+    EXPECT_EQ(interpolatedTangent(n, vec3(0.2f, 0.3f, 0.5f)).w, w);
+  }
+  for (const vec3 axis : {vec3(1, 0, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1)}) {
+    EXPECT_EQ(unpackTangent(packTangent(axis, 1.0f)), axis);
+  }
+  EXPECT_EQ(packTangent(vec3(0.0f), 1.0f), 0u);
+  EXPECT_EQ(interpolatedTangent(TriangleNormals{}, vec3(1, 0, 0)), vec4(0.0f));
 }
 
 // A square with a normal map lit by a directional light and seen from afar renders as the
@@ -311,16 +355,7 @@ TEST(GltfTextures, NormalMapTiltsTheShadingAsTheTurnedSurface) {
                        {"roughnessFactor", 0.5}}}};
     if (map != nullptr) material["normalTexture"] = {{"index", addUniformTexture(b, *map)}};
     const int m = addMaterial(b, material);
-    // The rotation taking +z onto turnTo.
-    const glm::dvec3 z(0, 0, 1), n = glm::normalize(turnTo);
-    glm::dvec3 axis = glm::cross(z, n);
-    const double s = glm::length(axis);
-    axis = s > 0 ? axis / s : glm::dvec3(1, 0, 0);
-    const double half = std::atan2(s, glm::dot(z, n)) / 2;
-    b.scene({addSquare(b, m,
-                       {{"rotation",
-                         {axis.x * std::sin(half), axis.y * std::sin(half), axis.z * std::sin(half),
-                          std::cos(half)}}}),
+    b.scene({addSquare(b, m, {{"rotation", rotationTaking(glm::dvec3(0, 0, 1), turnTo)}}),
              addCamera(b, 200.0, 0.002), addDirectionalLight(b, glm::dvec3(0.3, -1, -0.6), 2.0)});
     return b;
   };
@@ -337,6 +372,43 @@ TEST(GltfTextures, NormalMapTiltsTheShadingAsTheTurnedSurface) {
   const std::vector<std::uint8_t> up = {128, 128, 255};
   const vec3 u = meanOf(renderCpuImage(scene(&up, glm::dvec3(0, 0, 1)), 8, 16), 2, 2, 6, 6);
   EXPECT_NEAR(u.x, f.x, 0.01f * f.x);
+}
+
+// With a TANGENT along +y (w 1: the bitangent N x T = -x), the map's x tilts the normal towards
+// +y and its y towards -x: the square renders as the one turned to (-y, x, z) of the map's
+// (x, y, z); with w -1, to (y, x, z). The reader packs the tangents, and a mirroring node turns
+// their sign.
+TEST(GltfTextures, NormalMapUsesTheTangentAttribute) {
+  const std::vector<std::uint8_t> tilt = {191, 150, 238};
+  const auto scene = [&](bool mapped, glm::dvec3 turnTo, float w) {
+    GltfBuilder b;
+    json material = {{"pbrMetallicRoughness",
+                      {{"baseColorFactor", {0.8, 0.8, 0.8, 1}},
+                       {"metallicFactor", 0.0},
+                       {"roughnessFactor", 0.5}}}};
+    if (mapped) material["normalTexture"] = {{"index", addUniformTexture(b, tilt)}};
+    const int m = addMaterial(b, material);
+    b.scene({addSquare(b, m, {{"rotation", rotationTaking(glm::dvec3(0, 0, 1), turnTo)}},
+                       mapped ? glm::vec4(0, 1, 0, w) : glm::vec4(0.0f)),
+             addCamera(b, 200.0, 0.002), addDirectionalLight(b, glm::dvec3(0.3, -1, -0.6), 2.0)});
+    return b;
+  };
+  const glm::dvec3 t(2.0 * tilt[0] / 255.0 - 1.0, 2.0 * tilt[1] / 255.0 - 1.0,
+                     2.0 * tilt[2] / 255.0 - 1.0);
+  for (float w : {1.0f, -1.0f}) {
+    const glm::dvec3 expected = w > 0 ? glm::dvec3(-t.y, t.x, t.z) : glm::dvec3(t.y, t.x, t.z);
+    const vec3 a = meanOf(renderCpuImage(scene(true, glm::dvec3(0, 0, 1), w), 8, 16), 2, 2, 6, 6);
+    const vec3 e = meanOf(renderCpuImage(scene(false, expected, w), 8, 16), 2, 2, 6, 6);
+    EXPECT_NEAR(a.x, e.x, 0.01f * e.x) << "w " << w;
+  }
+  // The packed tangents, and a mirroring node's.
+  GltfBuilder b = scene(true, glm::dvec3(0, 0, 1), 1.0f);
+  b.doc["nodes"][0]["scale"] = {-1, 1, 1};
+  const Scene mirrored = loadGltfSceneBytes(b.gltf(), "test.gltf");
+  ASSERT_FALSE(mirrored.normals.empty());
+  const vec4 tm = interpolatedTangent(mirrored.normals[0], vec3(1, 0, 0));
+  EXPECT_NEAR(glm::length(vec3(tm) - vec3(0, 1, 0)), 0.0f, 1e-4f);
+  EXPECT_EQ(tm.w, -1.0f);
 }
 
 // A black square whose base colour texture's alpha is 0.2 on the left half and 0.8 on the right,
@@ -505,7 +577,8 @@ TEST(GltfTextures, TextureTransformRotatesAsTheExtensionsMatrix) {
 }
 
 // Every texture of the material at once (metallic-roughness, normal and emissive textures, a
-// MASK cut-out and a BLEND square), on both backends.
+// normal map in the frame of a TANGENT attribute, a MASK cut-out and a BLEND square), on both
+// backends.
 TEST(GltfTextures, TexturedSceneAgreesOnBothBackends) {
   GltfBuilder b;
   std::vector<std::uint8_t> mr, normals, emissive, rgba;
@@ -556,6 +629,8 @@ TEST(GltfTextures, TexturedSceneAgreesOnBothBackends) {
                      {{"translation", {0, -1, 0}},
                       {"rotation", {-0.7071068, 0, 0, 0.7071068}},
                       {"scale", {5, 5, 1}}}),
+           addSquare(b, sphereMaterial, {{"translation", {0, -0.4, 2}}, {"scale", {0.5, 0.3, 1}}},
+                     glm::vec4(0.6f, 0.8f, 0.0f, -1.0f)),  // the normal map in its TANGENT frame
            addCamera(b, 7.0, 0.7)});
   Scene scene = loadGltfSceneBytes(b.gltf(), "textured.gltf");
   EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();

@@ -28,6 +28,8 @@ struct LocalPrimitive {
   std::vector<std::array<glm::dvec3, 3>> positions;
   std::vector<std::array<glm::dvec3, 3>> normals;  // parallel, or empty: no NORMAL
   std::vector<std::array<glm::vec2, 3>> uvs;       // TEXCOORD_0, parallel, or empty
+  // TANGENT (direction and bitangent sign w), parallel to normals, or empty: none, or no NORMAL.
+  std::vector<std::array<glm::dvec4, 3>> tangents;
 };
 
 // The scene's material index for a glTF material index (-1: the default material), made on
