@@ -532,6 +532,55 @@ TEST(GltfTextures, MaterialTextureSlotsAndAlphaModes) {
             "expected 2 numbers");
 }
 
+// A texture of texCoord 1 (or KHR_texture_transform's texCoord 1) reads TEXCOORD_1: a square
+// whose TEXCOORD_0 is all zeros and TEXCOORD_1 its corners renders as the square of
+// TEXCOORD_0 and texCoord 0. A material whose textures read both sets keeps the first one's
+// (the other texture left out, warned).
+TEST(GltfTextures, SecondTextureCoordinateSet) {
+  const auto scene = [](int set, bool byTransform, bool mixed) {
+    GltfBuilder b;
+    const int t = addTexture(b, png(2, 1, 3, {250, 200, 100, 10, 20, 30}));
+    json info = {{"index", t}};
+    if (set == 1 && byTransform) {
+      info["extensions"]["KHR_texture_transform"] = {{"texCoord", 1}};
+      b.doc["extensionsUsed"] = json::array({"KHR_texture_transform"});
+    } else {
+      info["texCoord"] = set;
+    }
+    json pbr = {{"baseColorTexture", info}, {"metallicFactor", 0.0}};
+    if (mixed) pbr["metallicRoughnessTexture"] = {{"index", t}, {"texCoord", 1 - set}};
+    const int m = addMaterial(b, {{"pbrMetallicRoughness", pbr}});
+    const int p = b.floats({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, "VEC3", 3);
+    const int corners = b.floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
+    const int zeros = b.floats({0, 0, 0, 0, 0, 0, 0, 0}, "VEC2", 2);
+    const std::vector<std::uint16_t> idx = {0, 1, 2, 0, 2, 3};
+    const int i = b.accessor(b.view(idx), GltfBuilder::kUShort, idx.size(), "SCALAR");
+    json attributes = {{"POSITION", p},
+                       {"TEXCOORD_0", set == 0 ? corners : zeros},
+                       {"TEXCOORD_1", set == 0 ? zeros : corners}};
+    const int mesh =
+        b.mesh(json::array({{{"attributes", attributes}, {"indices", i}, {"material", m}}}));
+    b.scene({b.node({{"mesh", mesh}}), addCamera(b, 3.0, 0.5)});
+    return b;
+  };
+  const Image reference = renderCpuImage(scene(0, false, false), 16, 4);
+  EXPECT_GT(reference.at(2, 8).x, 2.0f * reference.at(13, 8).x);  // the texture is read
+  for (bool byTransform : {false, true}) {
+    const Image second = renderCpuImage(scene(1, byTransform, false), 16, 4);
+    for (size_t k = 0; k < second.pixels.size(); ++k) {
+      EXPECT_EQ(second.pixels[k], reference.pixels[k]) << k;
+    }
+  }
+  const Scene mixed = loadGltfSceneBytes(scene(1, false, true).gltf(), "test.gltf");
+  ASSERT_EQ(mixed.warnings.size(), 1u);
+  EXPECT_EQ(mixed.warnings[0],
+            "test.gltf: materials[0].pbrMetallicRoughness.metallicRoughnessTexture.texCoord: the "
+            "material's textures read different texture coordinate sets, and the renderer keeps "
+            "one per triangle (TEXCOORD_1): the texture is left out");
+  EXPECT_EQ(mixed.materialTextures[0].uRoughness, kNoTexture);
+  EXPECT_NE(mixed.materialTextures[0].reflectance, kNoTexture);
+}
+
 // KHR_texture_transform's offset, rotation and scale: the texel the renderer reads at a point
 // is the one the extension's matrix T R S (columns cos r, sin r and -sin r, cos r) picks from
 // glTF's coordinates there (v down the image), on a 4 x 4 image of distinct texels.

@@ -40,12 +40,24 @@ void readAlpha(const tinygltf::Material& m, const std::string& path, TextureRead
 
 MaterialTextures readMaterialTextures(const tinygltf::Model& model, int index,
                                       const Material& material, TextureReader& textures,
-                                      Context& context) {
+                                      Context& context, int& uvSet) {
   MaterialTextures t = noMaterialTextures();
   const std::string path = indexed("materials", std::size_t(index));
   const tinygltf::Material& m = model.materials[std::size_t(index)];
   const tinygltf::PbrMetallicRoughness& pbr = m.pbrMetallicRoughness;
   const std::string pbrPath = path + ".pbrMetallicRoughness";
+  // The set of the first texture read (the emissive one only where it emits).
+  uvSet = 0;
+  for (const TextureRef& ref :
+       {textureRef(pbr.baseColorTexture), textureRef(pbr.metallicRoughnessTexture),
+        textureRef(m.normalTexture),
+        material.emission != vec3(0.0f) ? textureRef(m.emissiveTexture) : TextureRef{}}) {
+    if (ref.index < 0) continue;
+    const int set = TextureReader::texCoordOf(ref);
+    uvSet = set == 1 ? 1 : 0;
+    break;
+  }
+  textures.useSet(uvSet);
   if (pbr.baseColorTexture.index >= 0) {
     t.reflectance = textures.baseColor(pbr.baseColorTexture, material.reflectance,
                                        pbrPath + ".baseColorTexture");

@@ -14,9 +14,11 @@
 namespace pt::gltf {
 
 // The textures of materials[index] (index >= 0), whose factors readMaterial made `material`;
-// noMaterialTextures() where it has none.
+// noMaterialTextures() where it has none. uvSet: the texture coordinate set they read (0 or
+// 1), the first read texture's; the triangles of the material keep that set, and a texture of
+// the other is left out (warned).
 MaterialTextures readMaterialTextures(const tinygltf::Model& model, int index,
                                       const Material& material, TextureReader& textures,
-                                      Context& context);
+                                      Context& context, int& uvSet);
 
 }  // namespace pt::gltf

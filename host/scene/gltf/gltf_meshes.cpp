@@ -78,7 +78,7 @@ void MeshReader::decode(const tinygltf::Primitive& p, const std::string& where,
   // Tangents serve normal maps, in the frame of the normals: without NORMAL they are ignored,
   // as the specification says.
   const AccessorValues tangent = optional("TANGENT", TINYGLTF_TYPE_VEC4);
-  optional("TEXCOORD_1", TINYGLTF_TYPE_VEC2);
+  const AccessorValues uv1 = optional("TEXCOORD_1", TINYGLTF_TYPE_VEC2);
   for (const auto& [name, index] : p.attributes) {
     bool known = false;
     for (const char* k : kRead) known = known || name == k;
@@ -143,15 +143,17 @@ void MeshReader::decode(const tinygltf::Primitive& p, const std::string& where,
         out.tangents.push_back(tg);
       }
     }
-    if (uv.count > 0) {
-      // glTF's v runs down the image; the renderer's textures have t = 1 at the top row.
+    // glTF's v runs down the image; the renderer's textures have t = 1 at the top row.
+    const auto corners = [&](const AccessorValues& a) {
       std::array<glm::vec2, 3> u;
       for (int k = 0; k < 3; ++k) {
         const std::size_t i = c[std::size_t(k)];
-        u[std::size_t(k)] = glm::vec2(float(uv.at(i, 0)), float(1.0 - uv.at(i, 1)));
+        u[std::size_t(k)] = glm::vec2(float(a.at(i, 0)), float(1.0 - a.at(i, 1)));
       }
-      out.uvs.push_back(u);
-    }
+      return u;
+    };
+    if (uv.count > 0) out.uvs.push_back(corners(uv));
+    if (uv1.count > 0) out.uvs1.push_back(corners(uv1));
   }
 }
 
@@ -180,7 +182,15 @@ void MeshReader::emit(int mesh, const std::string& where, const glm::dmat4& worl
   const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(linear));
   const bool mirrors = glm::determinant(linear) < 0.0;
   for (const LocalPrimitive& p : primitives(std::size_t(mesh))) {
-    const uint material = slot(p.material, p.where);
+    const auto [material, uvSet] = slot(p.material, p.where);
+    // The set the material's textures read; TEXCOORD_0 where the primitive lacks it (warned).
+    if (uvSet == 1 && p.uvs1.empty()) {
+      context_.warnOnce("texcoord missing", p.where + ".attributes",
+                        "the material's textures read TEXCOORD_1, which the primitive lacks: "
+                        "TEXCOORD_0 is used");
+    }
+    const std::vector<std::array<glm::vec2, 3>>& uvs =
+        uvSet == 1 && !p.uvs1.empty() ? p.uvs1 : p.uvs;
     reserveGeometric(scene.triangles, scene.triangles.size() + p.positions.size());
     for (std::size_t i = 0; i < p.positions.size(); ++i) {
       std::array<glm::dvec3, 3> n{};
@@ -195,7 +205,7 @@ void MeshReader::emit(int mesh, const std::string& where, const glm::dmat4& worl
           context_.fail(where, "the transform moves vertices beyond the range of 32-bit floats");
         }
         if (!p.normals.empty()) n[k] = normalMatrix * p.normals[i][k];
-        if (!p.uvs.empty()) uv[k] = p.uvs[i][k];
+        if (!uvs.empty()) uv[k] = uvs[i][k];
         if (!p.tangents.empty()) {
           // A tangent is a direction in the surface: it moves with the transform itself, and a
           // mirroring transform turns the bitangent's sign (the frame's handedness).
@@ -220,7 +230,7 @@ void MeshReader::emit(int mesh, const std::string& where, const glm::dmat4& worl
         continue;
       }
       const Appended a =
-          appendTriangle(scene, t, p.normals.empty() ? nullptr : &n, p.uvs.empty() ? nullptr : &uv);
+          appendTriangle(scene, t, p.normals.empty() ? nullptr : &n, uvs.empty() ? nullptr : &uv);
       if (a == Appended::kZeroArea) ++dropped_;
       if (a == Appended::kAdded && !p.tangents.empty()) {
         TriangleNormals& added = scene.normals.back();

@@ -83,16 +83,17 @@ Scene build(const tinygltf::Model& model, const std::string& file,
   warnUnsimulated(model, context);
   const std::vector<PlacedNode> nodes = placeNodes(model, context);
   // Scene materials made on first use, one per glTF material (and one for the default).
-  std::map<int, uint> slots;
+  std::map<int, gltf::MaterialChoice> slots;
   TextureReader textures(model, scene, context);
   const MaterialSlot slot = [&](int material, const std::string&) {
-    const auto [it, added] = slots.emplace(material, uint(scene.materials.size()));
+    const auto [it, added] =
+        slots.emplace(material, gltf::MaterialChoice{uint(scene.materials.size()), 0});
     if (added) {
       scene.materials.push_back(readMaterial(model, material, context));
       if (material >= 0) {
-        setMaterialTextures(
-            scene, it->second,
-            readMaterialTextures(model, material, scene.materials.back(), textures, context));
+        setMaterialTextures(scene, it->second.material,
+                            readMaterialTextures(model, material, scene.materials.back(), textures,
+                                                 context, it->second.uvSet));
       }
       const std::string name = material >= 0 ? model.materials[std::size_t(material)].name : "";
       scene.materialNames.push_back(

@@ -113,6 +113,17 @@ const TextureImage* TextureReader::decoded(std::size_t imageIndex) {
   return &*slot;
 }
 
+int TextureReader::texCoordOf(const TextureRef& ref) {
+  int texCoord = ref.texCoord;
+  const auto transform = ref.extensions->find("KHR_texture_transform");
+  if (transform != ref.extensions->end() && transform->second.IsObject() &&
+      transform->second.Has("texCoord") && transform->second.Get("texCoord").IsNumber()) {
+    const double n = transform->second.Get("texCoord").GetNumberAsDouble();
+    if (n >= 0.0 && n <= 65535.0) texCoord = int(n);
+  }
+  return texCoord;
+}
+
 uint TextureReader::texture(const TextureRef& ref, TextureChannels channels, vec3 factor,
                             const std::string& where) {
   if (ref.index < 0 || std::size_t(ref.index) >= model_.textures.size()) {
@@ -123,6 +134,7 @@ uint TextureReader::texture(const TextureRef& ref, TextureChannels channels, vec
   ImageTextureDesc desc;
   desc.encoding = channels == TextureChannels::kSrgb ? "sRGB" : "linear";
   int texCoord = ref.texCoord;
+  std::string texCoordWhere = where + ".texCoord";  // where the set is named
   vec2 skew(0.0f);  // the mapping's cross terms (TextureNode::skew), where it rotates
   const auto transform = ref.extensions->find("KHR_texture_transform");
   if (transform != ref.extensions->end()) {
@@ -146,6 +158,7 @@ uint TextureReader::texture(const TextureRef& ref, TextureChannels channels, vec
         context_.fail(at + ".texCoord", "expected a non-negative integer");
       }
       texCoord = int(n);
+      texCoordWhere = at + ".texCoord";
     }
     // The extension's u' = a u + b v + ou, v' = d u + e v + ov, its matrix T R S (a = su cos r,
     // b = -sv sin r, d = su sin r, e = sv cos r). glTF's v runs down the image and the
@@ -155,10 +168,17 @@ uint TextureReader::texture(const TextureRef& ref, TextureChannels channels, vec
     desc.mapping = vec4(float(a), float(e), float(b + offset[0]), float(1.0 - e - offset[1]));
     if (rotation != 0.0) skew = vec2(float(-b), float(-d));
   }
-  if (texCoord != 0) {
-    context_.warnOnce("texcoord", where + ".texCoord",
-                      "textures of a second texture coordinate set are not simulated: the "
-                      "texture is left out");
+  if (texCoord > 1) {
+    context_.warnOnce("texcoord", texCoordWhere,
+                      "texture coordinate sets beyond TEXCOORD_1 are not read: the texture is "
+                      "left out");
+    return kNoTexture;
+  }
+  if (texCoord != uvSet_) {
+    context_.warnOnce("texcoord sets", texCoordWhere,
+                      "the material's textures read different texture coordinate sets, and "
+                      "the renderer keeps one per triangle (TEXCOORD_" +
+                          std::to_string(uvSet_) + "): the texture is left out");
     return kNoTexture;
   }
   const Key key{ref.index,

@@ -2,8 +2,9 @@
 // their images decoded by the texture readers that exist (PNG, JPEG) from a file, a data URI
 // or a buffer view, their sampler's wrap mode and KHR_texture_transform (offset, scale,
 // rotation), times a factor; RGB, or one channel as a float texture. What the renderer cannot
-// do (mirrored repeat, different wraps on the two axes, a second texture coordinate set, image
-// formats other than PNG and JPEG) is warned and the texture left out.
+// do (mirrored repeat, different wraps on the two axes, one material's textures on different
+// texture coordinate sets, sets beyond TEXCOORD_1, image formats other than PNG and JPEG) is
+// warned and the texture left out.
 #pragma once
 
 #include <array>
@@ -48,6 +49,11 @@ class TextureReader {
   // transform; each image decoded once.
   uint texture(const TextureRef& ref, TextureChannels channels, vec3 factor,
                const std::string& where);
+  // The texture coordinate set `ref` reads: its texCoord, or its KHR_texture_transform's.
+  static int texCoordOf(const TextureRef& ref);
+  // The set the textures built next read (the material's, 0 or 1); a texture of another set is
+  // left out (warned): the triangles keep one set.
+  void useSet(int set) { uvSet_ = set; }
   // A constant texture.
   uint constant(vec3 value) { return builder_.constant(value); }
   // The base colour's RGB (sRGB).
@@ -67,6 +73,7 @@ class TextureReader {
   using Key = std::tuple<int, int, std::array<float, 3>, std::array<float, 6>>;
   std::map<Key, uint> built_;
   std::map<std::size_t, std::optional<TextureImage>> images_;
+  int uvSet_ = 0;
 };
 
 }  // namespace pt::gltf
