@@ -99,7 +99,7 @@ PT_INLINE BdptConnection bdptSampleLightFrom(PT_SCENE_PARAM PT_IN(BdptVertex) pt
     Triangle tri = loadTriangle(PT_SCENE_ARG e.triangle);
     vec2 b = sampleTriangleBarycentrics(uLight);
     vec3 point = (1.0f - b.x - b.y) * tri.v0 + b.x * tri.v1 + b.y * tri.v2;
-    c.sampled = bdptTriangleLightVertex(PT_SCENE_ARG index, point, vec3(0.0f), pt.key);
+    c.sampled = bdptTriangleLightVertex(PT_SCENE_ARG index, point, b, vec3(0.0f), pt.key);
     vec3 toLight = point - pt.p;
     float dist2 = dot(toLight, toLight);
     wi = toLight / sqrt(dist2);

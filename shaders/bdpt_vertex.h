@@ -173,9 +173,9 @@ PT_INLINE BdptVertex bdptEnvironmentVertex(PT_SCENE_PARAM vec3 origin, vec3 dire
   return v;
 }
 
-// A point on emissive triangle `emitter` (Emitter index) at position p, for a light subpath or
-// a light sample.
-PT_INLINE BdptVertex bdptTriangleLightVertex(PT_SCENE_PARAM uint emitter, vec3 p, vec3 beta,
+// A point on emissive triangle `emitter` (Emitter index) at position p (barycentrics b, the
+// weights of v1 and v2), for a light subpath or a light sample.
+PT_INLINE BdptVertex bdptTriangleLightVertex(PT_SCENE_PARAM uint emitter, vec3 p, vec2 b, vec3 beta,
                                              VertexKey key) {
   Emitter e = loadEmitter(PT_SCENE_ARG emitter);
   Triangle tri = loadTriangle(PT_SCENE_ARG e.triangle);
@@ -186,6 +186,7 @@ PT_INLINE BdptVertex bdptTriangleLightVertex(PT_SCENE_PARAM uint emitter, vec3 p
   v.ng = shading.normal;
   v.ns = shading.normal;
   v.s.material = loadMaterial(PT_SCENE_ARG tri.material);
+  v.s.material.emission = emissionAt(PT_SCENE_ARG v.s.material, tri, b);
   v.s.magnitude = shading.magnitude;
   v.s.area = shading.area;
   return v;
@@ -408,7 +409,7 @@ PT_INLINE BdptLightStart sampleBdptLightStart(PT_SCENE_PARAM vec2 uChoose, vec2 
     Triangle tri = loadTriangle(PT_SCENE_ARG e.triangle);
     vec2 b = sampleTriangleBarycentrics(uPos);
     vec3 point = (1.0f - b.x - b.y) * tri.v0 + b.x * tri.v1 + b.y * tri.v2;
-    ls.vertex = bdptTriangleLightVertex(PT_SCENE_ARG index, point, vec3(0.0f), key);
+    ls.vertex = bdptTriangleLightVertex(PT_SCENE_ARG index, point, b, vec3(0.0f), key);
     vec3 n = ls.vertex.ng;
     float sideShare = 1.0f;
     if (bdptTwoSided(ls.vertex)) {

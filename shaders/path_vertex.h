@@ -282,7 +282,8 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
       uvs = uvsAt(PT_SCENE_TEXTURES tri.primitive);
       uv.uv = interpolatedUV(uvs, b);
       footprintUVs = footprints;
-      if (footprints || (PT_HAS_BUMP_MAPS && textures.displacement != kNoTexture)) {
+      if (footprints || (PT_HAS_BUMP_MAPS && textures.displacement != kNoTexture) ||
+          (PT_TEXTURE_USES(kTextureUsesNormalMap) && textures.normalMap != kNoTexture)) {
         derivatives = triangleDerivatives(tri, uvs);
       }
       if (footprints) {
@@ -306,6 +307,7 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
     ns = interpolatedNormal(normals, b, ng);
     n = dot(ns, wo) >= 0.0f ? ns : -ns;
   }
+  bool vertexNormals = shadingNormals;
   bool bumped = PT_HAS_BUMP_MAPS && textured && textures.displacement != kNoTexture;
   // The vertex normals' changes along u and v: for a bump map and for the differentials of
   // specular bounces.
@@ -327,6 +329,16 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
       shadingNormals = true;
       n = dot(ns, wo) >= 0.0f ? ns : -ns;
     }
+  }
+  // A normal map (glTF's normalTexture) replaces it (texture.h), in the frame of the vertices'
+  // tangents where the mesh has them.
+  if (PT_HAS_TEXTURES && PT_TEXTURE_USES(kTextureUsesNormalMap) && textured &&
+      textures.normalMap != kNoTexture) {
+    vec4 tangent = vertexNormals ? interpolatedTangent(normals, b) : vec4(0.0f);
+    ns = normalMappedNormal(PT_SCENE_TEXTURES textures.normalMap, textures.normalScale, derivatives,
+                            tangent, uv, ns);
+    shadingNormals = true;
+    n = dot(ns, wo) >= 0.0f ? ns : -ns;
   }
 #endif
   s.p = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
@@ -471,6 +483,23 @@ PT_INLINE float emitterPdfFound(PT_SCENE_PARAM PT_IN(Triangle) tri, PT_IN(Surfac
   }
 #endif
   return lightPdf;
+}
+
+// The radiance that material m of triangle tri emits at the point of barycentrics b (the
+// weights of v1 and v2): its own emission, or its emission texture's value there.
+PT_INLINE vec3 emissionAt(PT_SCENE_PARAM Material m, Triangle tri, vec2 b) {
+  vec3 Le = m.emission;
+#ifndef PT_NO_BSDF_MATERIALS
+  if (PT_HAS_TEXTURES && PT_TEXTURE_USES(kTextureUsesEmission) && PT_PARAMS.texturesPresent != 0u) {
+    uint texture = materialTexturesAt(PT_SCENE_TEXTURES tri.material).emission;
+    if (texture != kNoTexture) {
+      vec2 uv =
+          interpolatedUV(uvsAt(PT_SCENE_TEXTURES tri.primitive), vec3(1.0f - b.x - b.y, b.x, b.y));
+      Le = max(evalTexture(PT_SCENE_TEXTURES texture, uv), vec3(0.0f));
+    }
+  }
+#endif
+  return Le;
 }
 
 // The cosine at which the surface at s emits towards the ray that found it: on its geometric
@@ -670,7 +699,7 @@ PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Vertex
 #endif
     }
     ls.to = offsetRayOrigin(point, lightNormal, lightShading.magnitude);
-    ls.Li = lightMaterial.emission;
+    ls.Li = emissionAt(PT_SCENE_ARG lightMaterial, light, b);
     ls.lightPdf = choice.pmf * dist2 / (cosLight * lightShading.area);
   }
   vec3 side = (lambertian && !s.shadingNormals) ? s.n : geometricSide(s, wi);

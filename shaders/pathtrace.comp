@@ -170,8 +170,9 @@ TextureNode textureNodeAt(uint i) {
   uvec4 b = texelFetch(textureTexels, at + 1);
   uvec4 c = texelFetch(textureTexels, at + 2);
   uvec4 d = texelFetch(textureTexels, at + 3);
+  uvec4 e = texelFetch(textureTexels, at + 4);
   return TextureNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b), c.x, c.y, c.z, c.w, d.x, d.y,
-                     d.z, uintBitsToFloat(d.w));
+                     d.z, uintBitsToFloat(d.w), uintBitsToFloat(e.xy), e.z, e.w);
 }
 uint imageWordAt(uint i) {
   return texelFetch(imageTexels, int(i >> 2u))[i & 3u];
@@ -181,8 +182,9 @@ MaterialTextures materialTexturesAt(uint i) {
   uvec4 a = texelFetch(materialTextureTexels, at);
   uvec4 b = texelFetch(materialTextureTexels, at + 1);
   uvec4 c = texelFetch(materialTextureTexels, at + 2);
+  uvec4 d = texelFetch(materialTextureTexels, at + 3);
   return MaterialTextures(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, uintBitsToFloat(c.y), c.z,
-                          c.w);
+                          c.w, d.x, d.y, uintBitsToFloat(d.z), uintBitsToFloat(d.w));
 }
 TriangleUVs uvsAt(uint primitive) {
   int at = int(2u * primitive);
@@ -252,10 +254,11 @@ Material loadMaterial(uint i) {
 #ifndef PT_NO_BSDF_MATERIALS
 TriangleNormals loadNormals(uint primitive) {
   int at = int(3u * primitive);
-  vec4 a = uintBitsToFloat(texelFetch(normalTexels, at));
-  vec4 b = uintBitsToFloat(texelFetch(normalTexels, at + 1));
-  vec4 c = uintBitsToFloat(texelFetch(normalTexels, at + 2));
-  return TriangleNormals(a.xyz, a.w, b.xyz, b.w, c.xyz, c.w);
+  uvec4 a = texelFetch(normalTexels, at);
+  uvec4 b = texelFetch(normalTexels, at + 1);
+  uvec4 c = texelFetch(normalTexels, at + 2);
+  return TriangleNormals(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
+                         uintBitsToFloat(c.xyz), c.w);
 }
 #endif
 

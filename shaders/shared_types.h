@@ -144,14 +144,16 @@ PT_CONST uint kMaterialTexels = 6u;  // 16-byte texels per Material (the GPU rea
 
 // The vertex normals of one triangle, for shading normals, in the scene's load order (indexed by
 // Triangle::primitive). Unit length, in world space. Uploaded only where some mesh has normals.
+// With them, the vertices' tangents where the mesh gives them (glTF's TANGENT, for normal
+// maps), each packed in a word (texture.h's packTangent; zero: none).
 struct TriangleNormals {
-  vec3 n0;          // 12 bytes: at v0
-  float reserved0;  //  4 bytes: zero
-  vec3 n1;          // 12 bytes: at v1
-  float reserved1;  //  4 bytes
-  vec3 n2;          // 12 bytes: at v2
-  float reserved2;  //  4 bytes
-};                  // 48 bytes
+  vec3 n0;        // 12 bytes: at v0
+  uint tangent0;  //  4 bytes: at v0, packed
+  vec3 n1;        // 12 bytes: at v1
+  uint tangent1;  //  4 bytes
+  vec3 n2;        // 12 bytes: at v2
+  uint tangent2;  //  4 bytes
+};                // 48 bytes
 
 // One entry of the emitter alias table (Walker 1977, Vose 1991): emitter i is picked with
 // probability pmf; sampling draws a slot uniformly and keeps it with probability
@@ -354,6 +356,7 @@ PT_CONST uint kFloatChannelAverage = 1u;
 PT_CONST uint kFloatChannelAlpha = 2u;
 PT_CONST uint kTextureInvert = 0x10000u;
 PT_CONST uint kTextureFloat = 0x20000u;  // the texture is a float texture (image lookups)
+PT_CONST uint kTextureSkewed = 0x40000u;  // the mapping has cross terms (TextureNode::skew)
 
 struct TextureNode {
   vec3 value;           // 12 bytes: constant: its value; image: pbrt-v4's "scale" (all three)
@@ -370,8 +373,13 @@ struct TextureNode {
                         //           the first word of level k's texels (level 0 is width x height,
                         //           powers of two; level k halves them, down to 1)
   float maxAnisotropy;  // 4 bytes: image, kTextureEwa: pbrt-v4's "maxanisotropy"
-};                      // 64 bytes
-PT_CONST uint kTextureNodeTexels = 4u;
+  vec2 skew;            // 8 bytes: with kTextureSkewed, the mapping's cross terms: s gains
+                        //          skew.x v and t gains skew.y u (a rotated mapping, glTF's
+                        //          KHR_texture_transform)
+  uint reserved0;       // 4 bytes: zero
+  uint reserved1;       // 4 bytes: zero
+};                      // 80 bytes
+PT_CONST uint kTextureNodeTexels = 5u;
 
 // The texture coordinates of one triangle's vertices, in the scene's load order (indexed by
 // Triangle::primitive); pbrt-v4's (0, 0), (1, 0), (1, 1) where a mesh has none. Uploaded only
@@ -397,11 +405,17 @@ struct MaterialTextures {
   uint alpha;          // cut-out (float): the surface is missing where it is 0
   uint flags;          // kRemapRoughness
   float scale;         // diffusetransmission: pbrt-v4's "scale" of both colours
-  uint thickness;      // coateddiffuse: the medium's thickness (float)
+  uint thickness;      // coateddiffuse: the medium's thickness (float); gltf: metallic
   uint g;              // coateddiffuse: the medium's asymmetry (float)
-};                     // 48 bytes
-PT_CONST uint kMaterialTextureTexels = 3u;
+  uint emission;       // emitted radiance (RGB, not clamped): gltf's emissiveTexture
+  uint normalMap;      // tangent-space normal map (RGB, linear): gltf's normalTexture
+  float normalScale;   // normalMap: the scale of its x and y (gltf's normalTexture.scale)
+  float alphaCutoff;   // kAlphaCutoff: alpha below it is 0, at or above it 1 (gltf's MASK)
+};                     // 64 bytes
+PT_CONST uint kMaterialTextureTexels = 4u;
 PT_CONST uint kRemapRoughness = 1u;  // roughness textures give pbrt-v4's roughness, not alpha
+PT_CONST uint kSquareRoughness = 2u;  // roughness textures give gltf's roughness: alpha = r^2
+PT_CONST uint kAlphaCutoff = 4u;      // the alpha texture is cut at alphaCutoff (gltf's MASK)
 
 // What a scene's textures need (PT_FX_TEXTURE_FEATURES): the material parameters some used
 // material takes from a texture, and whether any texture is a program of several nodes or reads
@@ -411,7 +425,10 @@ PT_CONST uint kTextureUsesReflectance = 1u << 0u;
 PT_CONST uint kTextureUsesTransmittance = 1u << 1u;
 PT_CONST uint kTextureUsesRoughness = 1u << 2u;    // uRoughness or vRoughness
 PT_CONST uint kTextureUsesEtaK = 1u << 3u;         // a conductor's eta or k
-PT_CONST uint kTextureUsesMedium = 1u << 4u;       // coateddiffuse's thickness or g
+PT_CONST uint kTextureUsesMedium = 1u << 4u;       // coateddiffuse's thickness or g, gltf's
+                                                   // metallic
+PT_CONST uint kTextureUsesEmission = 1u << 5u;     // emission (gltf's emissiveTexture)
+PT_CONST uint kTextureUsesNormalMap = 1u << 6u;    // a normal map (gltf's normalTexture)
 PT_CONST uint kTextureUsesPrograms = 1u << 8u;     // a texture of more than one node
 PT_CONST uint kTextureUsesImages = 1u << 9u;       // an image lookup
 PT_CONST uint kTextureUsesEwa = 1u << 10u;         // an image filtered by kTextureEwa

@@ -79,6 +79,19 @@ PT_INLINE vec2 mapDerivative(vec4 mapping, vec2 duv) {
   return vec2(mapping.x * duv.x, mapping.y * duv.y);
 }
 
+// A node's mapping of (u, v), with its cross terms where it has them (kTextureSkewed: a rotated
+// mapping), and of a change of (u, v).
+PT_INLINE vec2 mapNodeUV(TextureNode node, vec2 uv) {
+  vec2 st = mapUV(node.mapping, uv);
+  if ((node.flags & kTextureSkewed) != 0u) st = st + vec2(node.skew.x * uv.y, node.skew.y * uv.x);
+  return st;
+}
+PT_INLINE vec2 mapNodeDerivative(TextureNode node, vec2 duv) {
+  vec2 d = mapDerivative(node.mapping, duv);
+  if ((node.flags & kTextureSkewed) != 0u) d = d + vec2(node.skew.x * duv.y, node.skew.y * duv.x);
+  return d;
+}
+
 // ---- Image lookups ------------------------------------------------------------------------
 
 // A texel coordinate folded into [0, size) by the wrap mode, or -1 (kWrapBlack, outside).
@@ -401,8 +414,8 @@ PT_INLINE vec3 evalTextureAt(PT_TEXTURES_PARAM uint first, UVFootprint c) {
     if (node.type == kTextureConstant) {
       v = node.value;
     } else if (PT_TEXTURE_USES(kTextureUsesImages) && node.type == kTextureImage) {
-      v = imageLookup(PT_TEXTURES_ARG node, mapUV(node.mapping, c.uv),
-                      mapDerivative(node.mapping, c.duvdx), mapDerivative(node.mapping, c.duvdy));
+      v = imageLookup(PT_TEXTURES_ARG node, mapNodeUV(node, c.uv), mapNodeDerivative(node, c.duvdx),
+                      mapNodeDerivative(node, c.duvdy));
     } else if (node.type == kTextureCheckerboard) {
       top -= 2u;
       float w = checkerboardWeight(mapUV(node.mapping, c.uv), mapDerivative(node.mapping, c.duvdx),
@@ -445,20 +458,24 @@ PT_INLINE bool anyTexture(MaterialTextures t) {
   return t.reflectance != kNoTexture || t.transmittance != kNoTexture ||
          t.uRoughness != kNoTexture || t.vRoughness != kNoTexture || t.eta != kNoTexture ||
          t.k != kNoTexture || t.displacement != kNoTexture || t.alpha != kNoTexture ||
-         t.thickness != kNoTexture || t.g != kNoTexture;
+         t.thickness != kNoTexture || t.g != kNoTexture || t.emission != kNoTexture ||
+         t.normalMap != kNoTexture;
 }
 
 // The material's parameters at texture coordinates uv: each parameter that has a texture takes
 // the texture's value there, as pbrt-v4's materials evaluate theirs (reflectances clamped to
 // [0, 1] as its albedo spectra are; roughness remapped to alpha where the material asks;
 // diffusetransmission's scale; a conductor given by its reflectance takes eta = 1 and pbrt-v4's
-// k). Parameters without a texture keep the host's values.
+// k; gltf's roughness squared to alpha, its metallic in [0, 1], its emission as it is).
+// Parameters without a texture keep the host's values.
 PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextures t,
                                      UVFootprint uv) {
   bool remap = (t.flags & kRemapRoughness) != 0u;
+  bool square = (t.flags & kSquareRoughness) != 0u;
   // The parameters in this order, each texture evaluated by one call of evalTextureAt (see "One
-  // call site" above).
-  for (uint i = 0u; i < 8u; ++i) {
+  // call site" above). The emission (i = 8) only where some material has an emission texture.
+  uint parameters = PT_TEXTURE_USES(kTextureUsesEmission) ? 9u : 8u;
+  for (uint i = 0u; i < parameters; ++i) {
     PT_TEXTURE_LOOP_TICK();
     uint texture = i == 0u ? (PT_TEXTURE_USES(kTextureUsesReflectance) ? t.reflectance : kNoTexture)
                    : i == 1u
@@ -468,7 +485,8 @@ PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextu
                    : i == 4u ? (PT_TEXTURE_USES(kTextureUsesRoughness) ? t.uRoughness : kNoTexture)
                    : i == 5u ? (PT_TEXTURE_USES(kTextureUsesRoughness) ? t.vRoughness : kNoTexture)
                    : i == 6u ? (PT_TEXTURE_USES(kTextureUsesMedium) ? t.thickness : kNoTexture)
-                             : (PT_TEXTURE_USES(kTextureUsesMedium) ? t.g : kNoTexture);
+                   : i == 7u ? (PT_TEXTURE_USES(kTextureUsesMedium) ? t.g : kNoTexture)
+                             : t.emission;
     if (texture == kNoTexture) continue;
     vec3 value = evalTextureAt(PT_TEXTURES_ARG texture, uv);
     if (i == 0u) {
@@ -493,17 +511,20 @@ PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextu
       m.k = value;
     } else if (i == 4u) {
       float r = max(value.x, 0.0f);
-      m.alphaX = remap ? sqrt(r) : r;
+      m.alphaX = square ? r * r : remap ? sqrt(r) : r;
     } else if (i == 5u) {
       float r = max(value.x, 0.0f);
-      m.alphaY = remap ? sqrt(r) : r;
+      m.alphaY = square ? r * r : remap ? sqrt(r) : r;
     } else if (i == 6u) {
       // coateddiffuse's medium: pbrt-v4 keeps the thickness at least the smallest normal float
       // and clamps g to [-1, 1]; we keep g inside (-1, 1), where Henyey-Greenstein is not a
-      // delta.
-      m.thickness = max(value.x, 1.17549435e-38f);
-    } else {
+      // delta. gltf's metallic, in the same field, is kept in [0, 1].
+      m.thickness =
+          m.type == kMaterialGltf ? clamp(value.x, 0.0f, 1.0f) : max(value.x, 1.17549435e-38f);
+    } else if (i == 7u) {
       m.g = clamp(value.x, -0.999f, 0.999f);
+    } else {
+      m.emission = max(value, vec3(0.0f));
     }
   }
   return m;
@@ -636,6 +657,83 @@ PT_INLINE vec3 bumpedNormal(PT_TEXTURES_PARAM uint displacement, TriangleDerivat
   return dot(bumped, ng) < 0.0f ? -bumped : bumped;
 }
 
+// ---- Normal maps -------------------------------------------------------------------------
+
+// A vertex's tangent (glTF's TANGENT: a direction and the sign w of its bitangent) in one word
+// (TriangleNormals::tangent*): bit 31 set (zero is no tangent), bit 30 for w < 0, and the
+// direction's octahedral coordinates in 15 bits each (bits 15-29 and 0-14; within 2e-4
+// radians).
+#ifdef __cplusplus
+inline uint packTangent(vec3 t, float w) {
+  float l1 = abs(t.x) + abs(t.y) + abs(t.z);
+  if (!(l1 > 0.0f) || !(l1 < 3.0e38f)) return 0u;
+  vec3 o = t / l1;
+  float x = o.x, y = o.y;
+  if (o.z < 0.0f) {
+    x = (1.0f - abs(o.y)) * (o.x >= 0.0f ? 1.0f : -1.0f);
+    y = (1.0f - abs(o.x)) * (o.y >= 0.0f ? 1.0f : -1.0f);
+  }
+  const auto quantize = [](float v) { return uint(clamp(v, -1.0f, 1.0f) * 16383.0f + 16383.5f); };
+  return 0x80000000u | (w < 0.0f ? 0x40000000u : 0u) | quantize(x) << 15u | quantize(y);
+}
+#endif
+// The direction of a packed tangent (unit; zero where there is none).
+PT_INLINE vec3 unpackTangent(uint packed) {
+  if (packed == 0u) return vec3(0.0f);
+  float x = float((packed >> 15u) & 0x7FFFu) / 16383.0f - 1.0f;
+  float y = float(packed & 0x7FFFu) / 16383.0f - 1.0f;
+  vec3 t = vec3(x, y, 1.0f - abs(x) - abs(y));
+  if (t.z < 0.0f) {
+    t.x = (1.0f - abs(y)) * (x >= 0.0f ? 1.0f : -1.0f);
+    t.y = (1.0f - abs(x)) * (y >= 0.0f ? 1.0f : -1.0f);
+  }
+  return normalize(t);
+}
+// A triangle's tangent at barycentrics b (the vertices' interpolated, not made unit) and, in w,
+// the sign of its bitangent (v0's); w = 0 where the triangle has no tangents.
+PT_INLINE vec4 interpolatedTangent(TriangleNormals t, vec3 b) {
+  if (t.tangent0 == 0u) return vec4(0.0f);
+  vec3 d = b.x * unpackTangent(t.tangent0) + b.y * unpackTangent(t.tangent1) +
+           b.z * unpackTangent(t.tangent2);
+  return vec4(d, (t.tangent0 & 0x40000000u) != 0u ? -1.0f : 1.0f);
+}
+
+// The shading normal that a tangent-space normal map (glTF's normalTexture) gives a triangle
+// (its derivatives d, the hit's footprint uv) whose normal there is ns (the vertex normals'
+// or the geometric one): the map's RGB c at uv is the normal (2 c - 1) in the frame of the
+// tangent T, the bitangent B and ns; its x and y times `scale`. T is the vertices' tangent
+// where the mesh has them (vertexTangent, interpolatedTangent's: w its bitangent's sign; w = 0
+// for none), else dp/du, made perpendicular to ns; B = ns x T times w, or turned to dp/dv's
+// side. The green channel points up the image (along +t, glTF's -v), as glTF's normal maps
+// are stored. Where the frame or the normal is degenerate, ns is kept.
+PT_INLINE vec3 normalMappedNormal(PT_TEXTURES_PARAM uint normalMap, float scale,
+                                  TriangleDerivatives d, vec4 vertexTangent, UVFootprint uv,
+                                  vec3 ns) {
+  vec3 c = evalTextureAt(PT_TEXTURES_ARG normalMap, uv);
+  vec3 local = 2.0f * c - vec3(1.0f);
+  local = vec3(local.x * scale, local.y * scale, local.z);
+  bool given = vertexTangent.w != 0.0f;
+  vec3 along = given ? vec3(vertexTangent.x, vertexTangent.y, vertexTangent.z) : d.dpdu;
+  vec3 tangent = along - dot(along, ns) * ns;
+  float t2 = dot(tangent, tangent);
+  vec3 bitangent;
+  if (!(t2 > 0.0f) || !(t2 < 3.0e38f)) {
+    coordinateSystem(ns, tangent, bitangent);
+  } else {
+    tangent = tangent / sqrt(t2);
+    bitangent = cross(ns, tangent);
+    if (given) {
+      bitangent = vertexTangent.w * bitangent;
+    } else if (dot(bitangent, d.dpdv) < 0.0f) {
+      bitangent = -bitangent;
+    }
+  }
+  vec3 n = local.x * tangent + local.y * bitangent + local.z * ns;
+  float len2 = dot(n, n);
+  if (!(len2 > 0.0f) || !(len2 < 3.0e38f)) return ns;
+  return n / sqrt(len2);
+}
+
 // ---- Alpha cut-outs -----------------------------------------------------------------------
 
 // The number a ray's alpha tests compare alpha with, one per ray (for all the surfaces it
@@ -657,11 +755,14 @@ PT_INLINE float shadowAlphaRandom(vec2 uLight) {
 // a triangle of `material` (Triangle::primitive `primitive`) by a ray whose number is u (above):
 // the surface is there where its alpha texture is 1 or more (or it has none), missing where it
 // is 0 or less, and in between there for the rays whose number is at most alpha.
+// With kAlphaCutoff (glTF's MASK) alpha is first cut: 1 at or above the cut-off, else 0.
 PT_INLINE bool alphaKeepsHit(PT_TEXTURES_PARAM uint material, uint primitive, vec3 b, float u) {
-  uint alpha = materialTexturesAt(PT_TEXTURES_ARG material).alpha;
+  MaterialTextures t = materialTexturesAt(PT_TEXTURES_ARG material);
+  uint alpha = t.alpha;
   if (alpha == kNoTexture) return true;
   float a =
       evalFloatTexture(PT_TEXTURES_ARG alpha, interpolatedUV(uvsAt(PT_TEXTURES_ARG primitive), b));
+  if ((t.flags & kAlphaCutoff) != 0u) a = a >= t.alphaCutoff ? 1.0f : 0.0f;
   if (a >= 1.0f) return true;
   if (a <= 0.0f) return false;
   return u <= a;

@@ -276,7 +276,8 @@ BdptFullPath bdptFullPath(const PathScene& ps, const BdptPath& camera, uint n, i
   BdptFullPath f;
   f.x.assign(camera.v, camera.v + n);
   const BdptVertex& end = f.x[n - 1];
-  f.light = bdptTriangleLightVertex(ps, end.emitter, end.p, vec3(1.0f), end.key);
+  f.light = bdptTriangleLightVertex(ps, end.emitter, end.p, vec2(0.0f), vec3(1.0f),
+                                    end.key);  // untextured: b unread
   f.fromCamera.assign(n, 0.0f);
   f.fromLight.assign(n, 0.0f);
   for (uint i = 1; i < n; ++i) {

@@ -3,6 +3,7 @@
 // as a .glb.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -75,6 +76,45 @@ class GltfBuilder {
     doc["nodes"].push_back(node);
     return int(doc["nodes"].size()) - 1;
   }
+  // A UV sphere of radius 1: its positions, normals (the same points), texture coordinates
+  // (u around, v from the top; only where `uvs`, else -1) and 16-bit indices, without the
+  // triangles collapsed to a point at the poles.
+  struct SphereAccessors {
+    int positions, normals, uvs, indices;
+  };
+  SphereAccessors sphere(int rings, int segments, bool uvs) {
+    std::vector<float> p, uv;
+    std::vector<std::uint16_t> idx;
+    for (int i = 0; i <= rings; ++i) {
+      const double theta = 3.14159265358979 * i / rings;
+      for (int j = 0; j <= segments; ++j) {
+        const double phi = 2.0 * 3.14159265358979 * j / segments;
+        p.push_back(float(std::sin(theta) * std::cos(phi)));
+        p.push_back(float(std::cos(theta)));
+        p.push_back(float(-std::sin(theta) * std::sin(phi)));
+        uv.push_back(float(j) / float(segments));
+        uv.push_back(float(i) / float(rings));
+      }
+    }
+    for (int i = 0; i < rings; ++i) {
+      for (int j = 0; j < segments; ++j) {
+        const int a = i * (segments + 1) + j, c = a + segments + 1;
+        if (i != 0) {
+          for (int v : {a, c, a + 1}) idx.push_back(std::uint16_t(v));
+        }
+        if (i != rings - 1) {
+          for (int v : {a + 1, c, c + 1}) idx.push_back(std::uint16_t(v));
+        }
+      }
+    }
+    SphereAccessors s;
+    s.positions = floats(p, "VEC3", 3);
+    s.normals = floats(p, "VEC3", 3);  // a unit sphere's normals are its points
+    s.uvs = uvs ? floats(uv, "VEC2", 2) : -1;
+    s.indices = accessor(view(idx), kUShort, idx.size(), "SCALAR");
+    return s;
+  }
+
   // scenes[0] of the given root nodes.
   void scene(const std::vector<int>& roots) {
     doc["scenes"] = nlohmann::json::array({{{"nodes", roots}}});

@@ -19,44 +19,9 @@ namespace {
 using nlohmann::json;
 using test::GltfBuilder;
 
-// A UV sphere of radius 1 with its normals: positions and normals accessors, indices accessor.
-struct SphereAccessors {
-  int positions, normals, indices;
-};
-SphereAccessors addSphere(GltfBuilder& b, int rings, int segments) {
-  std::vector<float> p;
-  std::vector<std::uint16_t> idx;
-  for (int i = 0; i <= rings; ++i) {
-    const double theta = 3.14159265358979 * i / rings;
-    for (int j = 0; j <= segments; ++j) {
-      const double phi = 2.0 * 3.14159265358979 * j / segments;
-      p.push_back(float(std::sin(theta) * std::cos(phi)));
-      p.push_back(float(std::cos(theta)));
-      p.push_back(float(-std::sin(theta) * std::sin(phi)));
-    }
-  }
-  for (int i = 0; i < rings; ++i) {
-    for (int j = 0; j < segments; ++j) {
-      const int a = i * (segments + 1) + j, c = a + segments + 1;
-      // Each quad's two triangles, but not those collapsed to a point at the poles.
-      if (i != 0) {
-        for (int v : {a, c, a + 1}) idx.push_back(std::uint16_t(v));
-      }
-      if (i != rings - 1) {
-        for (int v : {a + 1, c, c + 1}) idx.push_back(std::uint16_t(v));
-      }
-    }
-  }
-  SphereAccessors s;
-  s.positions = b.floats(p, "VEC3", 3);
-  s.normals = b.floats(p, "VEC3", 3);  // a unit sphere's normals are its points
-  s.indices = b.accessor(b.view(idx), GltfBuilder::kUShort, idx.size(), "SCALAR");
-  return s;
-}
-
 TEST(GltfRender, MetallicRoughnessGridAgreesOnBothBackends) {
   GltfBuilder b;
-  const SphereAccessors sphere = addSphere(b, 12, 24);
+  const GltfBuilder::SphereAccessors sphere = b.sphere(12, 24, false);
   std::vector<int> roots;
   const std::vector<float> metallic = {0.0f, 0.5f, 1.0f};
   const std::vector<float> roughness = {0.0f, 0.3f, 0.6f, 1.0f};

@@ -132,7 +132,7 @@ void addTwistedSphere(Scene& scene, uint material, float twist) {
   if (scene.normals.empty()) {
     for (const Triangle& t : scene.triangles) {
       const vec3 ng = normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
-      scene.normals.push_back(TriangleNormals{ng, 0.0f, ng, 0.0f, ng, 0.0f});
+      scene.normals.push_back(TriangleNormals{ng, 0u, ng, 0u, ng, 0u});
     }
   }
   auto normalAt = [&](vec3 v) {
@@ -149,7 +149,7 @@ void addTwistedSphere(Scene& scene, uint material, float twist) {
     t.primitive = uint(scene.triangles.size());
     scene.triangles.push_back(t);
     scene.normals.push_back(
-        TriangleNormals{normalAt(t.v0), 0.0f, normalAt(t.v1), 0.0f, normalAt(t.v2), 0.0f});
+        TriangleNormals{normalAt(t.v0), 0u, normalAt(t.v1), 0u, normalAt(t.v2), 0u});
   }
 }
 

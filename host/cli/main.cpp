@@ -541,9 +541,10 @@ int main(int argc, char** argv) {
   render->add_option("--camera", r.camera,
                      "glTF files: the camera to render from, by index in the file's cameras or "
                      "by name (default: the first the scene places)");
-  render->add_option("--env", r.environment,
-                     "glTF files: an environment image (.exr, .pfm or .png; latitude-longitude, "
-                     "+y up) to light the model (default: a white sky where it has no light)");
+  render->add_option(
+      "--env", r.environment,
+      "glTF files: an environment image (.exr, .pfm, .png or .hdr; latitude-longitude, "
+      "+y up) to light the model (default: a white sky where it has no light)");
   render->add_option("--spp", r.spp, "Samples per pixel (default: the scene's)")->check(kPositive);
   render->add_option("--threads", r.threads, "CPU threads (default: all)")->check(kPositive);
   render

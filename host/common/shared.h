@@ -89,10 +89,13 @@ static_assert(sizeof(TextureNode) == 16 * kTextureNodeTexels);
 static_assert(offsetof(TextureNode, type) == 12 && offsetof(TextureNode, mapping) == 16);
 static_assert(offsetof(TextureNode, texels) == 32 && offsetof(TextureNode, count) == 52);
 static_assert(offsetof(TextureNode, levels) == 56 && offsetof(TextureNode, maxAnisotropy) == 60);
+static_assert(offsetof(TextureNode, skew) == 64);
 static_assert(sizeof(TriangleUVs) == 32 && offsetof(TriangleUVs, uv2) == 16);
 static_assert(sizeof(MaterialTextures) == 16 * kMaterialTextureTexels);
 static_assert(offsetof(MaterialTextures, displacement) == 24 &&
-              offsetof(MaterialTextures, scale) == 36);
+              offsetof(MaterialTextures, scale) == 36 && offsetof(MaterialTextures, alpha) == 28 &&
+              offsetof(MaterialTextures, emission) == 48 &&
+              offsetof(MaterialTextures, alphaCutoff) == 60);
 static_assert(sizeof(Light) == 64 && sizeof(Light) == 16 * kLightTexels);
 static_assert(offsetof(Light, radius) == 48 && offsetof(Light, material) == 52);
 static_assert(offsetof(Light, type) == 12 && offsetof(Light, radiance) == 16);

@@ -42,7 +42,8 @@ ImageFormat imageFormatOf(const std::filesystem::path& path);
 // extension or an unwritable path.
 void writeImage(const Image& image, const std::filesystem::path& path);
 
-// Reads .exr, .pfm or .png (PNG is decoded from sRGB to linear). Throws InputError naming
+// Reads .exr, .pfm, .png (PNG is decoded from sRGB to linear) or .hdr (Radiance RGBE, by
+// stb_image's stbi_loadf; read, not written). Throws InputError naming
 // the file for anything malformed.
 Image readImage(const std::filesystem::path& path);
 

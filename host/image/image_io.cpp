@@ -187,12 +187,18 @@ void writeImage(const Image& image, const std::filesystem::path& path) {
 }
 
 Image readImage(const std::filesystem::path& path) {
-  const ImageFormat format = imageFormatOf(path);
-  const Bytes bytes = readWholeFile(path, "an image file");
+  // Radiance RGBE (.hdr) is read, not written: it is not one of the ImageFormats.
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   using image_detail::FileFormat;
-  const FileFormat fileFormat = format == ImageFormat::kExr   ? FileFormat::kExr
-                                : format == ImageFormat::kPfm ? FileFormat::kPfm
-                                                              : FileFormat::kPng;
+  FileFormat fileFormat = FileFormat::kHdr;
+  if (ext != ".hdr") {
+    const ImageFormat format = imageFormatOf(path);
+    fileFormat = format == ImageFormat::kExr   ? FileFormat::kExr
+                 : format == ImageFormat::kPfm ? FileFormat::kPfm
+                                               : FileFormat::kPng;
+  }
+  const Bytes bytes = readWholeFile(path, "an image file");
   image_detail::DecodeOptions options;
   options.rgbOnly = true;
   options.limitTexels = false;

@@ -404,7 +404,8 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
       const bool any = t->reflectance != kNoTexture || t->transmittance != kNoTexture ||
                        t->uRoughness != kNoTexture || t->vRoughness != kNoTexture ||
                        t->eta != kNoTexture || t->k != kNoTexture || t->thickness != kNoTexture ||
-                       t->g != kNoTexture;
+                       t->g != kNoTexture || t->emission != kNoTexture ||
+                       t->normalMap != kNoTexture;
       fx.textures = fx.textures || any;
       fx.alphaCutouts = fx.alphaCutouts || t->alpha != kNoTexture;
       fx.bumpMaps = fx.bumpMaps || t->displacement != kNoTexture;
@@ -419,6 +420,8 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
       uses(t->k, kTextureUsesEtaK);
       uses(t->thickness, kTextureUsesMedium);
       uses(t->g, kTextureUsesMedium);
+      uses(t->emission, kTextureUsesEmission);
+      uses(t->normalMap, kTextureUsesNormalMap);
       // A bump map steps by the footprint; alpha is tested in the traversal, at a point.
       uses(t->displacement, kTextureUsesFootprints);
       if (t->alpha != kNoTexture) {

@@ -20,8 +20,10 @@
 #include "common/check.h"
 #include "common/named_values.h"
 #include "scene/camera_filter.h"
+#include "scene/gltf/gltf_wrapper.h"
 #include "scene/json_media.h"
 #include "scene/json_reader.h"
+#include "scene/json_sections.h"
 #include "scene/json_textures.h"
 #include "scene/json_transform.h"
 #include "scene/media.h"
@@ -134,11 +136,11 @@ PixelFilterDesc readFilter(const JsonNode& node) {
   return filter;
 }
 
-CameraDesc readCamera(const JsonNode& node) {
+// The keys given replace those of `desc` (a glTF wrapper's camera over the file's).
+CameraDesc readCamera(const JsonNode& node, CameraDesc desc = CameraDesc()) {
   // "medium" (the medium the camera is in) is read with the media (loadJsonScene).
   node.checkKeys({"position", "target", "up", "vfov", "width", "height", "filter", "lensRadius",
                   "focalDistance", "screenWindow", "cropWindow", "pixelBounds", "medium"});
-  CameraDesc desc;
   glm::dvec3 position(desc.position), target(desc.target), up(desc.up);
   if (auto n = node.find("position")) position = n->vec3();
   if (auto n = node.find("target")) target = n->vec3();
@@ -1006,6 +1008,26 @@ void readEnvironmentImage(const JsonNode& l, const std::filesystem::path& sceneF
   scene.environment = std::move(env);
 }
 
+// An "environment" light: an image (readEnvironmentImage) or a constant radiance.
+void readEnvironmentLight(const JsonNode& l, const std::filesystem::path& sceneFile, Scene& scene) {
+  if (l.find("filename")) {
+    readEnvironmentImage(l, sceneFile, scene);
+    return;
+  }
+  l.checkKeys({"type", "radiance"});
+  const JsonNode n = l.require("radiance");
+  const glm::dvec3 c = n.vec3();
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (!(c[k] >= 0.0) || !(static_cast<float>(c[k]) < 3.4e38f)) {
+      n[k].fail("expected a non-negative number that fits a 32-bit float, got " + n[k].describe());
+    }
+  }
+  Light light{};
+  light.type = kLightInfinite;
+  light.radiance = glm::vec3(c);
+  scene.lights.push_back(light);
+}
+
 // "lights": pbrt-v4's point, spot, distant and infinite lights (docs/scene-format.md), in world
 // space, with their radiometric quantities given directly.
 void readLights(const JsonNode& node, const std::filesystem::path& sceneFile, Scene& scene) {
@@ -1064,13 +1086,9 @@ void readLights(const JsonNode& node, const std::filesystem::path& sceneFile, Sc
       const JsonNode direction = l.require("direction");
       light.direction = unit(direction, direction.vec3());
       light.radiance = colour("radiance");
-    } else if (type == "environment" && l.find("filename")) {
-      readEnvironmentImage(l, sceneFile, scene);
-      continue;
     } else if (type == "environment") {
-      l.checkKeys({"type", "radiance"});
-      light.type = kLightInfinite;
-      light.radiance = colour("radiance");
+      readEnvironmentLight(l, sceneFile, scene);
+      continue;
     } else {
       typeNode.fail("unknown light type " + singleQuoted(type) +
                     " (expected \"point\", \"spot\", \"distant\" or \"environment\")");
@@ -1081,7 +1099,23 @@ void readLights(const JsonNode& node, const std::filesystem::path& sceneFile, Sc
 
 }  // namespace
 
-Scene loadJsonScene(const std::filesystem::path& path) {
+namespace scene_detail {
+
+CameraDesc readJsonCamera(const JsonNode& node, const CameraDesc& base) {
+  return readCamera(node, base);
+}
+IntegratorSettings readJsonIntegrator(const JsonNode& node) {
+  return readIntegrator(node);
+}
+void readJsonEnvironment(const JsonNode& node, const std::filesystem::path& sceneFile,
+                         Scene& scene) {
+  node.expectObject();
+  readEnvironmentLight(node, sceneFile, scene);
+}
+
+}  // namespace scene_detail
+
+Scene loadJsonScene(const std::filesystem::path& path, const SceneLoadOptions& options) {
   const std::string file = path.string();
   std::string text;
   std::string why;
@@ -1090,6 +1124,15 @@ Scene loadJsonScene(const std::filesystem::path& path) {
   }
   const nlohmann::json document = scene_detail::parseJson(text, file);
   const JsonNode root(document, "", file);
+  // A glTF file with what glTF lacks (docs/gltf.md, "A JSON wrapper").
+  if (document.is_object() && document.contains("gltf")) {
+    return scene_detail::loadGltfWrapper(root, path, options);
+  }
+  if (!options.camera.empty() || !options.environment.empty()) {
+    scene_detail::throwInputError(file, "",
+                                  std::string(options.camera.empty() ? "--env" : "--camera") +
+                                      " is for glTF files; this is not one");
+  }
   root.checkKeys({"description", "camera", "integrator", "textures", "media", "materials", "shapes",
                   "lights"});
 

@@ -10,6 +10,9 @@ namespace pt {
 
 // Reads a JSON scene file into a Scene with a flat triangle list. Throws InputError with
 // "<file>: <field>: <message>" for anything malformed. Mesh paths are relative to the file.
-Scene loadJsonScene(const std::filesystem::path& path);
+// A file with a "gltf" key is a glTF wrapper (docs/gltf.md); options are for those
+// (--camera and --env are refused for other JSON scenes).
+Scene loadJsonScene(const std::filesystem::path& path,
+                    const SceneLoadOptions& options = SceneLoadOptions());
 
 }  // namespace pt

@@ -2,7 +2,6 @@
 #include "scene/load_scene.h"
 
 #include "scene/gltf/gltf_scene.h"
-#include "scene/json_reader.h"
 #include "scene/json_scene.h"
 #include "scene/pbrt/pbrt_scene.h"
 
@@ -13,12 +12,7 @@ Scene loadScene(const std::filesystem::path& path, const SceneLoadOptions& optio
   if (path.extension() == ".gltf" || path.extension() == ".glb") {
     return loadGltfScene(path, options);  // docs/gltf.md
   }
-  if (!options.camera.empty() || !options.environment.empty()) {
-    scene_detail::throwInputError(path.string(), "",
-                                  std::string(options.camera.empty() ? "--env" : "--camera") +
-                                      " is for glTF files; this is not one");
-  }
-  return loadJsonScene(path);
+  return loadJsonScene(path, options);  // a JSON scene, or a glTF wrapper (docs/gltf.md)
 }
 
 }  // namespace pt

@@ -107,7 +107,7 @@ Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3
   };
   const auto flatNormals = [](const Triangle& f) {
     const vec3 ng = glm::normalize(glm::cross(f.v1 - f.v0, f.v2 - f.v0));
-    return TriangleNormals{ng, 0.0f, ng, 0.0f, ng, 0.0f};
+    return TriangleNormals{ng, 0u, ng, 0u, ng, 0u};
   };
   t.emitter = kNoEmitter;
   t.primitive = static_cast<uint>(scene.triangles.size());
@@ -125,8 +125,8 @@ Appended appendTriangle(Scene& scene, Triangle t, const std::array<glm::dvec3, 3
   if (normals != nullptr) {
     const vec3 ng = flatNormals(t).n0;
     const std::array<glm::dvec3, 3>& n = *normals;
-    scene.normals.push_back(TriangleNormals{unitNormal(n[0], ng), 0.0f, unitNormal(n[1], ng), 0.0f,
-                                            unitNormal(n[2], ng), 0.0f});
+    scene.normals.push_back(TriangleNormals{unitNormal(n[0], ng), 0u, unitNormal(n[1], ng), 0u,
+                                            unitNormal(n[2], ng), 0u});
   } else if (!scene.normals.empty()) {
     scene.normals.push_back(flatNormals(t));
   }

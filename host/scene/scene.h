@@ -137,8 +137,8 @@ struct SceneLoadOptions {
   // glTF files: the camera to render from, an index into the file's "cameras" or a camera's
   // name (pt render --camera); empty: the first camera a node of the scene places.
   std::string camera;
-  // glTF files: an environment image (.exr, .pfm or .png; latitude-longitude, +y up) that lights
-  // the model instead of the white sky a file without lights gets (pt render --env).
+  // glTF files: an environment image (.exr, .pfm, .png or .hdr; latitude-longitude, +y up) that
+  // lights the model instead of the white sky a file without lights gets (pt render --env).
   std::string environment;
 };
 

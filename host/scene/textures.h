@@ -45,7 +45,9 @@ inline MaterialTextures noMaterialTextures() {
   MaterialTextures t{};
   t.reflectance = t.transmittance = t.uRoughness = t.vRoughness = kNoTexture;
   t.eta = t.k = t.displacement = t.alpha = t.thickness = t.g = kNoTexture;
+  t.emission = t.normalMap = kNoTexture;
   t.scale = 1.0f;
+  t.normalScale = 1.0f;
   return t;
 }
 

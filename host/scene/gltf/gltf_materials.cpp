@@ -47,13 +47,6 @@ double extensionNumber(const tinygltf::Value& object, const char* key, double fa
   return v.GetNumberAsDouble();
 }
 
-void warnTexture(int index, const std::string& where, Context& context) {
-  if (index < 0) return;
-  context.warnOnce("texture", where,
-                   "textures other than the base colour's are not simulated yet: the "
-                   "material's factors are used");
-}
-
 }  // namespace
 
 Material readMaterial(const tinygltf::Model& model, int index, Context& context) {
@@ -79,15 +72,8 @@ Material readMaterial(const tinygltf::Model& model, int index, Context& context)
       context.fail(path + ".alphaMode", "'" + m.alphaMode + "' is not OPAQUE, MASK or BLEND");
     }
     if (!(m.alphaCutoff >= 0.0)) context.fail(path + ".alphaCutoff", "must be at least 0");
-    if (m.alphaMode != "OPAQUE") {
-      context.warnOnce("alpha", path + ".alphaMode",
-                       m.alphaMode + " is not simulated yet: the surface is rendered opaque");
-    }
-    // baseColorTexture: gltf_textures.h.
-    warnTexture(pbr.metallicRoughnessTexture.index, pbrPath + ".metallicRoughnessTexture", context);
-    warnTexture(m.normalTexture.index, path + ".normalTexture", context);
-    warnTexture(m.emissiveTexture.index, path + ".emissiveTexture", context);
-    // occlusionTexture: ambient occlusion is what path tracing computes; ignored by design.
+    // The textures and the alpha mode: gltf_material_textures.h. occlusionTexture: ambient
+    // occlusion is what path tracing computes; ignored by design.
     for (const auto& [name, value] : m.extensions) {
       const std::string where = path + ".extensions." + name;
       if (name == "KHR_materials_emissive_strength") {

@@ -1,7 +1,7 @@
 // glTF materials as the renderer's kMaterialGltf (shaders/bsdf.h: the specification's
 // metallic-roughness model), from their factors, KHR_materials_ior and
-// KHR_materials_emissive_strength (the base colour texture is gltf_textures.h's). What is not
-// simulated (the other textures, alpha modes, other extensions) is warned, once per kind.
+// KHR_materials_emissive_strength (the textures and the alpha mode are
+// gltf_material_textures.h's). Other extensions are warned, once per kind.
 #pragma once
 
 #include <cstddef>

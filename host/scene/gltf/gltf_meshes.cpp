@@ -9,6 +9,7 @@
 
 #include "scene/gltf/gltf_accessors.h"
 #include "scene/reader_helpers.h"
+#include "texture.h"
 
 namespace pt::gltf {
 
@@ -74,8 +75,10 @@ void MeshReader::decode(const tinygltf::Primitive& p, const std::string& where,
   };
   const AccessorValues n = optional("NORMAL", TINYGLTF_TYPE_VEC3);
   const AccessorValues uv = optional("TEXCOORD_0", TINYGLTF_TYPE_VEC2);
-  optional("TANGENT", TINYGLTF_TYPE_VEC4);  // checked; used by normal maps
-  optional("TEXCOORD_1", TINYGLTF_TYPE_VEC2);
+  // Tangents serve normal maps, in the frame of the normals: without NORMAL they are ignored,
+  // as the specification says.
+  const AccessorValues tangent = optional("TANGENT", TINYGLTF_TYPE_VEC4);
+  const AccessorValues uv1 = optional("TEXCOORD_1", TINYGLTF_TYPE_VEC2);
   for (const auto& [name, index] : p.attributes) {
     bool known = false;
     for (const char* k : kRead) known = known || name == k;
@@ -130,16 +133,27 @@ void MeshReader::decode(const tinygltf::Primitive& p, const std::string& where,
     if (n.count > 0) {
       for (int k = 0; k < 3; ++k) t[std::size_t(k)] = vec3At(n, c[std::size_t(k)]);
       out.normals.push_back(t);
+      if (tangent.count > 0) {
+        std::array<glm::dvec4, 3> tg;
+        for (int k = 0; k < 3; ++k) {
+          const std::size_t i = c[std::size_t(k)];
+          tg[std::size_t(k)] =
+              glm::dvec4(tangent.at(i, 0), tangent.at(i, 1), tangent.at(i, 2), tangent.at(i, 3));
+        }
+        out.tangents.push_back(tg);
+      }
     }
-    if (uv.count > 0) {
-      // glTF's v runs down the image; the renderer's textures have t = 1 at the top row.
+    // glTF's v runs down the image; the renderer's textures have t = 1 at the top row.
+    const auto corners = [&](const AccessorValues& a) {
       std::array<glm::vec2, 3> u;
       for (int k = 0; k < 3; ++k) {
         const std::size_t i = c[std::size_t(k)];
-        u[std::size_t(k)] = glm::vec2(float(uv.at(i, 0)), float(1.0 - uv.at(i, 1)));
+        u[std::size_t(k)] = glm::vec2(float(a.at(i, 0)), float(1.0 - a.at(i, 1)));
       }
-      out.uvs.push_back(u);
-    }
+      return u;
+    };
+    if (uv.count > 0) out.uvs.push_back(corners(uv));
+    if (uv1.count > 0) out.uvs1.push_back(corners(uv1));
   }
 }
 
@@ -168,11 +182,20 @@ void MeshReader::emit(int mesh, const std::string& where, const glm::dmat4& worl
   const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(linear));
   const bool mirrors = glm::determinant(linear) < 0.0;
   for (const LocalPrimitive& p : primitives(std::size_t(mesh))) {
-    const uint material = slot(p.material, p.where);
+    const auto [material, uvSet] = slot(p.material, p.where);
+    // The set the material's textures read; TEXCOORD_0 where the primitive lacks it (warned).
+    if (uvSet == 1 && p.uvs1.empty()) {
+      context_.warnOnce("texcoord missing", p.where + ".attributes",
+                        "the material's textures read TEXCOORD_1, which the primitive lacks: "
+                        "TEXCOORD_0 is used");
+    }
+    const std::vector<std::array<glm::vec2, 3>>& uvs =
+        uvSet == 1 && !p.uvs1.empty() ? p.uvs1 : p.uvs;
     reserveGeometric(scene.triangles, scene.triangles.size() + p.positions.size());
     for (std::size_t i = 0; i < p.positions.size(); ++i) {
       std::array<glm::dvec3, 3> n{};
       std::array<glm::vec2, 3> uv{};
+      std::array<uint, 3> tangents{};
       Triangle t{};
       vec3* corners[3] = {&t.v0, &t.v1, &t.v2};
       for (std::size_t k = 0; k < 3; ++k) {
@@ -182,12 +205,19 @@ void MeshReader::emit(int mesh, const std::string& where, const glm::dmat4& worl
           context_.fail(where, "the transform moves vertices beyond the range of 32-bit floats");
         }
         if (!p.normals.empty()) n[k] = normalMatrix * p.normals[i][k];
-        if (!p.uvs.empty()) uv[k] = p.uvs[i][k];
+        if (!uvs.empty()) uv[k] = uvs[i][k];
+        if (!p.tangents.empty()) {
+          // A tangent is a direction in the surface: it moves with the transform itself, and a
+          // mirroring transform turns the bitangent's sign (the frame's handedness).
+          const glm::dvec4 tg = p.tangents[i][k];
+          tangents[k] = packTangent(vec3(linear * glm::dvec3(tg)), float(mirrors ? -tg.w : tg.w));
+        }
       }
       if (mirrors) {
         std::swap(t.v1, t.v2);
         std::swap(n[1], n[2]);
         std::swap(uv[1], uv[2]);
+        std::swap(tangents[1], tangents[2]);
       }
       t.material = material;
       // The renderer's geometric normal is the float cross product normalized: a triangle too
@@ -200,8 +230,14 @@ void MeshReader::emit(int mesh, const std::string& where, const glm::dmat4& worl
         continue;
       }
       const Appended a =
-          appendTriangle(scene, t, p.normals.empty() ? nullptr : &n, p.uvs.empty() ? nullptr : &uv);
+          appendTriangle(scene, t, p.normals.empty() ? nullptr : &n, uvs.empty() ? nullptr : &uv);
       if (a == Appended::kZeroArea) ++dropped_;
+      if (a == Appended::kAdded && !p.tangents.empty()) {
+        TriangleNormals& added = scene.normals.back();
+        added.tangent0 = tangents[0];
+        added.tangent1 = tangents[1];
+        added.tangent2 = tangents[2];
+      }
       if (a == Appended::kTooMany) {
         context_.fail(where, "too many triangles in the scene (at most 4294967295)");
       }

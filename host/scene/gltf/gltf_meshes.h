@@ -28,11 +28,18 @@ struct LocalPrimitive {
   std::vector<std::array<glm::dvec3, 3>> positions;
   std::vector<std::array<glm::dvec3, 3>> normals;  // parallel, or empty: no NORMAL
   std::vector<std::array<glm::vec2, 3>> uvs;       // TEXCOORD_0, parallel, or empty
+  std::vector<std::array<glm::vec2, 3>> uvs1;      // TEXCOORD_1, parallel, or empty
+  // TANGENT (direction and bitangent sign w), parallel to normals, or empty: none, or no NORMAL.
+  std::vector<std::array<glm::dvec4, 3>> tangents;
 };
 
-// The scene's material index for a glTF material index (-1: the default material), made on
-// first use.
-using MaterialSlot = std::function<uint(int material, const std::string& where)>;
+// The scene's material for a glTF material index (-1: the default material), made on first
+// use, and the texture coordinate set its textures read (0 or 1: the triangles keep that one).
+struct MaterialChoice {
+  uint material = 0;
+  int uvSet = 0;
+};
+using MaterialSlot = std::function<MaterialChoice(int material, const std::string& where)>;
 
 class MeshReader {
  public:

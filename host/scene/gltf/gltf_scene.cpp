@@ -13,6 +13,7 @@
 #include "scene/gltf/gltf_context.h"
 #include "scene/gltf/gltf_document.h"
 #include "scene/gltf/gltf_lights.h"
+#include "scene/gltf/gltf_material_textures.h"
 #include "scene/gltf/gltf_materials.h"
 #include "scene/gltf/gltf_meshes.h"
 #include "scene/gltf/gltf_nodes.h"
@@ -33,6 +34,7 @@ using gltf::PlacedNode;
 using gltf::placeNodes;
 using gltf::readDocument;
 using gltf::readMaterial;
+using gltf::readMaterialTextures;
 using gltf::setCamera;
 using gltf::TextureReader;
 
@@ -81,22 +83,17 @@ Scene build(const tinygltf::Model& model, const std::string& file,
   warnUnsimulated(model, context);
   const std::vector<PlacedNode> nodes = placeNodes(model, context);
   // Scene materials made on first use, one per glTF material (and one for the default).
-  std::map<int, uint> slots;
+  std::map<int, gltf::MaterialChoice> slots;
   TextureReader textures(model, scene, context);
   const MaterialSlot slot = [&](int material, const std::string&) {
-    const auto [it, added] = slots.emplace(material, uint(scene.materials.size()));
+    const auto [it, added] =
+        slots.emplace(material, gltf::MaterialChoice{uint(scene.materials.size()), 0});
     if (added) {
       scene.materials.push_back(readMaterial(model, material, context));
-      const tinygltf::TextureInfo* base =
-          material >= 0
-              ? &model.materials[std::size_t(material)].pbrMetallicRoughness.baseColorTexture
-              : nullptr;
-      if (base != nullptr && base->index >= 0) {
-        MaterialTextures t = noMaterialTextures();
-        t.reflectance = textures.baseColor(
-            *base, scene.materials.back().reflectance,
-            indexed("materials", std::size_t(material)) + ".pbrMetallicRoughness.baseColorTexture");
-        if (t.reflectance != kNoTexture) setMaterialTextures(scene, it->second, t);
+      if (material >= 0) {
+        setMaterialTextures(scene, it->second.material,
+                            readMaterialTextures(model, material, scene.materials.back(), textures,
+                                                 context, it->second.uvSet));
       }
       const std::string name = material >= 0 ? model.materials[std::size_t(material)].name : "";
       scene.materialNames.push_back(
