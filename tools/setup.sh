@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libglm-dev libstb-dev nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libtinyexr-dev libcli11-dev
   libnanovdb-dev zlib1g-dev
-  libgtest-dev clang libfuzzer-14-dev
+  libgtest-dev clang-16 libfuzzer-16-dev
   libembree-dev embree-tools libbenchmark-dev libhwy-dev
   libvulkan-dev mesa-vulkan-drivers glslang-tools glslang-dev spirv-tools vulkan-validationlayers vulkan-tools
   glmark2-data gnuplot-nox python3
