@@ -123,6 +123,32 @@ TEST(MemoryLimit, HugeFilmFromTheSceneNamesTheScene) {
 #endif
 }
 
+TEST(MemoryLimit, SppmStateIsCountedWithTheFilm) {
+#if PT_TEST_SANITIZED
+  GTEST_SKIP() << "ulimit -v does not work under AddressSanitizer";
+#else
+  // A 2048x2048 film alone fits under a 2 GiB address-space limit (about 0.6 GiB); with the
+  // state sppm keeps per pixel (about 2.5 GiB in all) it does not: refused with status 2 and
+  // one line naming the scene, before either is allocated.
+  const test::TempDir dir;
+  const std::string out = (dir / "sppm.exr").string();
+  const std::string command = std::string(PT_BINARY) + " render " +
+                              (test::kConfigs / "cornell-box.json").string() +
+                              " --backend cpu --spp 1 --width 2048 --height 2048 --out " + out;
+  const ShellRun r = runShell("ulimit -v 2097152 && " + command + " --integrator sppm >/dev/null");
+  EXPECT_EQ(r.status, kExitInputError) << r.err;
+  EXPECT_NE(r.err.find("cornell-box.json: sppm with a 2048x2048 film needs "), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("bytes per pixel: the film and sppm's state), but only "), std::string::npos)
+      << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // The path tracer's film of the same size passes the same limit's check.
+  const ShellRun path = runShell("ulimit -v 2097152 && " + command + " --max-depth 1 >/dev/null");
+  EXPECT_EQ(path.err.find("memory is available"), std::string::npos) << path.err;
+#endif
+}
+
 TEST(MemoryLimit, FilmConstructorRefusesWhatCannotFit) {
   // In process: 2^20 x 2^14 pixels at over 40 bytes each is over 640 GiB, more than any test
   // machine has; refused before anything is allocated.

@@ -154,6 +154,10 @@ int runRender(const RenderArgs& args) {
       settings.width.value_or(scene.camera.width), settings.height.value_or(scene.camera.height),
       args.scene + (settings.width || settings.height ? ": with --width/--height, " : ": "));
   const SceneData data = prepareScene(std::move(scene), settings);
+  if (data.integrator == kIntegratorSppm) {
+    checkSppmFitsInMemory(int(data.params.camera.width), int(data.params.camera.height),
+                          args.scene + ": ");
+  }
 
   // The integrators of the CPU reference alone, for what they render: bidirectional path
   // tracing (cpu/bdpt.h) and photon mapping (cpu/sppm.h), whose photons start as BDPT's light

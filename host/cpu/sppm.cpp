@@ -11,11 +11,13 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "bdpt_vertex.h"
 #include "bvh/workers.h"
 #include "common/check.h"
+#include "common/memory.h"
 #include "cpu/bounce_random.h"
 #include "cpu/sppm_grid.h"
 #include "image/exact_sum.h"
@@ -107,6 +109,17 @@ uint32_t sppmPhotonsPerIteration(const SceneData& scene) {
   const int64_t n = scene.sppm.photonsPerIteration;
   if (n > 0) return uint32_t(n);
   return uint32_t(scene.params.camera.width) * uint32_t(scene.params.camera.height);
+}
+
+void checkSppmFitsInMemory(int width, int height, const std::string& what) {
+  // The film, the pixels' state and the grid's inputs (renderSppm's vectors below).
+  const size_t bytesPerPixel =
+      Film::bytesPerPixel() + sizeof(SppmPixel) + sizeof(vec3) + sizeof(float) + sizeof(char);
+  const uint64_t n = uint64_t(std::max(width, 0)) * uint64_t(std::max(height, 0));
+  checkFitsInMemory(
+      n * bytesPerPixel,
+      what + "sppm with a " + std::to_string(width) + "x" + std::to_string(height) + " film",
+      std::to_string(bytesPerPixel) + " bytes per pixel: the film and sppm's state");
 }
 
 CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& options, Film& film,

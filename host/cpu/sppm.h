@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "cpu/integrator.h"
@@ -30,6 +31,11 @@ struct SppmPixelReport {
   vec3 tau{0.0f};
   vec3 ldSum{0.0f};
 };
+
+// Throws InputError "<what>sppm with a WxH film needs ..." where the film and the state
+// renderSppm keeps for every pixel do not fit in the memory available: the command line checks
+// before it allocates either.
+void checkSppmFitsInMemory(int width, int height, const std::string& what);
 
 // Renders options.spp iterations (from sample index 0: iterations build on all before them, so
 // a render cannot be continued or split) and adds each pixel's estimate to the film as its one

@@ -9,12 +9,15 @@
 
 namespace pt {
 
+size_t Film::bytesPerPixel() {
+  // The resolved Image is counted too: it is allocated while the film is alive.
+  return sizeof(decltype(sampleCount)::value_type) + sizeof(decltype(invalidCount)::value_type) +
+         sizeof(decltype(exact)::value_type) + sizeof(decltype(Image::pixels)::value_type);
+}
+
 void Film::checkFitsInMemory(int w, int h, const std::string& what) {
-  // Refused with the numbers before allocating, not killed by the OOM killer halfway. The
-  // resolved Image is counted too: it is allocated while the film is alive.
-  constexpr size_t kBytesPerPixel =
-      sizeof(decltype(sampleCount)::value_type) + sizeof(decltype(invalidCount)::value_type) +
-      sizeof(decltype(exact)::value_type) + sizeof(decltype(Image::pixels)::value_type);
+  // Refused with the numbers before allocating, not killed by the OOM killer halfway.
+  const size_t kBytesPerPixel = bytesPerPixel();
   const uint64_t n = uint64_t(std::max(w, 0)) * uint64_t(std::max(h, 0));
   pt::checkFitsInMemory(n * kBytesPerPixel,
                         what + "a " + std::to_string(w) + "x" + std::to_string(h) + " film",

@@ -97,6 +97,8 @@ struct Film {
   // constructor checks, and a caller that knows where the size came from checks first, so that
   // its error names the file (`what`, e.g. "scene.json: ") and nothing has been built yet.
   static void checkFitsInMemory(int w, int h, const std::string& what = "");
+  // The bytes a film holds per pixel, with its resolved image.
+  static size_t bytesPerPixel();
 
   size_t pixelCount() const { return exact.size(); }
   // Pixel i's sum (row-major index), rounded to double from the exact sums when asked: adding
