@@ -371,8 +371,8 @@ MediumInterface loadMediumInterface(uint primitive) {
 // (docs/bdpt.md, docs/sppm.md): the build compiles them here, every effect on, so that they
 // stay GLSL.
 #include "bdpt_camera.h"
-#include "bdpt_vertex.h"
 #include "bdpt_connect.h"
+#include "bdpt_vertex.h"
 #include "sppm_vertex.h"
 #endif
 

@@ -355,7 +355,7 @@ PT_CONST uint kFloatChannelFirst = 0u;
 PT_CONST uint kFloatChannelAverage = 1u;
 PT_CONST uint kFloatChannelAlpha = 2u;
 PT_CONST uint kTextureInvert = 0x10000u;
-PT_CONST uint kTextureFloat = 0x20000u;  // the texture is a float texture (image lookups)
+PT_CONST uint kTextureFloat = 0x20000u;   // the texture is a float texture (image lookups)
 PT_CONST uint kTextureSkewed = 0x40000u;  // the mapping has cross terms (TextureNode::skew)
 
 struct TextureNode {
@@ -413,7 +413,7 @@ struct MaterialTextures {
   float alphaCutoff;   // kAlphaCutoff: alpha below it is 0, at or above it 1 (gltf's MASK)
 };                     // 64 bytes
 PT_CONST uint kMaterialTextureTexels = 4u;
-PT_CONST uint kRemapRoughness = 1u;  // roughness textures give pbrt-v4's roughness, not alpha
+PT_CONST uint kRemapRoughness = 1u;   // roughness textures give pbrt-v4's roughness, not alpha
 PT_CONST uint kSquareRoughness = 2u;  // roughness textures give gltf's roughness: alpha = r^2
 PT_CONST uint kAlphaCutoff = 4u;      // the alpha texture is cut at alphaCutoff (gltf's MASK)
 

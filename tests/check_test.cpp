@@ -129,7 +129,7 @@ TEST(MemoryLimit, SppmStateIsCountedWithTheFilm) {
 #else
   // A 2048x2048 film alone fits under a 2 GiB address-space limit (about 0.6 GiB); with the
   // state sppm keeps per pixel (about 2.5 GiB in all) it does not: refused with status 2 and
-  // one line naming the scene, before either is allocated.
+  // one line naming the scene, before the BVH build and before either is allocated.
   const test::TempDir dir;
   const std::string out = (dir / "sppm.exr").string();
   const std::string command = std::string(PT_BINARY) + " render " +
@@ -137,7 +137,9 @@ TEST(MemoryLimit, SppmStateIsCountedWithTheFilm) {
                               " --backend cpu --spp 1 --width 2048 --height 2048 --out " + out;
   const ShellRun r = runShell("ulimit -v 2097152 && " + command + " --integrator sppm >/dev/null");
   EXPECT_EQ(r.status, kExitInputError) << r.err;
-  EXPECT_NE(r.err.find("cornell-box.json: sppm with a 2048x2048 film needs "), std::string::npos)
+  EXPECT_NE(
+      r.err.find("cornell-box.json: with --width/--height, sppm with a 2048x2048 film needs "),
+      std::string::npos)
       << r.err;
   EXPECT_NE(r.err.find("bytes per pixel: the film and sppm's state), but only "), std::string::npos)
       << r.err;

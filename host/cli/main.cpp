@@ -150,14 +150,15 @@ int runRender(const RenderArgs& args) {
   settings.spp = args.spp;  // unset: the scene's
   // A film too large for memory is refused before the BVH build and the device start-up, with
   // the file (or the options) it came from.
-  Film::checkFitsInMemory(
-      settings.width.value_or(scene.camera.width), settings.height.value_or(scene.camera.height),
-      args.scene + (settings.width || settings.height ? ": with --width/--height, " : ": "));
-  const SceneData data = prepareScene(std::move(scene), settings);
-  if (data.integrator == kIntegratorSppm) {
-    checkSppmFitsInMemory(int(data.params.camera.width), int(data.params.camera.height),
-                          args.scene + ": ");
+  const int width = settings.width.value_or(scene.camera.width);
+  const int height = settings.height.value_or(scene.camera.height);
+  const std::string sizeFrom =
+      args.scene + (settings.width || settings.height ? ": with --width/--height, " : ": ");
+  Film::checkFitsInMemory(width, height, sizeFrom);
+  if (settings.integrator.value_or(scene.integrator.integrator) == kIntegratorSppm) {
+    checkSppmFitsInMemory(width, height, sizeFrom);  // the film and sppm's state together
   }
+  const SceneData data = prepareScene(std::move(scene), settings);
 
   // The integrators of the CPU reference alone, for what they render: bidirectional path
   // tracing (cpu/bdpt.h) and photon mapping (cpu/sppm.h), whose photons start as BDPT's light
