@@ -10,13 +10,13 @@
 #include <cmath>
 #include <cstdio>
 #include <mutex>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include "bdpt_connect.h"
 #include "bdpt_vertex.h"
 #include "bvh/traverse.h"
+#include "bvh/workers.h"
 #include "common/check.h"
 #include "cpu/bounce_random.h"
 #include "scene/camera_filter.h"
@@ -217,12 +217,12 @@ CpuRenderStats renderBdpt(const SceneData& scene, const CpuRenderOptions& option
   CpuRenderStats stats;
   stats.threads = options.threads > 0 ? options.threads : availableCpus();
 
-  // Passes of one sample index over the image, as renderCpu's. Within a pass, threads take
-  // rows of tiles through an atomic counter and add their pixels' own samples to the film
-  // (each pixel is one tile's); the splats of light tracing, which land anywhere, are kept per
-  // tile and added once the pass is done. The film's sums are exact, so the order they are
-  // added in changes no bit: the image is the same for every thread count. A stop drops the
-  // pass under way: its own samples taken back, its splats never added.
+  // Passes of one sample index over the image, as renderCpu's. Within a pass, the workers (one
+  // team for the whole render) take tiles through an atomic counter and add their pixels' own
+  // samples to the film (each pixel is one tile's); the splats of light tracing, which land
+  // anywhere, are kept per tile and added once the pass is done. The film's sums are exact, so the
+  // order they are added in changes no bit: the image is the same for every thread count. A stop
+  // drops the pass under way: its own samples taken back, its splats never added.
   constexpr int kTile = 8;
   const int tilesX = (film.width + kTile - 1) / kTile;
   const int tilesY = (film.height + kTile - 1) / kTile;
@@ -236,6 +236,7 @@ CpuRenderStats renderBdpt(const SceneData& scene, const CpuRenderOptions& option
   std::vector<char> traced(static_cast<size_t>(tileCount));
   std::atomic<uint64_t> totalRays{0};
   std::mutex progressMutex;
+  Workers workers(stats.threads);
 
   for (int passIndex = 0; passIndex < options.spp; ++passIndex) {
     if (options.stop && options.stop->load(std::memory_order_relaxed)) break;
@@ -279,10 +280,7 @@ CpuRenderStats renderBdpt(const SceneData& scene, const CpuRenderOptions& option
       }
       totalRays += rays;
     };
-    std::vector<std::thread> threads;
-    for (int i = 1; i < stats.threads; ++i) threads.emplace_back(worker);
-    worker();
-    for (std::thread& t : threads) t.join();
+    workers.run([&](int) { worker(); });
     if (dropped) {
       for (int tile = 0; tile < tileCount; ++tile) {
         if (!traced[size_t(tile)]) continue;
