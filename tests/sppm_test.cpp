@@ -368,6 +368,22 @@ TEST(SppmCli, ChosenRefusedAndChecked) {
   EXPECT_NE(gpu.out.find("integrator=sppm estimator=consistent(biased) photons_per_iteration=144 "),
             std::string::npos)
       << gpu.out;
+  // Where a photon checks more visible points than lavapipe's loop cap allows (the water
+  // caustic at 64x64 with pbrt-v4's default radius of 1, a sixteenth of the pool), the render
+  // is given up after its first iteration in one line; a device without the cap renders it.
+  const test::PtResult capped =
+      test::runPt("render " + (test::kConfigs / "water-caustic.json").string() +
+                  " --backend vulkan --integrator sppm --spp 3 --width 64 --height 64 --out " +
+                  (dir / "capped.exr").string());
+  if (capped.status == 0) {
+    EXPECT_EQ(capped.out.find("llvmpipe"), std::string::npos) << capped.out;
+  } else {
+    EXPECT_EQ(capped.status, 2) << capped.err;
+    EXPECT_NE(capped.err.find("ran into the device's loop-iteration cap"), std::string::npos)
+        << capped.err;
+    EXPECT_EQ(std::count(capped.err.begin(), capped.err.end(), '\n'), 1) << capped.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "capped.exr"));
+  }
   refused(box + " --backend cpu --integrator sppm" + small + (dir / "c.exr").string() +
               " --checkpoint " + (dir / "c.ptstate").string(),
           "--checkpoint: the sppm integrator's pixels depend on every iteration before");

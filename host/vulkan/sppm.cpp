@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "common/check.h"
@@ -65,6 +66,19 @@ void transferToCompute(const vk::raii::CommandBuffer& cmd) {
   barrier(cmd, vk::PipelineStageFlagBits::eTransfer, vk::AccessFlagBits::eTransferWrite,
           vk::PipelineStageFlagBits::eComputeShader,
           vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
+}
+
+// A camera path or photon cut short at lavapipe's loop cap leaves sums incomplete, of pixels no
+// one can tell: the render is given up, in one line, as soon as an iteration has one.
+void checkNotTruncated(const VulkanContext& ctx, const void* countersBack) {
+  DeviceCounters c;
+  std::memcpy(&c, countersBack, sizeof(c));
+  if (c.truncated == 0) return;
+  throw InputError("sppm on " + ctx.info().name + ": " + std::to_string(c.truncated) +
+                   " camera paths or photons ran into the device's loop-iteration cap (the most "
+                   "iterations one counted: " +
+                   std::to_string(c.maxLoopIterations) +
+                   "); render with a smaller --sppm-radius or image, or with --backend cpu");
 }
 
 void pushPass(const vk::raii::CommandBuffer& cmd, const ComputeProgram& program,
@@ -210,7 +224,10 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
     }
     computeToTransfer(cmd);
     cmd.copyBuffer(*flux.buffer, *readback.buffer, vk::BufferCopy(0, fluxAt, fluxSize));
+    cmd.copyBuffer(*buffers.counters().buffer, *readback.buffer,
+                   vk::BufferCopy(0, countersAt, sizeof(DeviceCounters)));
     commands.submitAndWait(ctx);
+    checkNotTruncated(ctx, back + countersAt);
 
     // Every pixel's update from the photons it gathered: the exact sums rounded once, as the
     // CPU reference's.
@@ -233,22 +250,16 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
   }
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  // The counters of every pass.
-  commands.begin();
-  cmd.copyBuffer(*buffers.counters().buffer, *readback.buffer,
-                 vk::BufferCopy(0, countersAt, sizeof(DeviceCounters)));
-  commands.submitAndWait(ctx);
+  // The counters of every pass (read back with the last photon pass's sums).
   DeviceCounters counters;
   std::memcpy(&counters, back + countersAt, sizeof(counters));
   stats.rays = uint64_t(counters.raysHigh) << 32 | counters.raysLow;
-  stats.truncatedSamples = counters.truncated;
   stats.maxLoopIterations = counters.maxLoopIterations;
 
-  // Each pixel's estimate, as its one sample; an image of any photon cut short at lavapipe's
-  // loop cap is invalid throughout (its sums are incomplete).
+  // Each pixel's estimate, as its one sample.
   if (done > 0) {
     for (size_t i = 0; i < pixels; ++i) {
-      const vec3 L = invalid[i] || counters.truncated != 0
+      const vec3 L = invalid[i]
                          ? vec3(NAN)
                          : sppmPixelRadiance(ldSum[i], state[i], float(done), float(photons));
       film.add(int(i % size_t(film.width)), int(i / size_t(film.width)), L);
