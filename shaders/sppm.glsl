@@ -90,7 +90,9 @@ void sppmGather(SppmGridShape grid, vec3 p, uint hit, vec3 beta, vec3 wi) {
 }
 
 // Photon pass.sampleCount of the dispatch's photons, from photon pass.reserved on, of
-// iteration pass.sampleIndex: one per invocation.
+// iteration pass.sampleIndex: one per invocation. pass.debugPixel: ~0u, or the one hit whose
+// visible points the photons take (a pass split by hits, the photon ending there; see
+// host/vulkan/sppm.cpp).
 void sppmTracePhotons() {
   params = paramsBuffer;
   SppmGridShape grid = sppmGridShape;
@@ -131,7 +133,10 @@ void sppmTracePhotons() {
       SurfacePoint s = surfacePointAt(hit.triangle, tri, hitBarycentrics(origin, direction, tri),
                                       -direction, noRayDifferential());
       // The first hit is direct light, which the camera paths' light samples count.
-      if (depth > 0u) sppmGather(grid, s.p, depth, beta, -direction);
+      if (depth > 0u && (pass.debugPixel == ~0u || depth == pass.debugPixel)) {
+        sppmGather(grid, s.p, depth, beta, -direction);
+      }
+      if (depth == pass.debugPixel) break;
       BdptVertex v = bdptSurfaceVertex(s, tri.emitter, key, beta, 0.0, prev);
       vec2 uRoulette = random2(sobol, key.pixel, iteration, key.dim + kDimRoulette, seed);
       vec3 betaNew = beta;

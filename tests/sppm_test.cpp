@@ -287,6 +287,24 @@ TEST(SppmVulkan, AgreesWithTheCpuReference) {
   EXPECT_LT(meanOf(renderImage(water, 3)), 0.9 * meanOf(caustic.cpuImage));
 }
 
+TEST(SppmVulkan, PhotonPassSplitByHitsPastTheLoopCap) {
+  // The water caustic at 64x64 with pbrt-v4's default radius of 1: a photon's buckets at all its
+  // hits together take lavapipe's SIMD groups past the loop cap, so the pass is run again split
+  // by hits, the same sums in another order of dispatches; the image still agrees.
+  RenderSettings settings;
+  settings.width = 64;
+  settings.height = 64;
+  settings.integrator = kIntegratorSppm;
+  SceneData water = prepareScene(loadScene(test::kConfigs / "water-caustic.json"), settings);
+  water.sppm.photonsPerIteration = 2000;
+  EXPECT_EQ(water.sppm.radius, 1.0f);
+  const Comparison cmp = renderBoth(water, 1);
+  expectAgreement(cmp);
+  if (cmp.gpu.device.find("llvmpipe") != std::string::npos) {
+    EXPECT_EQ(cmp.gpu.splitPhotonPasses, 1u);
+  }
+}
+
 TEST(SppmVulkan, SameBitsRunToRun) {
   // The photons' atomics arrive in any order; the exact sums make the image the same bits.
   SceneData scene = sppmTestScene(16, 4, kIntegratorSppm, 15.0f, 3000);
@@ -368,13 +386,15 @@ TEST(SppmCli, ChosenRefusedAndChecked) {
   EXPECT_NE(gpu.out.find("integrator=sppm estimator=consistent(biased) photons_per_iteration=144 "),
             std::string::npos)
       << gpu.out;
-  // Where a photon checks more visible points than lavapipe's loop cap allows (the water
-  // caustic at 64x64 with pbrt-v4's default radius of 1, a sixteenth of the pool), the render
-  // is given up after its first iteration in one line; a device without the cap renders it.
-  const test::PtResult capped =
-      test::runPt("render " + (test::kConfigs / "water-caustic.json").string() +
-                  " --backend vulkan --integrator sppm --spp 3 --width 64 --height 64 --out " +
-                  (dir / "capped.exr").string());
+  // Where a photon checks more visible points at one hit than lavapipe's loop cap allows (the
+  // water caustic at 128x128 with pbrt-v4's default radius of 1, a sixteenth of the pool), the
+  // render is given up after its first iteration in one line; a device without the cap renders
+  // it.
+  const test::PtResult capped = test::runPt(
+      "render " + (test::kConfigs / "water-caustic.json").string() +
+      " --backend vulkan --integrator sppm --spp 1 --sppm-photons 2000 --width 128 --height 128 "
+      "--out " +
+      (dir / "capped.exr").string());
   if (capped.status == 0) {
     EXPECT_EQ(capped.out.find("llvmpipe"), std::string::npos) << capped.out;
   } else {

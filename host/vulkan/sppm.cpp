@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <span>
 #include <string>
@@ -185,7 +186,10 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
     cmd.copyBuffer(*found.buffer, *readback.buffer, vk::BufferCopy(0, foundAt, foundSize));
     cmd.copyBuffer(*buffers.accum().buffer, *readback.buffer,
                    vk::BufferCopy(0, ldAt, buffers.accumSize));
+    cmd.copyBuffer(*buffers.counters().buffer, *readback.buffer,
+                   vk::BufferCopy(0, countersAt, sizeof(DeviceCounters)));
     commands.submitAndWait(ctx);
+    checkNotTruncated(ctx, back + countersAt);
 
     // The grid over the visible points that carry light to their pixel, uploaded with the
     // points' positions and radii.
@@ -207,27 +211,47 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
     auto* pointsUp = reinterpret_cast<vec4*>(up + gridSize);
     for (size_t i = 0; i < pixels; ++i) pointsUp[i] = vec4(gridAt[i], radii[i]);
 
-    // The photon pass, in dispatches of at most kSppmPhotonsPerDispatch photons.
+    // The photon pass, in dispatches of at most kSppmPhotonsPerDispatch photons, gathering at
+    // every hit (hits == 0) or split by hits: a dispatch for each hit, every photon traced to
+    // it and taking the visible points there alone. The sums are exact, so either way gives
+    // the same bits; the split keeps each invocation's loop iterations to one hit's bucket,
+    // where all of them together ran into lavapipe's loop cap.
+    const auto photonPassBy = [&](uint32_t hits) {
+      commands.begin();
+      cmd.fillBuffer(*flux.buffer, 0, VK_WHOLE_SIZE, 0);
+      cmd.fillBuffer(*buffers.counters().buffer, offsetof(DeviceCounters, truncated),
+                     sizeof(uint32_t), 0);
+      transferToCompute(cmd);
+      photonPass.bind(cmd);
+      for (uint32_t hit = hits == 0 ? ~0u : 1u; hits == 0 || hit < hits; ++hit) {
+        for (uint32_t first = 0; first < photons;) {
+          const uint32_t count = std::min(photons - first, kSppmPhotonsPerDispatch);
+          const uint32_t perRow = kSppmPhotonRowInvocations;
+          const uint32_t rows = (count + perRow - 1) / perRow;
+          pushPass(cmd, photonPass, PassConstants{uint32_t(iteration), count, hit, first});
+          cmd.dispatch(perRow / kWorkgroupSize, (rows + kWorkgroupSize - 1) / kWorkgroupSize, 1);
+          first += count;
+        }
+        if (hits == 0) break;
+      }
+      computeToTransfer(cmd);
+      cmd.copyBuffer(*flux.buffer, *readback.buffer, vk::BufferCopy(0, fluxAt, fluxSize));
+      cmd.copyBuffer(*buffers.counters().buffer, *readback.buffer,
+                     vk::BufferCopy(0, countersAt, sizeof(DeviceCounters)));
+      commands.submitAndWait(ctx);
+      DeviceCounters c;
+      std::memcpy(&c, back + countersAt, sizeof(c));
+      return c.truncated == 0;
+    };
     commands.begin();
     cmd.copyBuffer(*upload.buffer, *grid.buffer, vk::BufferCopy(0, 0, gridSize));
     cmd.copyBuffer(*upload.buffer, *gridPoints.buffer, vk::BufferCopy(gridSize, 0, foundSize));
-    cmd.fillBuffer(*flux.buffer, 0, VK_WHOLE_SIZE, 0);
-    transferToCompute(cmd);
-    photonPass.bind(cmd);
-    for (uint32_t first = 0; first < photons;) {
-      const uint32_t count = std::min(photons - first, kSppmPhotonsPerDispatch);
-      const uint32_t perRow = kSppmPhotonRowInvocations;
-      const uint32_t rows = (count + perRow - 1) / perRow;
-      pushPass(cmd, photonPass, PassConstants{uint32_t(iteration), count, ~0u, first});
-      cmd.dispatch(perRow / kWorkgroupSize, (rows + kWorkgroupSize - 1) / kWorkgroupSize, 1);
-      first += count;
-    }
-    computeToTransfer(cmd);
-    cmd.copyBuffer(*flux.buffer, *readback.buffer, vk::BufferCopy(0, fluxAt, fluxSize));
-    cmd.copyBuffer(*buffers.counters().buffer, *readback.buffer,
-                   vk::BufferCopy(0, countersAt, sizeof(DeviceCounters)));
     commands.submitAndWait(ctx);
-    checkNotTruncated(ctx, back + countersAt);
+    if (!photonPassBy(0)) {
+      ++stats.splitPhotonPasses;
+      photonPassBy(scene.params.maxDepth);
+      checkNotTruncated(ctx, back + countersAt);
+    }
 
     // Every pixel's update from the photons it gathered: the exact sums rounded once, as the
     // CPU reference's.
