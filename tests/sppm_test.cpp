@@ -248,6 +248,13 @@ std::string readText(const std::filesystem::path& path) {
 
 // ---- The Vulkan backend (lavapipe here) -------------------------------------------------------
 
+// A config at size x size pixels rendered by SPPM.
+SceneData sppmSceneOf(const char* config, int size) {
+  RenderSettings settings{.width = size, .height = size};
+  settings.integrator = kIntegratorSppm;
+  return prepareScene(loadScene(test::kConfigs / config), settings);
+}
+
 // Each pixel's photon flux is summed exactly on the device (64-bit atomics on ExactSum's fixed
 // point) and rounded once on the host, as the CPU sums it: the backends differ only where their
 // floats do (a path's last bits, a point on a cell's or a radius's edge), so the path tracer's
@@ -258,11 +265,7 @@ TEST(SppmVulkan, AgreesWithTheCpuReference) {
   // floor) at its depth of 8.
   const Comparison box = renderBoth(sppmTestScene(16, 4, kIntegratorSppm, 15.0f, 3000), 3);
   expectAgreement(box);
-  RenderSettings settings;
-  settings.width = 16;
-  settings.height = 16;
-  settings.integrator = kIntegratorSppm;
-  SceneData water = prepareScene(loadScene(test::kConfigs / "water-caustic.json"), settings);
+  SceneData water = sppmSceneOf("water-caustic.json", 16);
   water.sppm.radius = 0.1f;
   water.sppm.photonsPerIteration = 4000;
   EXPECT_TRUE(water.effects.dielectric);
@@ -274,7 +277,8 @@ TEST(SppmVulkan, AgreesWithTheCpuReference) {
   const std::string boxFilter = "PixelFilter \"box\"";
   ASSERT_NE(pbrt.find(boxFilter), std::string::npos);
   pbrt.replace(pbrt.find(boxFilter), boxFilter.size(), "PixelFilter \"mitchell\"");
-  settings.maxDepth = 4;
+  RenderSettings settings{.width = 16, .height = 16, .maxDepth = 4};
+  settings.integrator = kIntegratorSppm;
   SceneData mitchell =
       prepareScene(loadPbrtSceneText(pbrt, test::kConfigs / "mitchell.pbrt"), settings);
   mitchell.sppm.radius = 15.0f;
@@ -291,11 +295,7 @@ TEST(SppmVulkan, PhotonPassSplitByHitsPastTheLoopCap) {
   // The water caustic at 64x64 with pbrt-v4's default radius of 1: a photon's buckets at all its
   // hits together take lavapipe's SIMD groups past the loop cap, so the pass is run again split
   // by hits, the same sums in another order of dispatches; the image still agrees.
-  RenderSettings settings;
-  settings.width = 64;
-  settings.height = 64;
-  settings.integrator = kIntegratorSppm;
-  SceneData water = prepareScene(loadScene(test::kConfigs / "water-caustic.json"), settings);
+  SceneData water = sppmSceneOf("water-caustic.json", 64);
   water.sppm.photonsPerIteration = 2000;
   EXPECT_EQ(water.sppm.radius, 1.0f);
   const Comparison cmp = renderBoth(water, 1);
