@@ -10,6 +10,10 @@
 #ifdef PT_DEBUG_PRINTF
 #extension GL_EXT_debug_printf : enable
 #endif
+#ifdef PT_SPPM_PHOTONS
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+#endif
 
 #include "sampling.h"
 #include "shared_types.h"
@@ -366,14 +370,17 @@ MediumInterface loadMediumInterface(uint primitive) {
 #define PT_MEDIUM_KINDS kMediumKinds
 #include "volume_vertex.h"
 #endif
-#ifdef PT_CHECK_LIGHT_PATHS
-// The headers of bidirectional path tracing and photon mapping, which no shader calls yet
-// (docs/bdpt.md, docs/sppm.md): the build compiles them here, every effect on, so that they
-// stay GLSL.
+#if defined(PT_CHECK_LIGHT_PATHS) || defined(PT_SPPM)
+// The headers of bidirectional path tracing and photon mapping (docs/bdpt.md, docs/sppm.md):
+// SPPM's passes call them; the build also compiles them all here, every effect on, so that
+// BDPT's stay GLSL.
 #include "bdpt_camera.h"
 #include "bdpt_connect.h"
 #include "bdpt_vertex.h"
 #include "sppm_vertex.h"
+#endif
+#ifdef PT_SPPM
+#include "sppm.glsl"
 #endif
 
 // A ray whose first traversal gave up at an edge function of exactly zero (traceRayWith in
@@ -452,6 +459,9 @@ struct Path {
   PathState state;  // L, beta, etaScale, bsdfPdf, specularBounce (path_vertex.h)
 #endif
   float weight;   // the camera sample's weight (filter.h): multiplies L at the end
+#ifdef PT_SPPM_CAMERA
+  bool ending;  // past SPPM's visible point: the path's last ray is under way
+#endif
   bool hitReady;  // the ray's closest hit is hitFound and hit already (see Retrace)
   bool hitFound;
   HitData hit;
@@ -472,6 +482,9 @@ Path startPath(uvec2 pixel, uint sampleIndex) {
   path.crossings = 0u;
 #else
   path.state = cameraPathState(camera);
+#endif
+#ifdef PT_SPPM_CAMERA
+  path.ending = false;
 #endif
   path.hitReady = false;
   path.hitFound = false;
@@ -529,10 +542,16 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
   // Add emitted light found by this ray, weighed against light sampling (MIS).
   addEmissionFound(path.state, tri, s, hit.t, path.origin);
 
-  // Stop after maxDepth scattering events.
+  // Stop after maxDepth scattering events (or one ray past SPPM's visible point).
   if (path.depth == params.maxDepth) return true;
+#ifdef PT_SPPM_CAMERA
+  if (path.ending) return true;
+#endif
   VertexKey key = VertexKey(pixel, sampleIndex, kDimFirstBounce + kDimsPerBounce * path.depth);
   ++path.depth;
+#ifdef PT_SPPM_CAMERA
+  path.ending = sppmKeepVisiblePoint(s, key, path.depth, path.state.beta * path.weight);
+#endif
 
   // Sample direct illumination from an emitter (next-event estimation): a light sample, its
   // shadow ray, its contribution weighed against BSDF sampling (MIS).
@@ -575,12 +594,20 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
 }
 #endif
 
+#ifdef PT_SPPM_PHOTONS
+void main() {
+  sppmTracePhotons();
+}
+#else
 void main() {
   params = paramsBuffer;
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= params.camera.width || pixel.y >= params.camera.height) return;
   uint index = pixel.y * params.camera.width + pixel.x;
   gDebug = index == pass.debugPixel;
+#ifdef PT_SPPM_CAMERA
+  gSppmPixel = index;
+#endif
   // The film's pixel, which the random numbers and the camera ray are of: a crop renders its
   // pixels of the whole film's image.
   uvec2 filmPixel = pixel + uvec2(params.camera.cropX, params.camera.cropY);
@@ -659,3 +686,4 @@ void main() {
   uint before = atomicAdd(counters.raysLow, gRays);
   if (before + gRays < before) atomicAdd(counters.raysHigh, 1u);  // carry into the high word
 }
+#endif

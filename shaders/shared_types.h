@@ -588,6 +588,18 @@ PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v =
 // LightBvhNode[], then (four to a texel) each Emitter's leaf and the unbounded Emitters' indices
 #define PT_BINDING_LIGHT_BVH 17
 #define PT_BINDING_COUNT 18
+// Stochastic progressive photon mapping's passes (shaders/sppm.glsl) bind these besides.
+#define PT_BINDING_SPPM_POINTS 18       // the visible points' records, in the shader's layout
+#define PT_BINDING_SPPM_FOUND 19        // vec4 per pixel: its visible point, w 1 where there is one
+#define PT_BINDING_SPPM_GRID 20         // SppmGridShape, the buckets' starts, the entries (uint)
+#define PT_BINDING_SPPM_GRID_POINTS 21  // vec4 per pixel: the visible point, its search radius
+#define PT_BINDING_SPPM_FLUX 22         // PT_SPPM_FLUX_WORDS uint64 per pixel
+// A pixel's photons of one iteration on the device: the exact sums of their flux (red, green,
+// blue: five limbs each, exact_sum_atomic.glsl), then their count plus 2^PT_SPPM_INVALID_SHIFT
+// for each whose flux was NaN or infinite.
+#define PT_SPPM_FLUX_WORDS 16u
+#define PT_SPPM_COUNT_WORD 15u
+#define PT_SPPM_INVALID_SHIFT 40u
 
 // The one specialization constant: the traversal stack's size, rows of four entries
 // (bvh.glsl), from the tree. The effect set is not specialized but compiled in: the host

@@ -1,12 +1,13 @@
 // Stochastic progressive photon mapping (Hachisuka and Jensen 2009; pbrt-v4's SPPMIntegrator)
-// at one vertex, written once for the CPU reference and a later shader: where a camera path
-// takes its visible point, which photons count there and what one adds to its pixel, a photon's
-// Russian roulette, the random numbers of a photon, and the per-pixel update of the photon
-// count, search radius and flux, and the pixel's radiance estimate. The camera path's steps up
-// to the visible point are path_vertex.h's (emission found, light sampling, BSDF sampling); a
-// photon's emission and scattering are bdpt_vertex.h's (sampleBdptLightStart, bdptScatter for
-// importance). Tracing rays, the hash grid of visible points and how passes are scheduled are
-// each backend's (host/cpu/sppm.cpp).
+// at one vertex, written once for the CPU reference and the shader (sppm.glsl): where a camera
+// path takes its visible point, which photons count there and what one adds to its pixel, a
+// photon's Russian roulette, the random numbers of a photon, and the per-pixel update of the
+// photon count, search radius and flux, and the pixel's radiance estimate. The camera path's
+// steps up to the visible point are path_vertex.h's (emission found, light sampling, BSDF
+// sampling); a photon's emission and scattering are bdpt_vertex.h's (sampleBdptLightStart,
+// bdptScatter for importance), the grid's cells sppm_grid_cell.h's. Tracing rays, building the
+// hash grid of visible points and how passes are scheduled are each backend's
+// (host/cpu/sppm.cpp, host/vulkan/sppm.cpp).
 #ifndef PT_SPPM_VERTEX_H
 #define PT_SPPM_VERTEX_H
 

@@ -160,13 +160,13 @@ int runRender(const RenderArgs& args) {
   }
   const SceneData data = prepareScene(std::move(scene), settings);
 
-  // The integrators of the CPU reference alone, for what they render: bidirectional path
-  // tracing (cpu/bdpt.h) and photon mapping (cpu/sppm.h), whose photons start as BDPT's light
-  // subpaths.
+  // The integrators besides the path tracer, for what they render: bidirectional path tracing
+  // (cpu/bdpt.h, the CPU reference's alone) and photon mapping (cpu/sppm.h, vulkan/sppm.h),
+  // whose photons start as BDPT's light subpaths.
   const std::optional<BdptStrategy> bdptStrategy = parseBdptStrategy(args.overrides.strategy);
   const std::string integrator(nameOf(kIntegratorNames, data.integrator));
   if (data.integrator != kIntegratorPath) {
-    if (args.backend != "cpu") {
+    if (args.backend != "cpu" && data.integrator != kIntegratorSppm) {
       throw InputError(args.scene + ": the " + integrator +
                        " integrator runs on the CPU only: its GPU version is not there yet "
                        "(render with --backend cpu, or --integrator path)");

@@ -45,20 +45,21 @@ SppmGrid::SppmGrid(const std::vector<vec3>& points, const std::vector<float>& ra
   }
   start_.assign(2, 0u);
   if (count == 0 || !(maxRadius > 0.0f)) return;
-  lower_ = lo;
-  extent_ = hi - lo;
+  shape_.lower = lo;
+  shape_.extent = hi - lo;
+  const vec3 extent = shape_.extent;
   // pbrt-v4's resolution: the longest side in cells of the largest radius, the others in
   // proportion, at least one cell each.
-  const float maxExtent = std::max(extent_.x, std::max(extent_.y, extent_.z));
+  const float maxExtent = std::max(extent.x, std::max(extent.y, extent.z));
   const float base = std::min(std::floor(maxExtent / maxRadius), kSppmGridMaxResolution);
   for (int a = 0; a < 3; ++a) {
-    resolution_[a] = std::max(int(base * extent_[a] / maxExtent), 1);
+    shape_.resolution[a] = std::max(int(base * extent[a] / maxExtent), 1);
   }
 
   // Each point in the bucket of every cell its box overlaps: counted per bucket, then listed (a
   // counting sort, in point order within each bucket).
-  buckets_ = nextPrime(uint32_t(count));
-  const uint32_t size = buckets_;
+  shape_.buckets = nextPrime(uint32_t(count));
+  const uint32_t size = shape_.buckets;
   std::vector<uint32_t> counts(size_t(size) + 1, 0u);
   // The buckets of the cells point i's box overlaps, each once: where two of its cells hash to
   // the same bucket, pbrt-v4 lists the point twice there and a photon in either cell counts
@@ -66,12 +67,12 @@ SppmGrid::SppmGrid(const std::vector<vec3>& points, const std::vector<float>& ra
   std::vector<uint32_t> buckets;
   auto forCells = [&](size_t i, auto&& f) {
     ivec3 a, b;
-    toCell(points[i] - vec3(radii[i]), a);
-    toCell(points[i] + vec3(radii[i]), b);
+    sppmGridCell(shape_, points[i] - vec3(radii[i]), a);
+    sppmGridCell(shape_, points[i] + vec3(radii[i]), b);
     buckets.clear();
     for (int z = a.z; z <= b.z; ++z) {
       for (int y = a.y; y <= b.y; ++y) {
-        for (int x = a.x; x <= b.x; ++x) buckets.push_back(hashOf(ivec3(x, y, z)));
+        for (int x = a.x; x <= b.x; ++x) buckets.push_back(sppmGridBucket(shape_, ivec3(x, y, z)));
       }
     }
     std::sort(buckets.begin(), buckets.end());
@@ -87,27 +88,7 @@ SppmGrid::SppmGrid(const std::vector<vec3>& points, const std::vector<float>& ra
   for (size_t i = 0; i < points.size(); ++i) {
     if (present[i]) forCells(i, [&](uint32_t h) { entries_[counts[h]++] = uint32_t(i); });
   }
-}
-
-bool SppmGrid::toCell(vec3 p, ivec3& cell) const {
-  bool inside = true;
-  for (int a = 0; a < 3; ++a) {
-    const float offset = extent_[a] > 0.0f ? (p[a] - lower_[a]) / extent_[a] : 0.0f;
-    // In float, as pbrt-v4, but the bounds' upper face inside (its last cell's); a NaN
-    // coordinate lands outside.
-    const float scaled = float(resolution_[a]) * offset;
-    const bool in = scaled >= 0.0f && scaled <= float(resolution_[a]);
-    inside = inside && in;
-    cell[a] =
-        in ? std::min(int(scaled), resolution_[a] - 1) : (scaled > 0.0f ? resolution_[a] - 1 : 0);
-  }
-  return inside;
-}
-
-uint32_t SppmGrid::hashOf(ivec3 cell) const {
-  // pcg4d's mix of the three coordinates (sampling.h), reduced to the table.
-  const uvec4 h = pcg4d(uvec4(uint(cell.x), uint(cell.y), uint(cell.z), 0x5BD1E995u));
-  return h.x % buckets_;
+  shape_.entries = uint32_t(entries_.size());
 }
 
 }  // namespace pt

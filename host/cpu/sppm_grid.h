@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/shared.h"
+#include "sppm_grid_cell.h"
 
 namespace pt {
 
@@ -26,8 +27,8 @@ class SppmGrid {
   template <typename F>
   void forCandidates(vec3 p, F&& f) const {
     ivec3 cell;
-    if (!empty() && toCell(p, cell)) {
-      const uint32_t h = hashOf(cell);
+    if (!empty() && sppmGridCell(shape_, p, cell)) {
+      const uint32_t h = sppmGridBucket(shape_, cell);
       for (uint32_t k = start_[h]; k < start_[h + 1]; ++k) f(entries_[k]);
     }
   }
@@ -44,19 +45,20 @@ class SppmGrid {
   }
 
   bool empty() const { return entries_.empty(); }
-  ivec3 resolution() const { return resolution_; }
+  ivec3 resolution() const { return shape_.resolution; }
   size_t entryCount() const { return entries_.size(); }  // (point, cell) pairs listed
 
- private:
-  // The cell of p, clamped to the grid; false where p lies outside its bounds.
-  bool toCell(vec3 p, ivec3& cell) const;
-  uint32_t hashOf(ivec3 cell) const;
+  // The grid as the GPU's photons read it (shaders/sppm.glsl): its shape, the buckets' starts
+  // (bucket h's entries are [starts[h], starts[h + 1])) and the entries, point indices.
+  const SppmGridShape& shape() const { return shape_; }
+  const std::vector<uint32_t>& bucketStarts() const { return start_; }
+  const std::vector<uint32_t>& entries() const { return entries_; }
 
+ private:
   const std::vector<vec3>& points_;
   const std::vector<float>& radii_;
-  vec3 lower_{0.0f}, extent_{0.0f};
-  ivec3 resolution_{1};
-  uint32_t buckets_ = 1;         // the hash table's size: a prime near the point count
+  // Its bounds, resolution and the hash table's size: a prime near the point count.
+  SppmGridShape shape_{vec3(0.0f), 1u, vec3(0.0f), 0u, ivec3(1), 0u};
   std::vector<uint32_t> start_;  // the hash table: bucket h's entries are [start_[h], start_[h+1])
   std::vector<uint32_t> entries_;  // point indices, bucket by bucket
 };

@@ -15,6 +15,8 @@
 #include "vulkan/glsl_compiler.h"
 #include "vulkan/gpu_bvh.h"
 #include "vulkan/resources.h"
+#include "vulkan/scene_buffers.h"
+#include "vulkan/sppm.h"
 
 namespace pt {
 namespace {
@@ -23,23 +25,10 @@ using S = vk::PipelineStageFlagBits;
 using A = vk::AccessFlagBits;
 using U = vk::BufferUsageFlagBits;
 
-// The device buffers of one render, indexed by PT_BINDING_*, and the host-visible buffer the
-// accumulation and the counters are copied back through.
-struct RenderBuffers {
-  std::vector<Buffer> bound;
-  uint32_t stackRows = 0;    // the traversal's stack for the uploaded tree (gpuStackRows)
-  std::vector<bool> texels;  // by binding: read as texels (a uniform texel buffer)
-  Buffer readback;
-  vk::DeviceSize accumSize = 0;
-
-  const Buffer& accum() const { return bound[PT_BINDING_ACCUM]; }
-  const Buffer& counters() const { return bound[PT_BINDING_COUNTERS]; }
-};
+}  // namespace
 
 // ---- Upload: the flat scene arrays into device-local buffers ---------------------------------
 
-// Creates every buffer the shader binds and records the copies of the scene arrays from
-// `staging` (filled here, kept alive by the caller until the commands have run).
 RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
                           const vk::raii::CommandBuffer& cmd, Buffer& staging) {
   const Camera& cam = scene.params.camera;
@@ -133,19 +122,21 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
 
 // ---- Pipeline: shaders/pathtrace.comp compiled for the scene's effect set -----------------
 
-ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const SceneData& scene,
-                                    const VulkanRenderOptions& options,
-                                    const RenderBuffers& buffers) {
+ComputeProgram makePathtraceProgram(const VulkanContext& ctx, const std::string& definitions,
+                                    const RenderBuffers& buffers,
+                                    const std::vector<Binding>& extra) {
   std::vector<Binding> bound;
   for (size_t i = 0; i < buffers.bound.size(); ++i) {
     bound.push_back(Binding{&buffers.bound[i], buffers.texels[i]});
   }
-  const std::vector<uint32_t>& spirv =
-      compileShader("pathtrace.comp", pathtraceDefinitions(scene, options));
+  bound.insert(bound.end(), extra.begin(), extra.end());
+  const std::vector<uint32_t>& spirv = compileShader("pathtrace.comp", definitions);
   const vk::SpecializationMapEntry stackEntry(PT_SPEC_STACK_ROWS, 0, sizeof(uint32_t));
   const vk::SpecializationInfo specInfo(1, &stackEntry, sizeof(uint32_t), &buffers.stackRows);
   return makeComputeProgram(ctx, spirv, bound, sizeof(PassConstants), &specInfo);
 }
+
+namespace {
 
 // ---- Passes: dispatches of the shader, recorded into one command buffer -----------------------
 
@@ -342,10 +333,11 @@ std::string pathtraceDefinitions(const SceneData& scene, const VulkanRenderOptio
   // analytic lights, the pixel filters other than the box and the thin lens take the variant
   // without those (PT_NO_BSDF_MATERIALS: the same image).
   const Camera& camera = scene.params.camera;
-  const bool full = all || fx.hasBsdfMaterials() || fx.shadingNormals || fx.deltaLights ||
-                    fx.environment || fx.twoSidedEmitters || fx.sphereLights || fx.textures ||
-                    fx.alphaCutouts || fx.bumpMaps || camera.filterType != kFilterBox ||
-                    camera.lensRadius > 0.0f;
+  // SPPM's passes call BDPT's light start, which reads the analytic lights.
+  const bool full = all || scene.integrator == kIntegratorSppm || fx.hasBsdfMaterials() ||
+                    fx.shadingNormals || fx.deltaLights || fx.environment || fx.twoSidedEmitters ||
+                    fx.sphereLights || fx.textures || fx.alphaCutouts || fx.bumpMaps ||
+                    camera.filterType != kFilterBox || camera.lensRadius > 0.0f;
   if (fx.media) {
     text += "#define PT_VOLPATH\n";
   } else if (options.context.debugPrintf) {
@@ -358,6 +350,7 @@ std::string pathtraceDefinitions(const SceneData& scene, const VulkanRenderOptio
 
 VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions& options,
                                Film& film) {
+  if (scene.integrator == kIntegratorSppm) return renderSppmVulkan(scene, options, film);
   const auto start = std::chrono::steady_clock::now();
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
@@ -369,7 +362,8 @@ VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions
   commands.begin();
   Buffer staging;
   const RenderBuffers buffers = uploadScene(ctx, scene, cmd, staging);
-  const ComputeProgram program = makePathtraceProgram(ctx, scene, options, buffers);
+  const ComputeProgram program =
+      makePathtraceProgram(ctx, pathtraceDefinitions(scene, options), buffers);
   const uint32_t debugPixel = options.debugPixelX >= 0 ? uint32_t(options.debugPixelY) * cam.width +
                                                              uint32_t(options.debugPixelX)
                                                        : ~0u;

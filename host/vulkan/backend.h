@@ -35,6 +35,7 @@ struct VulkanRenderOptions : RenderOptions {
 // dispatch that compiles the shader); wallSeconds counts set-up and upload too.
 struct VulkanRenderStats : RenderStats {
   uint32_t maxLoopIterations = 0;  // most loop iterations one invocation ran (lavapipe's cap)
+  uint32_t splitPhotonPasses = 0;  // sppm: photon passes run again split by hits (the cap)
   uint32_t validationErrors = 0;
   std::string device;
   // The samples of a batch not folded into the film: when stopped in the middle of a batch,

@@ -179,16 +179,34 @@ VulkanContext::VulkanContext(const ContextOptions& options) try {
   vk::PhysicalDeviceFeatures features;
   features.shaderFloat64 = VK_TRUE;
   std::vector<const char*> extensions;
-  if (options.debugPrintf) {
-    // debugPrintfEXT needs non-semantic instructions: core in Vulkan 1.3, else an extension.
-    const auto available = physicalDevice.enumerateDeviceExtensionProperties();
+  const auto available = physicalDevice.enumerateDeviceExtensionProperties();
+  const auto addIfAvailable = [&](const char* name) {
     for (const auto& e : available) {
-      if (std::string(e.extensionName.data()) == VK_KHR_SHADER_NON_SEMANTIC_INFO_EXTENSION_NAME)
-        extensions.push_back(VK_KHR_SHADER_NON_SEMANTIC_INFO_EXTENSION_NAME);
+      if (std::string(e.extensionName.data()) == name) extensions.push_back(name);
     }
+  };
+  // debugPrintfEXT needs non-semantic instructions: core in Vulkan 1.3, else an extension.
+  if (options.debugPrintf) addIfAvailable(VK_KHR_SHADER_NON_SEMANTIC_INFO_EXTENSION_NAME);
+  vk::DeviceCreateInfo createInfo({}, queueInfo, {}, {}, &features);
+  vk::PhysicalDeviceShaderAtomicInt64Features atomics;
+  if (options.int64Atomics) {
+    // Core in Vulkan 1.2, else an extension; asked for only by the renders that use them.
+    const auto supported =
+        physicalDevice.getFeatures2<vk::PhysicalDeviceFeatures2,
+                                    vk::PhysicalDeviceShaderAtomicInt64Features>();
+    if (!supported.get<vk::PhysicalDeviceFeatures2>().features.shaderInt64 ||
+        !supported.get<vk::PhysicalDeviceShaderAtomicInt64Features>().shaderBufferInt64Atomics) {
+      throw NoDeviceError(info_.name +
+                          " has no 64-bit integer buffer atomics (shaderBufferInt64Atomics), "
+                          "which the sppm integrator sums its photons with");
+    }
+    addIfAvailable(VK_KHR_SHADER_ATOMIC_INT64_EXTENSION_NAME);
+    features.shaderInt64 = VK_TRUE;
+    atomics.shaderBufferInt64Atomics = VK_TRUE;
+    createInfo.pNext = &atomics;
   }
-  device = vk::raii::Device(physicalDevice,
-                            vk::DeviceCreateInfo({}, queueInfo, {}, extensions, &features));
+  createInfo.setPEnabledExtensionNames(extensions);
+  device = vk::raii::Device(physicalDevice, createInfo);
   queue = device.getQueue(queueFamily, 0);
 } catch (const vk::IncompatibleDriverError&) {
   throw NoDeviceError("no Vulkan driver found (Debian: mesa-vulkan-drivers for lavapipe)");
