@@ -1105,6 +1105,8 @@ PT_INLINE BsdfSample gltfLayeredSample(GltfLayers l, vec3 wo, float uc, vec2 u, 
     i = reflectAbout(o, trSampleWm(l.s.d, o, u));
   } else if (uc < p.x + p.y + p.z) {
     i = sampleCosineHemisphere(u);
+  } else if (!(p.w > 0.0f)) {
+    return noBsdfSample();  // uc beyond the probabilities' sum, rounded below 1
   } else if (l.refracts) {
     // The interface, in wo's own orientation; uc rescaled to its share for its own choice.
     float ur = min((uc - (p.x + p.y + p.z)) / max(p.w, 1e-30f), 0.99999994f);

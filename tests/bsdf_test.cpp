@@ -1751,6 +1751,24 @@ TEST(BsdfHardCases, NoInvalidValues) {
       materials.push_back(coatedDiffuse(p));
     }
   }
+  // glTF's extensions at their extremes: smooth and nearly smooth, ior 1 (no interface) and 4,
+  // black and white, every layer at once.
+  for (float roughness : {0.0f, 0.04f, 1.0f}) {
+    for (float ior : {1.0f, 4.0f}) {
+      for (bool volume : {false, true}) {
+        materials.push_back(gltfLayered({.base = vec3(volume ? 1.0f : 0.0f),
+                                         .metallic = 0.5f,
+                                         .roughness = roughness,
+                                         .ior = ior,
+                                         .transmission = 1.0f,
+                                         .volume = volume,
+                                         .clearcoat = 1.0f,
+                                         .clearcoatRoughness = roughness,
+                                         .specular = 1.0f,
+                                         .specularColour = vec3(4.0f, 0.0f, 1.0f)}));
+      }
+    }
+  }
   std::vector<vec3> incoming;
   for (double z : {1.0, 0.5, 1e-3, 1e-6, -1e-6, -1e-3, -0.5, -1.0})
     incoming.push_back(direction(z, 0.3));
