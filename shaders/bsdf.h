@@ -29,6 +29,11 @@ namespace pt {
 #define PT_HAS_COATED_DIFFUSE true
 #define PT_HAS_GLTF true
 #endif
+// glTF's material extensions (transmission, volume, clearcoat, specular: gltfLayered*), which
+// the shader compiles in only for scenes with a material that uses one.
+#ifndef PT_HAS_GLTF_LAYERS
+#define PT_HAS_GLTF_LAYERS true
+#endif
 
 // Counts an iteration of the layered BSDF's loops where the shader keeps count of its loops
 // (lavapipe caps them; see pathtrace.comp); nothing in C++.
@@ -926,6 +931,226 @@ PT_INLINE BsdfSample gltfSample(GltfSurface s, vec3 wo, float uc, vec2 u) {
   return BsdfSample(f, pdf, wi, kBsdfReflection, 1.0f, false);
 }
 
+// ---- glTF's material extensions -------------------------------------------------------------
+// KHR_materials_transmission, _volume, _clearcoat and _specular on top of the material above,
+// layered as the extensions' specifications layer them:
+//
+//   coated   = mix(material, clearcoat_brdf, clearcoat Fc(N.V)),  Fc Schlick's of f0 0.04
+//   material = mix(dielectric, metal_brdf, metallic)
+//   dielectric = fresnel_mix(F(N.V), base = mix(diffuse, specular_btdf baseColor, transmission),
+//                            layer = specular_brdf)
+//   F = f0 + (f90 - f0)(1 - cos)^5, f0 = min(((ior - 1) / (ior + 1))^2 specularColor, 1)
+//       specular, f90 = specular (KHR_materials_specular)
+//
+// with the macro surface's N.V in every Fresnel weight of a layer, as the material above takes
+// it, so that each layer passes on exactly what it does not reflect. specular_btdf is thin-walled
+// (the reflection lobe mirrored through the surface, KHR_materials_transmission's thin wall)
+// unless the material bounds a volume (KHR_materials_volume's thicknessFactor > 0): then the
+// transmitted share is a rough dielectric interface of the material's ior (Walter et al. 2007,
+// dielectricF above, exact Fresnel per microfacet, total internal reflection from inside) whose
+// refracted part is tinted by the base colour, in place of the layer's Fresnel mix. Material
+// fields (kMaterialGltf with nSamples != 0): nSamples the kGltf* flags, transmittance (the
+// transmission factor, the clearcoat factor, the clearcoat's alpha), k the specular colour, eta.y
+// the specular factor; the rest as the material above.
+
+struct GltfLayers {
+  GltfSurface s;
+  vec3 f0;             // the dielectric's reflectance at normal incidence (KHR_materials_specular)
+  float f90;           // its reflectance at grazing incidence
+  float transmission;  // the share of the dielectric's base that is transmitted
+  bool refracts;       // the transmission refracts into a volume (else thin-walled)
+  float eta;           // the index of refraction
+  float clearcoat;
+  TrowbridgeReitz coat;
+};
+
+PT_INLINE GltfLayers gltfLayersOf(Material m) {
+  GltfSurface s = gltfSurfaceOf(m);
+  vec3 f0 = min(vec3(s.f0) * m.k, vec3(1.0f)) * m.eta.y;
+  bool refracts = (m.nSamples & kGltfVolume) != 0u;
+  return GltfLayers(s, f0, m.eta.y, m.transmittance.x, refracts, m.eta.x, m.transmittance.y,
+                    TrowbridgeReitz(m.transmittance.z, m.transmittance.z));
+}
+
+// What each lobe is weighed by for wo (cosThetaO = |wo.z|), before its own Fresnel term where it
+// has one: the clear coat's Fc (scalar), the base's 1 - clearcoat Fc (the rest is below).
+PT_INLINE float gltfCoatWeight(GltfLayers l, float cosThetaO) {
+  return l.clearcoat * (0.04f + 0.96f * schlickWeight(cosThetaO));
+}
+PT_INLINE vec3 gltfLayerFresnel(GltfLayers l, float cosThetaO) {
+  return l.f0 + (vec3(l.f90) - l.f0) * schlickWeight(cosThetaO);
+}
+// The specular reflection lobe: the dielectric layer's F(N.V) (of the opaque share alone where
+// the transmitted share refracts: the interface has its own reflection) and the metal's
+// Schlick term at V.H.
+PT_INLINE vec3 gltfLayeredSpecularWeight(GltfLayers l, float cosThetaO, float cosThetaH) {
+  float opaque = l.refracts ? 1.0f - l.transmission : 1.0f;
+  vec3 metal = l.s.baseColor + (vec3(1.0f) - l.s.baseColor) * schlickWeight(cosThetaH);
+  vec3 w = (1.0f - l.s.metallic) * opaque * gltfLayerFresnel(l, cosThetaO) + l.s.metallic * metal;
+  return (1.0f - gltfCoatWeight(l, cosThetaO)) * w;
+}
+PT_INLINE vec3 gltfLayeredDiffuseWeight(GltfLayers l, float cosThetaO) {
+  return (1.0f - gltfCoatWeight(l, cosThetaO)) * (1.0f - l.s.metallic) * (1.0f - l.transmission) *
+         (vec3(1.0f) - gltfLayerFresnel(l, cosThetaO)) * l.s.baseColor;
+}
+// The transmitted share: thin-walled, (1 - F(N.V)) baseColor; refracting, the interface's whole
+// weight (its refracted part tinted apart).
+PT_INLINE vec3 gltfTransmissionWeight(GltfLayers l, float cosThetaO) {
+  float w = (1.0f - gltfCoatWeight(l, cosThetaO)) * (1.0f - l.s.metallic) * l.transmission;
+  if (l.refracts) return vec3(w);
+  return w * (vec3(1.0f) - gltfLayerFresnel(l, cosThetaO)) * l.s.baseColor;
+}
+
+// The probabilities of sampling the coat, the specular lobe, the diffuse lobe and the
+// transmission for wo (x, y, z, w): their weights' largest channels, normalized.
+PT_INLINE vec4 gltfLobeProbabilities(GltfLayers l, float cosThetaO) {
+  vec4 p = vec4(gltfCoatWeight(l, cosThetaO),
+                maxComponent(gltfLayeredSpecularWeight(l, cosThetaO, cosThetaO)),
+                maxComponent(gltfLayeredDiffuseWeight(l, cosThetaO)),
+                maxComponent(gltfTransmissionWeight(l, cosThetaO)));
+  float sum = p.x + p.y + p.z + p.w;
+  return sum > 0.0f ? p / sum : vec4(0.0f);
+}
+
+// A microfacet reflection lobe without its Fresnel term, appendix B's D G1(L) G1(V) /
+// (4 |N.L| |N.V|), for wo and wi above the surface; and the density of sampling it by visible
+// normals.
+PT_INLINE float gltfMicrofacet(TrowbridgeReitz d, vec3 wo, vec3 wi) {
+  vec3 wm = wi + wo;
+  if (dot(wm, wm) == 0.0f || wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+  wm = normalize(wm);
+  return trD(d, wm) * trG1(d, wo) * trG1(d, wi) / (4.0f * wi.z * wo.z);
+}
+PT_INLINE float gltfMicrofacetPdf(TrowbridgeReitz d, vec3 wo, vec3 wi) {
+  vec3 wm = wi + wo;
+  if (dot(wm, wm) == 0.0f || wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+  wm = normalize(wm);
+  return trPdf(d, wo, wm) / (4.0f * abs(dot(wo, wm)));
+}
+PT_INLINE vec3 gltfMirrored(vec3 w) {
+  return vec3(w.x, w.y, -w.z);
+}
+
+// The refracting interface's f or its pdf (in wo's own orientation), its refracted part tinted.
+PT_INLINE vec3 gltfRefractionF(GltfLayers l, vec3 wo, vec3 wi, bool radiance) {
+  vec3 f = dielectricF(l.s.d, l.eta, wo, wi, radiance);
+  return sameHemisphere(wo, wi) ? f : f * l.s.baseColor;
+}
+
+PT_INLINE vec3 gltfLayeredF(GltfLayers l, vec3 wo, vec3 wi, bool radiance) {
+  float cosThetaO = absCosTheta(wo);
+  if (cosThetaO == 0.0f || wi.z == 0.0f) return vec3(0.0f);
+  vec3 f = vec3(0.0f);
+  if (l.refracts && l.transmission > 0.0f) {
+    f += gltfTransmissionWeight(l, cosThetaO) * gltfRefractionF(l, wo, wi, radiance);
+  }
+  // The other lobes are two-sided: wo turned above the surface, wi with it.
+  vec3 o = wo.z < 0.0f ? -wo : wo;
+  vec3 i = wo.z < 0.0f ? -wi : wi;
+  bool baseSmooth = effectivelySmooth(l.s.d);
+  if (i.z > 0.0f) {
+    f += gltfLayeredDiffuseWeight(l, cosThetaO) * kInvPi;
+    if (!baseSmooth) {
+      vec3 wm = normalize(o + i);
+      f += gltfLayeredSpecularWeight(l, cosThetaO, abs(dot(o, wm))) * gltfMicrofacet(l.s.d, o, i);
+    }
+    if (l.clearcoat > 0.0f && !effectivelySmooth(l.coat)) {
+      f += vec3(gltfCoatWeight(l, cosThetaO) * gltfMicrofacet(l.coat, o, i));
+    }
+  } else if (!l.refracts && !baseSmooth) {
+    f += gltfTransmissionWeight(l, cosThetaO) * gltfMicrofacet(l.s.d, o, gltfMirrored(i));
+  }
+  return f;
+}
+
+PT_INLINE float gltfLayeredPdf(GltfLayers l, vec3 wo, vec3 wi) {
+  float cosThetaO = absCosTheta(wo);
+  if (cosThetaO == 0.0f || wi.z == 0.0f) return 0.0f;
+  vec4 p = gltfLobeProbabilities(l, cosThetaO);
+  float pdf = 0.0f;
+  if (l.refracts && p.w > 0.0f) pdf += p.w * dielectricPdf(l.s.d, l.eta, wo, wi, kSampleAll);
+  vec3 o = wo.z < 0.0f ? -wo : wo;
+  vec3 i = wo.z < 0.0f ? -wi : wi;
+  bool baseSmooth = effectivelySmooth(l.s.d);
+  if (i.z > 0.0f) {
+    pdf += p.z * i.z * kInvPi;
+    if (!baseSmooth) pdf += p.y * gltfMicrofacetPdf(l.s.d, o, i);
+    if (p.x > 0.0f && !effectivelySmooth(l.coat)) pdf += p.x * gltfMicrofacetPdf(l.coat, o, i);
+  } else if (!l.refracts && !baseSmooth) {
+    pdf += p.w * gltfMicrofacetPdf(l.s.d, o, gltfMirrored(i));
+  }
+  return pdf;
+}
+
+PT_INLINE BsdfSample gltfLayeredSample(GltfLayers l, vec3 wo, float uc, vec2 u, bool radiance) {
+  float cosThetaO = absCosTheta(wo);
+  if (cosThetaO == 0.0f) return noBsdfSample();
+  vec4 p = gltfLobeProbabilities(l, cosThetaO);
+  vec3 o = wo.z < 0.0f ? -wo : wo;
+  vec3 i;
+  float etap = 1.0f;
+  bool baseSmooth = effectivelySmooth(l.s.d);
+  if (uc < p.x) {
+    // The clear coat.
+    if (effectivelySmooth(l.coat)) {
+      return BsdfSample(vec3(gltfCoatWeight(l, cosThetaO) / cosThetaO), p.x,
+                        vec3(-wo.x, -wo.y, wo.z), kBsdfReflection | kBsdfSpecular, 1.0f, false);
+    }
+    i = reflectAbout(o, trSampleWm(l.coat, o, u));
+  } else if (uc < p.x + p.y) {
+    if (baseSmooth) {
+      return BsdfSample(gltfLayeredSpecularWeight(l, cosThetaO, cosThetaO) / cosThetaO, p.y,
+                        vec3(-wo.x, -wo.y, wo.z), kBsdfReflection | kBsdfSpecular, 1.0f, false);
+    }
+    i = reflectAbout(o, trSampleWm(l.s.d, o, u));
+  } else if (uc < p.x + p.y + p.z) {
+    i = sampleCosineHemisphere(u);
+  } else if (!(p.w > 0.0f)) {
+    return noBsdfSample();  // uc beyond the probabilities' sum, rounded below 1
+  } else if (l.refracts) {
+    // The interface, in wo's own orientation; uc rescaled to its share for its own choice.
+    float ur = min((uc - (p.x + p.y + p.z)) / max(p.w, 1e-30f), 0.99999994f);
+    BsdfSample bs = dielectricSample(l.s.d, l.eta, wo, ur, u, radiance, kSampleAll);
+    if (bs.flags == 0u) return noBsdfSample();
+    if ((bs.flags & kBsdfSpecular) != 0u) {
+      vec3 tint = (bs.flags & kBsdfTransmission) != 0u ? l.s.baseColor : vec3(1.0f);
+      return BsdfSample(gltfTransmissionWeight(l, cosThetaO) * tint * bs.f, p.w * bs.pdf, bs.wi,
+                        bs.flags, bs.eta, false);
+    }
+    i = wo.z < 0.0f ? -bs.wi : bs.wi;
+    etap = bs.eta;
+  } else if (baseSmooth) {
+    // Thin-walled: straight through.
+    return BsdfSample(gltfTransmissionWeight(l, cosThetaO) / cosThetaO, p.w, -wo,
+                      kBsdfTransmission | kBsdfSpecular, 1.0f, false);
+  } else {
+    // Thin-walled: the specular lobe's direction, mirrored through the surface.
+    i = reflectAbout(o, trSampleWm(l.s.d, o, u));
+    if (i.z <= 0.0f) return noBsdfSample();
+    i = gltfMirrored(i);
+  }
+  // A microfacet's reflection below the surface is no sample of its lobe (whose density counts
+  // only the directions above).
+  if (uc < p.x + p.y && i.z <= 0.0f) return noBsdfSample();
+  vec3 wi = wo.z < 0.0f ? -i : i;
+  float pdf = gltfLayeredPdf(l, wo, wi);
+  vec3 f = gltfLayeredF(l, wo, wi, radiance);
+  if (!(pdf > 0.0f) || wi.z == 0.0f) return noBsdfSample();
+  bool reflects = sameHemisphere(wo, wi);
+  return BsdfSample(f, pdf, wi, reflects ? kBsdfReflection : kBsdfTransmission,
+                    reflects ? 1.0f : etap, false);
+}
+
+// Whether the layered material has a lobe light sampling can find, or a delta lobe.
+PT_INLINE bool gltfLayeredHasNonSpecular(GltfLayers l) {
+  return !effectivelySmooth(l.s.d) || (l.s.metallic < 1.0f && l.transmission < 1.0f) ||
+         (l.clearcoat > 0.0f && !effectivelySmooth(l.coat));
+}
+PT_INLINE bool gltfLayeredHasSpecular(GltfLayers l) {
+  return effectivelySmooth(l.s.d) || (l.refracts && l.eta == 1.0f && l.transmission > 0.0f) ||
+         (l.clearcoat > 0.0f && effectivelySmooth(l.coat));
+}
+
 // ---- The material switch: what the integrators call ---------------------------------------
 // For types other than diffuse and mirror (those two stay in the integrators' own code).
 
@@ -943,6 +1168,7 @@ PT_INLINE bool bsdfHasNonSpecular(Material m) {
   }
   if (PT_HAS_THIN_DIELECTRIC && m.type == kMaterialThinDielectric) return false;
   if (PT_HAS_GLTF && m.type == kMaterialGltf) {
+    if (PT_HAS_GLTF_LAYERS && m.nSamples != 0u) return gltfLayeredHasNonSpecular(gltfLayersOf(m));
     return !effectivelySmooth(distributionOf(m)) || m.thickness < 1.0f;
   }
   return true;  // diffuse transmission, coated diffuse
@@ -960,7 +1186,10 @@ PT_INLINE bool bsdfHasSpecular(Material m) {
     return dielectricIsSmooth(distributionOf(m), m.eta.x);
   }
   if (PT_HAS_THIN_DIELECTRIC && m.type == kMaterialThinDielectric) return true;
-  if (PT_HAS_GLTF && m.type == kMaterialGltf) return effectivelySmooth(distributionOf(m));
+  if (PT_HAS_GLTF && m.type == kMaterialGltf) {
+    if (PT_HAS_GLTF_LAYERS && m.nSamples != 0u) return gltfLayeredHasSpecular(gltfLayersOf(m));
+    return effectivelySmooth(distributionOf(m));
+  }
   return false;  // diffuse, diffuse transmission (mirror: the integrators' own)
 }
 
@@ -981,7 +1210,11 @@ PT_INLINE vec3 bsdfFTransport(Material m, vec3 wo, vec3 wi, bool radiance, Rando
   if (PT_HAS_COATED_DIFFUSE && m.type == kMaterialCoatedDiffuse) {
     return coatedDiffuseF(coatedDiffuseOf(m), wo, wi, radiance, rng);
   }
-  if (PT_HAS_GLTF && m.type == kMaterialGltf) return gltfF(gltfSurfaceOf(m), wo, wi);
+  if (PT_HAS_GLTF && m.type == kMaterialGltf) {
+    if (PT_HAS_GLTF_LAYERS && m.nSamples != 0u)
+      return gltfLayeredF(gltfLayersOf(m), wo, wi, radiance);
+    return gltfF(gltfSurfaceOf(m), wo, wi);
+  }
   return vec3(0.0f);  // thin dielectric: delta lobes only
 }
 PT_INLINE vec3 bsdfF(Material m, vec3 wo, vec3 wi, RandomStream rng) {
@@ -1003,7 +1236,10 @@ PT_INLINE float bsdfPdf(Material m, vec3 wo, vec3 wi, RandomStream rng) {
   if (PT_HAS_COATED_DIFFUSE && m.type == kMaterialCoatedDiffuse) {
     return coatedDiffusePdf(coatedDiffuseOf(m), wo, wi, rng);
   }
-  if (PT_HAS_GLTF && m.type == kMaterialGltf) return gltfPdf(gltfSurfaceOf(m), wo, wi);
+  if (PT_HAS_GLTF && m.type == kMaterialGltf) {
+    if (PT_HAS_GLTF_LAYERS && m.nSamples != 0u) return gltfLayeredPdf(gltfLayersOf(m), wo, wi);
+    return gltfPdf(gltfSurfaceOf(m), wo, wi);
+  }
   return 0.0f;
 }
 
@@ -1027,7 +1263,12 @@ PT_INLINE BsdfSample bsdfSampleTransport(Material m, vec3 wo, float uc, vec2 u, 
   if (PT_HAS_COATED_DIFFUSE && m.type == kMaterialCoatedDiffuse) {
     return coatedDiffuseSample(coatedDiffuseOf(m), wo, uc, u, radiance, rng);
   }
-  if (PT_HAS_GLTF && m.type == kMaterialGltf) return gltfSample(gltfSurfaceOf(m), wo, uc, u);
+  if (PT_HAS_GLTF && m.type == kMaterialGltf) {
+    if (PT_HAS_GLTF_LAYERS && m.nSamples != 0u) {
+      return gltfLayeredSample(gltfLayersOf(m), wo, uc, u, radiance);
+    }
+    return gltfSample(gltfSurfaceOf(m), wo, uc, u);
+  }
   return noBsdfSample();
 }
 // Radiance transport, what path tracing samples.

@@ -41,6 +41,7 @@ layout(local_size_x = kWorkgroupSize, local_size_y = kWorkgroupSize) in;
 #define PT_FX_DIFFUSE_TRANSMISSION true
 #define PT_FX_COATED_DIFFUSE true
 #define PT_FX_GLTF true
+#define PT_FX_GLTF_LAYERS true
 #define PT_FX_SHADING_NORMALS true
 #define PT_FX_DELTA_LIGHTS true
 #define PT_FX_ENVIRONMENT true
@@ -71,6 +72,7 @@ const bool kThinDielectric = false;
 const bool kDiffuseTransmission = false;
 const bool kCoatedDiffuse = false;
 const bool kGltf = false;
+const bool kGltfLayers = false;
 const bool kShadingNormals = false;
 const bool kDeltaLights = false;
 const bool kEnvironment = false;
@@ -87,6 +89,7 @@ const bool kThinDielectric = PT_FX_THIN_DIELECTRIC;
 const bool kDiffuseTransmission = PT_FX_DIFFUSE_TRANSMISSION;
 const bool kCoatedDiffuse = PT_FX_COATED_DIFFUSE;
 const bool kGltf = PT_FX_GLTF;
+const bool kGltfLayers = PT_FX_GLTF_LAYERS;
 const bool kShadingNormals = PT_FX_SHADING_NORMALS;
 const bool kDeltaLights = PT_FX_DELTA_LIGHTS;
 const bool kEnvironment = PT_FX_ENVIRONMENT;
@@ -163,6 +166,7 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 #define PT_HAS_DIFFUSE_TRANSMISSION kDiffuseTransmission
 #define PT_HAS_COATED_DIFFUSE kCoatedDiffuse
 #define PT_HAS_GLTF kGltf
+#define PT_HAS_GLTF_LAYERS kGltfLayers
 #define PT_LOOP_TICK() gLoopIterations++
 #include "bsdf.h"
 #include "lights.h"

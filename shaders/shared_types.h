@@ -112,6 +112,12 @@ PT_CONST uint kMaterialCoatedDiffuse = 6u;  // dielectric coat over a Lambertian
 PT_CONST uint kMaterialInterface = 7u;
 // glTF 2.0's metallic-roughness material (its appendix B; shaders/bsdf.h says how it is read).
 PT_CONST uint kMaterialGltf = 8u;
+// Which of glTF's material extensions a kMaterialGltf material uses, in its nSamples (0: none,
+// the metallic-roughness material alone; shaders/bsdf.h's gltfLayered* otherwise).
+PT_CONST uint kGltfTransmission = 1u;  // KHR_materials_transmission
+PT_CONST uint kGltfVolume = 2u;        // KHR_materials_volume: the transmission refracts
+PT_CONST uint kGltfClearcoat = 4u;     // KHR_materials_clearcoat
+PT_CONST uint kGltfSpecular = 8u;      // KHR_materials_specular
 PT_CONST uint kMaterialTypeCount = 9u;
 
 // One material. The first two rows are all that diffuse and mirror surfaces read; the others
@@ -126,18 +132,20 @@ struct Material {
   uint twoSided;       //  4 bytes: 1: emission leaves both sides (pbrt-v4's "twosided")
   vec3 eta;            // 12 bytes: conductor: real part of the index of refraction per channel;
                        //           dielectric, thindielectric, coateddiffuse, gltf: the index
-                       //           in .x
+                       //           in .x; gltf: the specular factor in .y
   float alphaX;        //  4 bytes: Trowbridge-Reitz alpha along the tangent (conductor,
                        //           dielectric, coateddiffuse's coat)
-  vec3 k;              // 12 bytes: conductor: imaginary part of the index (absorption)
+  vec3 k;              // 12 bytes: conductor: imaginary part of the index (absorption); gltf:
+                       //           the specular colour factor
   float alphaY;        //  4 bytes: alpha along the bitangent
   vec3 transmittance;  // 12 bytes: diffusetransmission: transmittance; coateddiffuse: the
-                       //           albedo of the medium between coat and base
+                       //           albedo of the medium between coat and base; gltf: the
+                       //           transmission and clearcoat factors, the clearcoat's alpha
   float thickness;     //  4 bytes: coateddiffuse: the medium's optical thickness; gltf: the
                        //           metallic factor
   float g;             //  4 bytes: coateddiffuse: Henyey-Greenstein asymmetry of the medium
   uint maxDepth;       //  4 bytes: coateddiffuse: random-walk length
-  uint nSamples;       //  4 bytes: coateddiffuse: random walks per evaluation
+  uint nSamples;       //  4 bytes: coateddiffuse: random walks per evaluation; gltf: kGltf*
   uint reserved1;      //  4 bytes: zero
 };                     // 96 bytes
 PT_CONST uint kMaterialTexels = 6u;  // 16-byte texels per Material (the GPU reads them so)

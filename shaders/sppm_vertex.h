@@ -60,7 +60,8 @@ PT_INLINE bool sppmPhotonCounts(PT_IN(SppmVisiblePoint) vp, uint hit, uint maxDe
 
 // Whether the BSDF of shading point s has a diffuse lobe (pbrt-v4's IsDiffuse of its flags):
 // Lambertian, diffuse transmission, the coated diffuse's base, a glTF surface's base where it
-// is not wholly metal.
+// is not wholly metal nor wholly transmissive (KHR_materials_transmission, its factor in
+// transmittance.x: 0 without the extension).
 PT_INLINE bool sppmHasDiffuseLobe(PT_IN(SurfacePoint) s) {
   if (s.scatter == kScatterLambertian) return true;
   if (s.scatter != kScatterBsdf) return false;
@@ -69,7 +70,7 @@ PT_INLINE bool sppmHasDiffuseLobe(PT_IN(SurfacePoint) s) {
       type == kMaterialCoatedDiffuse) {
     return true;
   }
-  return type == kMaterialGltf && s.material.thickness < 1.0f;
+  return type == kMaterialGltf && s.material.thickness < 1.0f && s.material.transmittance.x < 1.0f;
 }
 
 // Whether the camera path keeps its visible point at shading point s, after `depth` scattering

@@ -27,6 +27,8 @@ namespace {
 using test::conductor;
 using test::dielectric;
 using test::diffuseTransmission;
+using test::gltfLayered;
+using test::GltfLayerParams;
 using test::gltfMaterial;
 using test::LobeFocus;
 using test::SphereGrid;
@@ -47,7 +49,7 @@ constexpr int kFewerSamples = 200000 / kSampleDivisor;
 // each runs at the Sidak-corrected level for kMaxTests tests (BsdfChi2.TestCount checks the
 // bound).
 constexpr double kSignificance = 0.01;
-constexpr int kMaxTests = 160;
+constexpr int kMaxTests = 200;
 const double kTestSignificance = test::sidakSignificance(kSignificance, kMaxTests);
 
 // The grid of the chi-square tests: per hemisphere 16 x 32 cells.
@@ -145,6 +147,11 @@ std::string describe(const Material& m) {
   if (m.type == kMaterialGltf) {
     s << " base " << m.reflectance.x << "," << m.reflectance.y << "," << m.reflectance.z
       << " metallic " << m.thickness;
+    if (m.nSamples != 0u) {
+      s << " layers " << m.nSamples << " transmission " << m.transmittance.x << " clearcoat "
+        << m.transmittance.y << " alpha " << m.transmittance.z << " specular " << m.eta.y << " "
+        << m.k.x << "," << m.k.y << "," << m.k.z;
+    }
   }
   if (m.type == kMaterialCoatedDiffuse) {
     s << " thickness " << m.thickness << " g " << m.g << " maxdepth " << m.maxDepth << " nsamples "
@@ -404,6 +411,61 @@ std::vector<Chi2Case> gltfCases() {
   return cases;
 }
 
+// glTF's extensions: thin-walled and refracting transmission (from both sides), the clear coat
+// (rough and smooth, over rough and smooth bases), KHR_materials_specular, all together.
+std::vector<Chi2Case> gltfLayerCases() {
+  std::vector<Chi2Case> cases;
+  const vec3 above = direction(0.6, 0.4), steep = direction(0.15, 2.0),
+             below = direction(-0.5, 1.0);
+  for (float roughness : {0.3f, 0.7f}) {
+    for (float transmission : {0.5f, 1.0f}) {
+      for (vec3 wo : {above, below}) {
+        cases.push_back({gltfLayered({.roughness = roughness, .transmission = transmission}), wo,
+                         kFewerSamples});
+      }
+    }
+    for (vec3 wo : {above, steep, below, direction(-0.9, 0.3)}) {
+      cases.push_back({gltfLayered({.roughness = roughness, .transmission = 1.0f, .volume = true}),
+                       wo, kFewerSamples});
+    }
+  }
+  cases.push_back({gltfLayered({.metallic = 0.2f,
+                                .roughness = 0.4f,
+                                .ior = 1.33f,
+                                .transmission = 0.6f,
+                                .volume = true}),
+                   below, kFewerSamples});
+  for (vec3 wo : {above, steep}) {
+    cases.push_back(
+        {gltfLayered({.roughness = 0.6f, .clearcoat = 1.0f, .clearcoatRoughness = 0.3f}), wo,
+         kFewerSamples});
+    cases.push_back(
+        {gltfLayered(
+             {.metallic = 1.0f, .roughness = 0.0f, .clearcoat = 0.7f, .clearcoatRoughness = 0.5f}),
+         wo, kFewerSamples});
+    cases.push_back({gltfLayered({.roughness = 0.5f, .clearcoat = 1.0f}), wo, kFewerSamples});
+    cases.push_back(
+        {gltfLayered(
+             {.roughness = 0.5f, .specular = 0.5f, .specularColour = vec3(1.0f, 0.5f, 2.0f)}),
+         wo, kFewerSamples});
+  }
+  for (vec3 wo : {above, below}) {
+    cases.push_back({gltfLayered({.metallic = 0.3f,
+                                  .roughness = 0.45f,
+                                  .transmission = 0.5f,
+                                  .volume = true,
+                                  .clearcoat = 0.5f,
+                                  .clearcoatRoughness = 0.4f,
+                                  .specular = 0.7f,
+                                  .specularColour = vec3(0.9f, 1.0f, 0.6f)}),
+                     wo, kFewerSamples});
+  }
+  // Smooth thin-walled transmission beside the diffuse lobe (delta lobes counted apart).
+  cases.push_back(
+      {gltfLayered({.roughness = 0.0f, .transmission = 0.5f}), direction(0.6, 0.4), kFewerSamples});
+  return cases;
+}
+
 TEST(BsdfChi2, Machinery) {
   EXPECT_NEAR(test::gammaQ(1.0, 2.5), std::exp(-2.5), 1e-12);
   // The 95 % quantiles of chi-square with 1 and 1000 degrees of freedom.
@@ -449,6 +511,10 @@ TEST(BsdfChi2, Gltf) {
   for (const Chi2Case& c : gltfCases()) chi2Test(c);
 }
 
+TEST(BsdfChi2, GltfExtensions) {
+  for (const Chi2Case& c : gltfLayerCases()) chi2Test(c);
+}
+
 // The samplers at alpha 0.0015 against the double-precision reference pdf: the sampling is
 // right there, and this machinery resolves lobes that narrow.
 TEST(BsdfChi2, NearSmoothSamplersMatchTheExactPdf) {
@@ -489,6 +555,18 @@ TEST(BsdfChi2, RejectsAWrongPdf) {
        gltfMaterial(vec3(0.5f), 0.6f, 0.5f)},
       {"gltf roughness 0.5 against the pdf of roughness 0.55", gltfMaterial(vec3(0.5f), 0.5f, 0.5f),
        gltfMaterial(vec3(0.5f), 0.5f, 0.55f)},
+      {"gltf transmission 0.5 against the pdf of transmission 0.6",
+       gltfLayered({.roughness = 0.5f, .transmission = 0.5f}),
+       gltfLayered({.roughness = 0.5f, .transmission = 0.6f})},
+      {"gltf volume ior 1.5 against the pdf of ior 1.4",
+       gltfLayered({.roughness = 0.3f, .transmission = 1.0f, .volume = true}),
+       gltfLayered({.roughness = 0.3f, .ior = 1.4f, .transmission = 1.0f, .volume = true})},
+      {"gltf thin-walled transmission against the pdf of a refracting one",
+       gltfLayered({.roughness = 0.3f, .transmission = 1.0f}),
+       gltfLayered({.roughness = 0.3f, .transmission = 1.0f, .volume = true})},
+      {"gltf clearcoat roughness 0.3 against the pdf of 0.35",
+       gltfLayered({.roughness = 0.8f, .clearcoat = 1.0f, .clearcoatRoughness = 0.3f}),
+       gltfLayered({.roughness = 0.8f, .clearcoat = 1.0f, .clearcoatRoughness = 0.35f})},
   };
   for (const Wrong& w : wrongs) {
     const test::Chi2Result r = chi2Test(
@@ -777,6 +855,17 @@ std::vector<Material> roughMaterials() {
     for (float roughness : {0.04f, 0.5f, 1.0f}) {
       materials.push_back(gltfMaterial(vec3(0.8f, 0.4f, 0.1f), metallic, roughness));
     }
+  }
+  for (float roughness : {0.2f, 0.8f}) {
+    materials.push_back(gltfLayered({.roughness = roughness, .transmission = 0.7f}));
+    materials.push_back(
+        gltfLayered({.roughness = roughness, .transmission = 0.7f, .volume = true}));
+    materials.push_back(gltfLayered({.metallic = 0.4f,
+                                     .roughness = roughness,
+                                     .clearcoat = 0.8f,
+                                     .clearcoatRoughness = 0.3f,
+                                     .specular = 0.6f,
+                                     .specularColour = vec3(1.0f, 0.3f, 0.6f)}));
   }
   return materials;
 }
@@ -1264,6 +1353,26 @@ TEST(BsdfEnergy, WhiteFurnaceNeverExceedsOne) {
   }
 }
 
+// Draws `sets` materials (make(rng, i)) and checks that none reflects and transmits more than
+// it receives from any of `incoming` (the sampled albedo within 3 sigma of 1); returns the
+// highest albedo seen.
+template <typename AlbedoOf, typename Make>
+double highestRandomAlbedo(int sets, uint64_t seed, const std::vector<vec3>& incoming,
+                           const AlbedoOf& albedo, const Make& make) {
+  Rng rng(seed);
+  double highest = 0.0;
+  for (int i = 0; i < sets; ++i) {
+    const Material m = make(rng, i);
+    for (vec3 wo : incoming) {
+      const Albedo a = albedo(m, wo, kFurnaceSamples / 8);
+      EXPECT_LE(a.mean, 1.0 + 3.0 * a.sigma + 1e-6)
+          << describe(m) << " wo " << describe(wo) << ": albedo " << a.mean << " +- " << a.sigma;
+      highest = std::max(highest, a.mean);
+    }
+  }
+  return highest;
+}
+
 // glTF's material in the white furnace: metallic 1 with a white base colour is lossless where
 // smooth (every sample's weight 1) and so is a smooth dielectric over a white base (the base
 // receives what the specular layer does not reflect); no parameter set, drawn at random over
@@ -1286,20 +1395,12 @@ TEST(BsdfEnergy, GltfWhiteFurnace) {
     const Albedo a = albedo(smooth, wo, kFurnaceSamples / 4);
     EXPECT_NEAR(a.mean, 1.0, 4.0 * a.sigma + 1e-6) << describe(smooth) << " " << describe(wo);
   }
-  Rng rng(4141);
-  double highest = 0.0;
-  for (int i = 0; i < 40; ++i) {
+  const double highest = highestRandomAlbedo(40, 4141, incoming, albedo, [](Rng& rng, int i) {
     const float metallic = i % 4 == 0 ? 0.0f : rng.uniform();
     const float roughness = i % 5 == 0 ? 0.0f : rng.uniform();
     const float ior = i % 7 == 0 ? 0.0f : 1.0f + 2.0f * rng.uniform();
-    const Material m = gltfMaterial(vec3(1.0f), metallic, roughness, ior);
-    for (vec3 wo : incoming) {
-      const Albedo a = albedo(m, wo, kFurnaceSamples / 8);
-      EXPECT_LE(a.mean, 1.0 + 3.0 * a.sigma + 1e-6)
-          << describe(m) << " wo " << describe(wo) << ": albedo " << a.mean << " +- " << a.sigma;
-      highest = std::max(highest, a.mean);
-    }
-  }
+    return gltfMaterial(vec3(1.0f), metallic, roughness, ior);
+  });
   std::printf("glTF white furnace: the highest albedo of 40 random parameter sets: %.5f\n",
               highest);
 }
@@ -1350,6 +1451,123 @@ TEST(BsdfFresnel, GltfClosedForms) {
         const double reflected = metallic > 0.0f ? b + (1.0 - b) * x : 0.04 + 0.96 * x;
         EXPECT_NEAR(s.f[c] * absCosTheta(s.wi), reflected, 1e-6) << describe(m) << " " << c;
       }
+    }
+  }
+}
+
+// glTF's extensions in the white furnace (importance transport, as the dielectric above: the
+// refracting volume's radiance from inside legitimately exceeds 1): lossless where every layer
+// is smooth and white, the weight of every sample 1 (thin-walled transmission, the refracting
+// interface, a clear coat over white metal); in expectation for a smooth white dielectric under
+// a clear coat with KHR_materials_specular; and no parameter set, drawn at random over the whole
+// range, above 1.
+TEST(BsdfEnergy, GltfExtensionsWhiteFurnace) {
+  const std::vector<vec3> incoming = {vec3(0.0f, 0.0f, 1.0f), direction(0.5, 0.3),
+                                      direction(0.1, 1.3),    direction(1e-3, 2.0),
+                                      direction(-0.5, 0.3),   direction(-0.9, 1.0)};
+  const auto albedo = [](const Material& m, vec3 wo, int n) {
+    return sampledAlbedo(
+        [&](float uc, vec2 u, uint) {
+          return bsdfSampleTransport(m, wo, uc, u, false, RandomStream{});
+        },
+        n, seedOf(caseName(m, wo)));
+  };
+  const vec3 white(1.0f);
+  const std::vector<Material> everySampleOne = {
+      gltfLayered({.base = white, .roughness = 0.0f, .transmission = 1.0f}),
+      gltfLayered({.base = white, .roughness = 0.0f, .transmission = 1.0f, .volume = true}),
+      gltfLayered({.base = white, .metallic = 1.0f, .roughness = 0.0f, .clearcoat = 1.0f})};
+  const Material coated = gltfLayered({.base = white,
+                                       .roughness = 0.0f,
+                                       .clearcoat = 0.6f,
+                                       .specular = 0.5f,
+                                       .specularColour = vec3(1.0f, 0.5f, 2.0f)});
+  for (vec3 wo : incoming) {
+    for (const Material& m : everySampleOne) {
+      const Albedo a = albedo(m, wo, kFurnaceSamples / 4);
+      EXPECT_NEAR(a.mean, 1.0, 1e-5) << describe(m) << " wo " << describe(wo);
+      EXPECT_LT(a.sigma, 1e-6) << describe(m) << " wo " << describe(wo);
+    }
+    const Albedo a = albedo(coated, wo, kFurnaceSamples / 4);
+    EXPECT_NEAR(a.mean, 1.0, 4.0 * a.sigma + 1e-6) << describe(coated) << " " << describe(wo);
+  }
+  const double highest = highestRandomAlbedo(48, 4242, incoming, albedo, [&](Rng& rng, int i) {
+    GltfLayerParams p;
+    p.base = white;
+    p.metallic = i % 4 == 0 ? 0.0f : rng.uniform();
+    p.roughness = i % 5 == 0 ? 0.0f : rng.uniform();
+    p.ior = 1.0f + 2.0f * rng.uniform();
+    p.transmission = i % 3 == 0 ? 1.0f : rng.uniform();
+    p.volume = i % 2 == 0;
+    p.clearcoat = i % 6 == 1 ? 0.0f : rng.uniform();
+    p.clearcoatRoughness = i % 7 == 0 ? 0.0f : rng.uniform();
+    p.specular = rng.uniform();
+    p.specularColour = vec3(2.0f * rng.uniform(), 2.0f * rng.uniform(), 2.0f * rng.uniform());
+    return gltfLayered(p);
+  });
+  std::printf("glTF extensions' white furnace: the highest albedo of 48 random sets: %.5f\n",
+              highest);
+}
+
+// The extensions' layering against the specifications' formulas written out in double: without
+// any of them in effect (transmission 0, no coat, specular 1 and white) f and the pdf are the
+// material's own; the clear coat adds clearcoat Fc(N.V) times its lobe over (1 - clearcoat
+// Fc(N.V)) times the material; KHR_materials_specular's f0 = min(f0(ior) specularColour, 1)
+// specular and f90 = specular; thin-walled transmission is (1 - metallic) transmission
+// (1 - F(N.V)) baseColor times the specular lobe at wi mirrored through the surface.
+TEST(BsdfFresnel, GltfExtensionsClosedForms) {
+  Rng rng(78);
+  const auto lobe = [](double alpha, dvec3 o, dvec3 l) {
+    const ExactTrowbridgeReitz d{alpha, alpha};
+    return d.d(normalize(o + l)) * d.g1(o) * d.g1(l) / (4.0 * o.z * l.z);
+  };
+  for (int i = 0; i < 2000; ++i) {
+    GltfLayerParams p;
+    p.base = vec3(rng.uniform(), rng.uniform(), rng.uniform());
+    p.metallic = rng.uniform();
+    p.roughness = 0.05f + 0.95f * rng.uniform();
+    p.ior = 1.0f + 2.0f * rng.uniform();
+    vec3 wo = rng.direction(), wi = rng.direction();
+    wo.z = std::abs(wo.z);
+    wi.z = std::abs(wi.z);
+    if (wo.z < 1e-3f || wi.z < 1e-3f) continue;
+    const RandomStream stream{};
+    // Neutral: the material's own f and pdf.
+    const Material plain = gltfMaterial(p.base, p.metallic, p.roughness, p.ior);
+    const Material neutral = gltfLayered(p);
+    const vec3 f0 = bsdfF(plain, wo, wi, stream), f1 = bsdfF(neutral, wo, wi, stream);
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(f1[c], f0[c], 1e-6 * f0[c] + 1e-9) << describe(neutral);
+    ASSERT_NEAR(bsdfPdf(neutral, wo, wi, stream), bsdfPdf(plain, wo, wi, stream),
+                1e-6 * bsdfPdf(plain, wo, wi, stream) + 1e-9);
+    // The specular extension, the coat and thin-walled transmission together.
+    p.clearcoat = rng.uniform();
+    p.clearcoatRoughness = 0.05f + 0.95f * rng.uniform();
+    p.specular = rng.uniform();
+    p.specularColour = vec3(2.0f * rng.uniform(), 2.0f * rng.uniform(), 2.0f * rng.uniform());
+    p.transmission = rng.uniform();
+    const Material m = gltfLayered(p);
+    const dvec3 o = dvec3(wo), l = dvec3(wi);
+    const double alpha = double(p.roughness) * p.roughness;
+    const double coatAlpha = double(p.clearcoatRoughness) * p.clearcoatRoughness;
+    const double x = std::pow(1.0 - o.z, 5.0);
+    const double fc = double(p.clearcoat) * (0.04 + 0.96 * x);
+    const double ior0 = sqr((double(p.ior) - 1.0) / (double(p.ior) + 1.0));
+    const vec3 reflected = bsdfF(m, wo, wi, stream);
+    const vec3 transmitted = bsdfF(m, wo, vec3(wi.x, wi.y, -wi.z), stream);
+    for (int c = 0; c < 3; ++c) {
+      const double b = double(p.base[c]);
+      const double f0c = std::min(ior0 * double(p.specularColour[c]), 1.0) * p.specular;
+      const double F = f0c + (double(p.specular) - f0c) * x;
+      const double metal = b + (1.0 - b) * std::pow(1.0 - dot(o, normalize(o + l)), 5.0);
+      const double dm = 1.0 - double(p.metallic);
+      const double base = dm * (1.0 - p.transmission) * (1.0 - F) * b / kPiD +
+                          (dm * F + p.metallic * metal) * lobe(alpha, o, l);
+      const double expected = (1.0 - fc) * base + fc * lobe(coatAlpha, o, l);
+      ASSERT_NEAR(reflected[c], expected, 1e-4 * expected + 1e-7)
+          << describe(m) << " wo " << describe(wo) << " wi " << describe(wi) << " channel " << c;
+      const double through = (1.0 - fc) * dm * p.transmission * (1.0 - F) * b * lobe(alpha, o, l);
+      ASSERT_NEAR(transmitted[c], through, 1e-4 * through + 1e-7)
+          << describe(m) << " wo " << describe(wo) << " wi mirrored " << describe(wi);
     }
   }
 }
@@ -1461,7 +1679,13 @@ TEST(BsdfFlags, HasSpecularIsWhatSamplingReturns) {
       {"smooth coat", coatedDiffuse(CoatParams{})},
       {"rough coat", coatedDiffuse(roughCoat)},
       {"smooth glTF metal", gltfMaterial(vec3(0.8f), 1.0f, 0.0f)},
-      {"rough glTF plastic", gltfMaterial(vec3(0.8f), 0.0f, 0.5f)}};
+      {"rough glTF plastic", gltfMaterial(vec3(0.8f), 0.0f, 0.5f)},
+      {"rough glTF glass", gltfLayered({.roughness = 0.5f, .transmission = 1.0f, .volume = true})},
+      {"smooth glTF glass", gltfLayered({.roughness = 0.0f, .transmission = 1.0f, .volume = true})},
+      {"smooth thin glTF", gltfLayered({.roughness = 0.0f, .transmission = 0.5f})},
+      {"smooth coat on rough glTF", gltfLayered({.roughness = 0.5f, .clearcoat = 0.5f})},
+      {"rough coat on rough glTF",
+       gltfLayered({.roughness = 0.5f, .clearcoat = 0.5f, .clearcoatRoughness = 0.5f})}};
   for (const auto& [name, m] : materials) {
     bool specular = false;
     for (const vec3 wo : {normalize(vec3(0.3f, -0.2f, 0.9f)), normalize(vec3(0.9f, 0.1f, 0.2f)),
@@ -1525,6 +1749,24 @@ TEST(BsdfHardCases, NoInvalidValues) {
       p.thickness = 1.0f;
       p.maxDepth = 64u;
       materials.push_back(coatedDiffuse(p));
+    }
+  }
+  // glTF's extensions at their extremes: smooth and nearly smooth, ior 1 (no interface) and 4,
+  // black and white, every layer at once.
+  for (float roughness : {0.0f, 0.04f, 1.0f}) {
+    for (float ior : {1.0f, 4.0f}) {
+      for (bool volume : {false, true}) {
+        materials.push_back(gltfLayered({.base = vec3(volume ? 1.0f : 0.0f),
+                                         .metallic = 0.5f,
+                                         .roughness = roughness,
+                                         .ior = ior,
+                                         .transmission = 1.0f,
+                                         .volume = volume,
+                                         .clearcoat = 1.0f,
+                                         .clearcoatRoughness = roughness,
+                                         .specular = 1.0f,
+                                         .specularColour = vec3(4.0f, 0.0f, 1.0f)}));
+      }
     }
   }
   std::vector<vec3> incoming;
@@ -1605,7 +1847,7 @@ TEST(BsdfHardCases, NoInvalidValues) {
 TEST(BsdfChi2, TestCount) {
   const size_t chi2 = conductorCases().size() + dielectricCases().size() +
                       diffuseTransmissionCases().size() + 2 * nearSmoothCases().size() +
-                      gltfCases().size();
+                      gltfCases().size() + gltfLayerCases().size();
   const size_t coated = coatedCases().size();
   EXPECT_LE(chi2 + coated, size_t(kMaxTests));
   std::printf("%zu chi-square tests, %zu coated-diffuse tests, each at significance %.3g\n", chi2,

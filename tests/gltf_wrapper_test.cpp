@@ -25,7 +25,7 @@ std::string hdrFile() {
   return s;
 }
 
-GltfBuilder oneTriangle() {
+GltfBuilder triangleWithTwoCameras() {
   GltfBuilder b;
   const int p = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3", 3);
   b.mesh(json::array({{{"attributes", {{"POSITION", p}}}}}));
@@ -59,7 +59,7 @@ TEST(GltfEnvironment, RadianceHdrReadWithItsPixelValues) {
   EXPECT_EQ(image.pixels[0], vec3(1.0f, 0.5f, 0.25f));
   EXPECT_EQ(image.pixels[1], vec3(4.0f, 2.0f, 1.0f));
   // --env with it lights a glTF file (no white sky then).
-  const auto model = dir.write("model.gltf", oneTriangle().gltf());
+  const auto model = dir.write("model.gltf", triangleWithTwoCameras().gltf());
   const Scene scene = loadScene(model, SceneLoadOptions{.environment = file.string()});
   ASSERT_TRUE(scene.environment.has_value());
   EXPECT_TRUE(scene.lights.empty());
@@ -74,7 +74,7 @@ TEST(GltfEnvironment, RadianceHdrReadWithItsPixelValues) {
 TEST(GltfWrapper, NamesTheFileAndAddsEnvironmentCameraAndIntegrator) {
   const test::TempDir dir;
   dir.write("sky.hdr", hdrFile());
-  dir.write("model.gltf", oneTriangle().gltf());
+  dir.write("model.gltf", triangleWithTwoCameras().gltf());
   const auto wrapper =
       dir.write("scene.json", json({{"description", "a triangle under a sky"},
                                     {"gltf", "model.gltf"},
@@ -115,7 +115,7 @@ TEST(GltfWrapper, NamesTheFileAndAddsEnvironmentCameraAndIntegrator) {
 
 TEST(GltfWrapper, ErrorsNameTheWrapperAndTheField) {
   const test::TempDir dir;
-  dir.write("model.gltf", oneTriangle().gltf());
+  dir.write("model.gltf", triangleWithTwoCameras().gltf());
   dir.write("model.obj", "v 0 0 0\n");
   struct Case {
     json wrapper;

@@ -59,4 +59,27 @@ inline Material gltfMaterial(vec3 baseColor, float metallic, float roughness, fl
   m.alphaX = m.alphaY = roughness * roughness;
   return m;
 }
+// glTF's material with its extensions (KHR_materials_transmission, _volume, _clearcoat,
+// _specular) as the glTF reader fills them.
+struct GltfLayerParams {
+  vec3 base = vec3(0.8f, 0.4f, 0.1f);
+  float metallic = 0.0f;
+  float roughness = 0.5f;
+  float ior = 1.5f;
+  float transmission = 0.0f;
+  bool volume = false;  // the transmission refracts (thicknessFactor > 0)
+  float clearcoat = 0.0f;
+  float clearcoatRoughness = 0.0f;
+  float specular = 1.0f;
+  vec3 specularColour = vec3(1.0f);
+};
+inline Material gltfLayered(const GltfLayerParams& p) {
+  Material m = gltfMaterial(p.base, p.metallic, p.roughness, p.ior);
+  m.nSamples = kGltfTransmission | kGltfSpecular | (p.volume ? kGltfVolume : 0u) |
+               (p.clearcoat > 0.0f ? kGltfClearcoat : 0u);
+  m.transmittance = vec3(p.transmission, p.clearcoat, p.clearcoatRoughness * p.clearcoatRoughness);
+  m.k = p.specularColour;
+  m.eta.y = p.specular;
+  return m;
+}
 }  // namespace pt::test

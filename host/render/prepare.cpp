@@ -56,6 +56,7 @@ std::string EffectSet::toString() const {
   add(diffuseTransmission, "diffusetransmission");
   add(coatedDiffuse, "coateddiffuse");
   add(gltf, "gltf");
+  add(gltfLayers, "gltf-layers");
   add(shadingNormals, "shading-normals");
   add(deltaLights, "delta-lights");
   add(environment, "environment");
@@ -441,6 +442,7 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     if (m.type == kMaterialDiffuseTransmission) fx.diffuseTransmission = true;
     if (m.type == kMaterialCoatedDiffuse) fx.coatedDiffuse = true;
     if (m.type == kMaterialGltf) fx.gltf = true;
+    if (m.type == kMaterialGltf && m.nSamples != 0u) fx.gltfLayers = true;
     if (m.type > kMaterialMirror && bsdfHasNonSpecular(m)) lightSampled = true;
   }
   // Light is sampled from the points where a medium scatters.

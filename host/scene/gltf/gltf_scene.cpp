@@ -7,6 +7,7 @@
 #include <map>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "image/image.h"
 #include "scene/gltf/gltf_camera.h"
@@ -18,6 +19,7 @@
 #include "scene/gltf/gltf_meshes.h"
 #include "scene/gltf/gltf_nodes.h"
 #include "scene/gltf/gltf_textures.h"
+#include "scene/gltf/gltf_volume_media.h"
 #include "scene/json_reader.h"
 
 namespace pt {
@@ -41,6 +43,8 @@ using gltf::TextureReader;
 // Extensions of the file that the reader reads, in part or whole (docs/gltf.md).
 bool isReadExtension(const std::string& name) {
   return name == "KHR_materials_emissive_strength" || name == "KHR_materials_ior" ||
+         name == "KHR_materials_transmission" || name == "KHR_materials_volume" ||
+         name == "KHR_materials_clearcoat" || name == "KHR_materials_specular" ||
          name == "KHR_lights_punctual" || name == "KHR_texture_transform";
 }
 
@@ -85,11 +89,13 @@ Scene build(const tinygltf::Model& model, const std::string& file,
   // Scene materials made on first use, one per glTF material (and one for the default).
   std::map<int, gltf::MaterialChoice> slots;
   TextureReader textures(model, scene, context);
+  std::vector<gltf::MaterialExtensions> extensions;  // parallel to scene.materials
   const MaterialSlot slot = [&](int material, const std::string&) {
     const auto [it, added] =
         slots.emplace(material, gltf::MaterialChoice{uint(scene.materials.size()), 0});
     if (added) {
-      scene.materials.push_back(readMaterial(model, material, context));
+      extensions.emplace_back();
+      scene.materials.push_back(readMaterial(model, material, context, &extensions.back()));
       if (material >= 0) {
         setMaterialTextures(scene, it->second.material,
                             readMaterialTextures(model, material, scene.materials.back(), textures,
@@ -114,6 +120,7 @@ Scene build(const tinygltf::Model& model, const std::string& file,
                              " zero-area triangle" + (meshes.dropped() == 1 ? "" : "s"));
   }
   if (scene.triangles.empty()) context.fail("scene", "the scene has no triangles to render");
+  gltf::addVolumeMedia(extensions, scene);
   padMaterialTextures(scene);
   setCamera(model, nodes, options.camera, scene, context);
   addPunctualLights(model, nodes, scene, context);
