@@ -63,6 +63,7 @@ check_seed=2000001
 # relMSE whose time to reach is tabulated, per scene.
 declare -A target=([cornell-box]=0.0005 [water-caustic]=0.005)
 
+[[ -x $pt ]] || { echo "no $pt: build it first (cmake --build $build --target pt)" >&2; exit 2; }
 mkdir -p "$out/img" "$out/logs" "$plots"
 results=$out/results.csv
 run_info=$out/run.env
@@ -276,8 +277,8 @@ $((elapsed / 60)) min $((elapsed % 60)) s of rendering); the reading below is wr
   every level of every integrator is a separate render; the times are medians over the
   $runs rounds, which interleave the integrators level by level so that they see the same
   load. The errors do not depend on the round.
-- SPPM: ${sppm_flags[cornell-box]} on the Cornell box, ${sppm_flags[water-caustic]} on the
-  water caustic; \`--spp\` sets its iterations. SPPM is consistent but biased: its error
+- SPPM: \`${sppm_flags[cornell-box]}\` on the Cornell box,
+  \`${sppm_flags[water-caustic]}\` on the water caustic; \`--spp\` sets its iterations. SPPM is consistent but biased: its error
   contains the blur of its radius, which shrinks with the iterations.
 - References (seed ${ref_seeds[0]}; a second seed, ${ref_seeds[1]}, only to measure their noise):
   - Cornell box: the path tracer, \`${ref_flags[cornell-box]}\`: ${ref_noise[cornell-box]}.
