@@ -265,6 +265,11 @@ if [[ -f $doc ]] && grep -q '<!-- notes:begin -->' "$doc"; then
   notes=$(sed -n '/<!-- notes:begin -->/,/<!-- notes:end -->/p' "$doc")
 fi
 [[ -n $notes ]] || notes=$'<!-- notes:begin -->\n(none yet)\n<!-- notes:end -->'
+# The integrators' comparison is written by tools/accuracy-integrators.sh: kept as it is.
+integrators=""
+if [[ -f $doc ]] && grep -q '<!-- integrators:begin -->' "$doc"; then
+  integrators=$(sed -n '/<!-- integrators:begin -->/,/<!-- integrators:end -->/p' "$doc")
+fi
 {
   cat <<EOF
 # What accuracy costs in time
@@ -357,6 +362,7 @@ EOF
     printf '\n## Runs with invalid samples\n\nThese runs reported NaN/Inf or truncated samples (left out of the image, rows kept):\n\n'
     sed 's/^/- /' "$out/problems.txt"
   fi
+  [[ -z $integrators ]] || printf '\n%s\n' "$integrators"
   cat <<EOF
 
 ## Notes on this run
