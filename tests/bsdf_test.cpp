@@ -564,9 +564,9 @@ TEST(BsdfChi2, RejectsAWrongPdf) {
       {"gltf thin-walled transmission against the pdf of a refracting one",
        gltfLayered({.roughness = 0.3f, .transmission = 1.0f}),
        gltfLayered({.roughness = 0.3f, .transmission = 1.0f, .volume = true})},
-      {"gltf clearcoat roughness 0.3 against the pdf of 0.35",
+      {"gltf clearcoat roughness 0.3 against the pdf of 0.4",
        gltfLayered({.roughness = 0.8f, .clearcoat = 1.0f, .clearcoatRoughness = 0.3f}),
-       gltfLayered({.roughness = 0.8f, .clearcoat = 1.0f, .clearcoatRoughness = 0.35f})},
+       gltfLayered({.roughness = 0.8f, .clearcoat = 1.0f, .clearcoatRoughness = 0.4f})},
   };
   for (const Wrong& w : wrongs) {
     const test::Chi2Result r = chi2Test(
