@@ -462,7 +462,7 @@ struct Path {
 #else
   PathState state;  // L, beta, etaScale, bsdfPdf, specularBounce (path_vertex.h)
 #endif
-  float weight;   // the camera sample's weight (filter.h): multiplies L at the end
+  float weight;  // the camera sample's weight (filter.h): multiplies L at the end
 #ifdef PT_SPPM_CAMERA
   bool ending;  // past SPPM's visible point: the path's last ray is under way
 #endif

@@ -67,10 +67,10 @@ struct EffectSet {
   bool diffuseTransmission = false;
   bool coatedDiffuse = false;
   bool gltf = false;
-  bool gltfLayers = false;  // some gltf material uses an extension (transmission, clearcoat...)
-  bool shadingNormals = false;    // some mesh has vertex normals: shading normals interpolated
-  bool deltaLights = false;       // point, spot or distant lights (sampled, never hit)
-  bool environment = false;       // an infinite light: rays that leave the scene see it
+  bool gltfLayers = false;      // some gltf material uses an extension (transmission, clearcoat...)
+  bool shadingNormals = false;  // some mesh has vertex normals: shading normals interpolated
+  bool deltaLights = false;     // point, spot or distant lights (sampled, never hit)
+  bool environment = false;     // an infinite light: rays that leave the scene see it
   bool environmentImage = false;  // that light is an image (shaders/environment.h)
   bool twoSidedEmitters = false;  // some emissive triangle emits on both sides
   bool sphereLights = false;      // sphere area lights, sampled by the cone they subtend

@@ -26,9 +26,9 @@ struct DeviceInfo {
 };
 
 struct ContextOptions {
-  std::string device;        // name substring or index; empty: discrete GPU, else the best
-  bool validation = false;   // enable VK_LAYER_KHRONOS_validation, count its errors
-  bool debugPrintf = false;  // route debugPrintfEXT through the validation layer to stderr
+  std::string device;         // name substring or index; empty: discrete GPU, else the best
+  bool validation = false;    // enable VK_LAYER_KHRONOS_validation, count its errors
+  bool debugPrintf = false;   // route debugPrintfEXT through the validation layer to stderr
   bool int64Atomics = false;  // enable 64-bit integer buffer atomics (the sppm integrator's)
 };
 
