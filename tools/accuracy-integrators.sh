@@ -221,15 +221,7 @@ done
 # removed); the slope of relMSE against spp over the last three levels (-1 for an unbiased
 # estimator, flatter for bias or a reference's floor).
 table() {  # scene
-  awk -F, -v scene="$1" -v target="${target[$1]}" '
-    function g(x) { return sprintf("%.3g", x) }
-    function lerp(x, x0, x1, y0, y1) { return y0 + (x - x0) / (x1 - x0) * (y1 - y0) }
-    function timeTo(k,   i) {
-      if (r[k, 1] <= target) return "≤ " g(t[k, 1])
-      for (i = 2; i <= n[k]; ++i) if (r[k, i] <= target)
-        return g(exp(lerp(log(target), log(r[k, i - 1]), log(r[k, i]), log(t[k, i - 1]), log(t[k, i]))))
-      return "not reached"
-    }
+  awk -F, -v scene="$1" -v target="${target[$1]}" -f tools/time-to-target.awk -f <(cat <<'EOF'
     function slope(k,   i, m, x, y, sx, sy, sxx, sxy) {
       m = 3
       for (i = n[k] - m + 1; i <= n[k]; ++i) {
@@ -252,7 +244,9 @@ table() {  # scene
           g(t[k, 1]), g(t[k, n[k]]), g(e[k, 1]), g(e[k, n[k]]), g(r[k, 1]), g(r[k, n[k]]),
           slope(k), g(cost), timeTo(k)
       }
-    }' "$merged"
+    }
+EOF
+  ) "$merged"
 }
 
 # ---- The block in docs/accuracy.md ------------------------------------------------------------

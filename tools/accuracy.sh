@@ -210,15 +210,7 @@ done
 # the smallest final time in the group, so that every curve reaches it. Both by linear
 # interpolation between levels on the log-log curve.
 table() {  # scene, labels, backends
-  awk -F, -v scene="$1" -v labels="$2" -v backends="$3" -v target="$target" '
-    function g(x) { return sprintf("%.3g", x) }
-    function lerp(x, x0, x1, y0, y1) { return y0 + (x - x0) / (x1 - x0) * (y1 - y0) }
-    function timeTo(k,   i) {
-      if (r[k, 1] <= target) return "≤ " g(t[k, 1])
-      for (i = 2; i <= n[k]; ++i) if (r[k, i] <= target)
-        return g(exp(lerp(log(target), log(r[k, i - 1]), log(r[k, i]), log(t[k, i - 1]), log(t[k, i]))))
-      return "not reached"
-    }
+  awk -F, -v scene="$1" -v labels="$2" -v backends="$3" -v target="$target" -f tools/time-to-target.awk -f <(cat <<'EOF'
     function atTime(k, T,   i) {
       if (T < t[k, 1]) return "—"
       if (T <= t[k, 1]) return g(r[k, 1])
@@ -252,7 +244,9 @@ table() {  # scene, labels, backends
           g(t[k, n[k]]), g(r[k, n[k]]), slope(k), g(mr[k, n[k]]), timeTo(k), atTime(k, T[B[b]]),
           g(T[B[b]])
       }
-    }' "$merged"
+    }
+EOF
+  ) "$merged"
 }
 field() {  # scene backend label column(6 spp, 7 seconds, 9 relmse, 10 mrays): the last level
   awk -F, -v s="$1" -v b="$2" -v l="$3" -v c="$4" '$3 == s && $2 == b && $1 == l {v = $c} END {print v}' "$merged"
