@@ -92,7 +92,9 @@ TEST(Vulkan, FastIntersectionMatchesCpuReference) {
 
 TEST(Vulkan, BothSamplersMatchCpuReference) {
   // Independent and Owen-scrambled Sobol numbers are the same on both backends, with the
-  // sampler specialised and decided at run time.
+  // sampler specialised and (independent numbers; UnspecializedShaderGivesTheSameImage renders
+  // the same scene's Sobol numbers so) decided at run time. The shader with every effect
+  // compiled in takes lavapipe 5-15 s per pipeline, each render a pipeline of its own.
   for (uint sampler : {kSamplerIndependent, kSamplerSobol}) {
     SCOPED_TRACE("sampler " + std::to_string(sampler));
     RenderSettings settings{.width = 48, .height = 48};
@@ -100,13 +102,16 @@ TEST(Vulkan, BothSamplersMatchCpuReference) {
     const SceneData data = prepareScene(loadScene(kConfigs / "cornell-mirror.json"), settings);
     EXPECT_EQ(data.effects.sobol, sampler == kSamplerSobol);
     expectAgreement(renderBoth(data, 4));
-    expectAgreement(renderBoth(data, 4, /*specialize=*/false));
+    if (sampler == kSamplerIndependent) {
+      expectAgreement(renderBoth(data, 4, /*specialize=*/false));
+    }
   }
 }
 
 TEST(Vulkan, UnspecializedShaderGivesTheSameImage) {
   // Every effect compiled in and decided at run time must not change the result.
   const SceneData data = prepareConfigScene("cornell-mirror.json", 32);
+  EXPECT_TRUE(data.effects.sobol);  // BothSamplersMatchCpuReference leaves this case here
   Film a(32, 32), b(32, 32);
   VulkanRenderOptions options = validatedOptions(4);
   const VulkanRenderStats s1 = renderVulkan(data, options, a);
