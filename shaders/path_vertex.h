@@ -631,6 +631,11 @@ PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Vertex
   ls.emitter = emitter.triangle;
   bool lambertian = s.scatter < kScatterBsdf;  // mirrors sample no light
   vec3 wi;
+  bool bsdfTowardsLight = false;  // bsdf.h's material: its value towards the light decides
+  vec3 to = vec3(0.0f);
+  vec3 Li = vec3(0.0f);
+  float lightPdf = 0.0f;
+  bool delta = false;
 #ifndef PT_NO_BSDF_MATERIALS
   if (PT_HAS_ANALYTIC_LIGHTS && (emitter.triangle & kEmitterLight) != 0u) {
     // An analytic light: the environment image's sample for an infinite light that has one,
@@ -654,14 +659,12 @@ PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Vertex
       ls.f = vec3(henyeyGreenstein(dot(s.wo, wi), s.material.g));
     } else {
       if (!(maxComponent(analytic.Li) > 0.0f)) return ls;
-      ls.wiLocal = toLocal(s.frame, wi);
-      ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
-      if (!(maxComponent(ls.f) > 0.0f)) return ls;
+      bsdfTowardsLight = true;
     }
-    ls.to = analytic.target;
-    ls.Li = analytic.Li;
-    ls.lightPdf = choice.pmf * analytic.pdf;
-    ls.delta = analytic.delta;
+    to = analytic.target;
+    Li = analytic.Li;
+    lightPdf = choice.pmf * analytic.pdf;
+    delta = analytic.delta;
   } else
 #endif
   {
@@ -693,15 +696,26 @@ PT_INLINE LightSample sampleLightAt(PT_SCENE_PARAM PT_IN(SurfacePoint) s, Vertex
     } else {
 #ifndef PT_NO_BSDF_MATERIALS
       if (!(cosLight > 0.0f)) return ls;
-      ls.wiLocal = toLocal(s.frame, wi);
-      ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
-      if (!(maxComponent(ls.f) > 0.0f)) return ls;
+      bsdfTowardsLight = true;
 #endif
     }
-    ls.to = offsetRayOrigin(point, lightNormal, lightShading.magnitude);
-    ls.Li = emissionAt(PT_SCENE_ARG lightMaterial, light, b);
-    ls.lightPdf = choice.pmf * dist2 / (cosLight * lightShading.area);
+    to = offsetRayOrigin(point, lightNormal, lightShading.magnitude);
+    Li = emissionAt(PT_SCENE_ARG lightMaterial, light, b);
+    lightPdf = choice.pmf * dist2 / (cosLight * lightShading.area);
   }
+#ifndef PT_NO_BSDF_MATERIALS
+  // One call of the BSDF for both kinds of light: a shader inlines every call, and lavapipe's
+  // time to compile grows faster than the inlined code.
+  if (bsdfTowardsLight) {
+    ls.wiLocal = toLocal(s.frame, wi);
+    ls.f = bsdfFCos(PT_SCENE_ARG s, key, ls.wiLocal);
+    if (!(maxComponent(ls.f) > 0.0f)) return ls;
+  }
+#endif
+  ls.to = to;
+  ls.Li = Li;
+  ls.lightPdf = lightPdf;
+  ls.delta = delta;
   vec3 side = (lambertian && !s.shadingNormals) ? s.n : geometricSide(s, wi);
   ls.from = offsetRayOrigin(s.p, side, s.magnitude);
   ls.found = true;
