@@ -419,8 +419,20 @@ struct MaterialTextures {
   uint normalMap;      // tangent-space normal map (RGB, linear): gltf's normalTexture
   float normalScale;   // normalMap: the scale of its x and y (gltf's normalTexture.scale)
   float alphaCutoff;   // kAlphaCutoff: alpha below it is 0, at or above it 1 (gltf's MASK)
-};                     // 64 bytes
-PT_CONST uint kMaterialTextureTexels = 4u;
+  // gltf's material extensions (shaders/bsdf.h, gltfLayersOf), each a float texture but the
+  // last: KHR_materials_transmission's transmission (transmittance.x), KHR_materials_clearcoat's
+  // clear coat (transmittance.y) and its roughness (squared to transmittance.z),
+  // KHR_materials_specular's specular (eta.y) and its colour (k, RGB).
+  uint transmission;
+  uint clearcoat;
+  uint clearcoatRoughness;
+  uint specular;
+  uint specularColour;
+  uint reserved0;  // zero
+  uint reserved1;  // zero
+  uint reserved2;  // zero
+};                 // 96 bytes
+PT_CONST uint kMaterialTextureTexels = 6u;
 PT_CONST uint kRemapRoughness = 1u;   // roughness textures give pbrt-v4's roughness, not alpha
 PT_CONST uint kSquareRoughness = 2u;  // roughness textures give gltf's roughness: alpha = r^2
 PT_CONST uint kAlphaCutoff = 4u;      // the alpha texture is cut at alphaCutoff (gltf's MASK)
@@ -437,6 +449,8 @@ PT_CONST uint kTextureUsesMedium = 1u << 4u;       // coateddiffuse's thickness 
                                                    // metallic
 PT_CONST uint kTextureUsesEmission = 1u << 5u;     // emission (gltf's emissiveTexture)
 PT_CONST uint kTextureUsesNormalMap = 1u << 6u;    // a normal map (gltf's normalTexture)
+PT_CONST uint kTextureUsesGltfLayers = 1u << 7u;   // gltf's extension textures (transmission,
+                                                   // clear coat, specular)
 PT_CONST uint kTextureUsesPrograms = 1u << 8u;     // a texture of more than one node
 PT_CONST uint kTextureUsesImages = 1u << 9u;       // an image lookup
 PT_CONST uint kTextureUsesEwa = 1u << 10u;         // an image filtered by kTextureEwa

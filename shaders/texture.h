@@ -453,28 +453,67 @@ PT_INLINE float evalFloatTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
 
 // ---- Materials ----------------------------------------------------------------------------
 
+// Whether a material reads a texture of gltf's extensions (compiled only where one is used).
+PT_INLINE bool gltfLayerTextured(MaterialTextures t) {
+  return PT_TEXTURE_USES(kTextureUsesGltfLayers) &&
+         (t.transmission != kNoTexture || t.clearcoat != kNoTexture ||
+          t.clearcoatRoughness != kNoTexture || t.specular != kNoTexture ||
+          t.specularColour != kNoTexture);
+}
+
 // Whether a material reads any texture (and so the hit's texture coordinates).
 PT_INLINE bool anyTexture(MaterialTextures t) {
   return t.reflectance != kNoTexture || t.transmittance != kNoTexture ||
          t.uRoughness != kNoTexture || t.vRoughness != kNoTexture || t.eta != kNoTexture ||
          t.k != kNoTexture || t.displacement != kNoTexture || t.alpha != kNoTexture ||
          t.thickness != kNoTexture || t.g != kNoTexture || t.emission != kNoTexture ||
-         t.normalMap != kNoTexture;
+         t.normalMap != kNoTexture || gltfLayerTextured(t);
+}
+
+// gltf's extension textures, parameters 9 to 13 of resolveMaterialAt: transmission, clear coat,
+// the coat's roughness, specular, specular colour (kNoTexture where the shader has none).
+PT_INLINE uint gltfLayerTexture(MaterialTextures t, uint i) {
+  return i == 9u    ? t.transmission
+         : i == 10u ? t.clearcoat
+         : i == 11u ? t.clearcoatRoughness
+         : i == 12u ? t.specular
+                    : t.specularColour;
+}
+// The value of parameter i (9 to 13) in the fields gltfLayersOf reads (shaders/bsdf.h): each
+// texture is its factor times the texel (the reader's scale), as the extensions define them.
+PT_INLINE Material gltfLayerTextureApplied(Material m, uint i, vec3 value) {
+  float x = clamp(value.x, 0.0f, 1.0f);
+  if (i == 9u) {
+    m.transmittance.x = x;
+  } else if (i == 10u) {
+    m.transmittance.y = x;
+  } else if (i == 11u) {
+    m.transmittance.z = x * x;  // the coat's alpha: its roughness squared
+  } else if (i == 12u) {
+    m.eta.y = x;
+  } else {
+    m.k = max(value, vec3(0.0f));
+  }
+  return m;
 }
 
 // The material's parameters at texture coordinates uv: each parameter that has a texture takes
 // the texture's value there, as pbrt-v4's materials evaluate theirs (reflectances clamped to
 // [0, 1] as its albedo spectra are; roughness remapped to alpha where the material asks;
 // diffusetransmission's scale; a conductor given by its reflectance takes eta = 1 and pbrt-v4's
-// k; gltf's roughness squared to alpha, its metallic in [0, 1], its emission as it is).
-// Parameters without a texture keep the host's values.
+// k; gltf's roughness squared to alpha, its metallic in [0, 1], its emission as it is; its
+// extensions' transmission, clear coat and specular in [0, 1], the coat's roughness squared to
+// alpha, the specular colour at least 0). Parameters without a texture keep the host's values.
 PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextures t,
                                      UVFootprint uv) {
   bool remap = (t.flags & kRemapRoughness) != 0u;
   bool square = (t.flags & kSquareRoughness) != 0u;
   // The parameters in this order, each texture evaluated by one call of evalTextureAt (see "One
-  // call site" above). The emission (i = 8) only where some material has an emission texture.
-  uint parameters = PT_TEXTURE_USES(kTextureUsesEmission) ? 9u : 8u;
+  // call site" above). The emission (i = 8) only where some material has an emission texture,
+  // gltf's extension textures (i = 9 to 13) only where some material has one of them.
+  uint parameters = PT_TEXTURE_USES(kTextureUsesGltfLayers) ? 14u
+                    : PT_TEXTURE_USES(kTextureUsesEmission) ? 9u
+                                                            : 8u;
   for (uint i = 0u; i < parameters; ++i) {
     PT_TEXTURE_LOOP_TICK();
     uint texture = i == 0u ? (PT_TEXTURE_USES(kTextureUsesReflectance) ? t.reflectance : kNoTexture)
@@ -486,7 +525,8 @@ PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextu
                    : i == 5u ? (PT_TEXTURE_USES(kTextureUsesRoughness) ? t.vRoughness : kNoTexture)
                    : i == 6u ? (PT_TEXTURE_USES(kTextureUsesMedium) ? t.thickness : kNoTexture)
                    : i == 7u ? (PT_TEXTURE_USES(kTextureUsesMedium) ? t.g : kNoTexture)
-                             : t.emission;
+                   : PT_TEXTURE_USES(kTextureUsesGltfLayers) && i > 8u ? gltfLayerTexture(t, i)
+                                                                       : t.emission;
     if (texture == kNoTexture) continue;
     vec3 value = evalTextureAt(PT_TEXTURES_ARG texture, uv);
     if (i == 0u) {
@@ -523,6 +563,8 @@ PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextu
           m.type == kMaterialGltf ? clamp(value.x, 0.0f, 1.0f) : max(value.x, 1.17549435e-38f);
     } else if (i == 7u) {
       m.g = clamp(value.x, -0.999f, 0.999f);
+    } else if (PT_TEXTURE_USES(kTextureUsesGltfLayers) && i > 8u) {
+      m = gltfLayerTextureApplied(m, i, value);
     } else {
       m.emission = max(value, vec3(0.0f));
     }

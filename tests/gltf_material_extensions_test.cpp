@@ -133,23 +133,26 @@ TEST(GltfMaterialExtensions, AttenuationIsAnAbsorbingMediumInsideTheMesh) {
 }
 
 TEST(GltfMaterialExtensions, TexturesAndUnsimulatedExtensionsWarnOnceAndAreErrorsWithStrict) {
-  GltfBuilder b = twoTriangles({{"KHR_materials_clearcoat",
-                                 {{"clearcoatFactor", 1.0}, {"clearcoatTexture", {{"index", 0}}}}},
-                                {"KHR_materials_sheen", {{"sheenColorFactor", {1, 1, 1}}}}},
-                               {{"KHR_materials_clearcoat",
-                                 {{"clearcoatFactor", 1.0}, {"clearcoatTexture", {{"index", 0}}}}},
-                                {"KHR_materials_sheen", {{"sheenColorFactor", {1, 1, 1}}}}});
+  GltfBuilder b =
+      twoTriangles({{"KHR_materials_clearcoat",
+                     {{"clearcoatFactor", 1.0}, {"clearcoatNormalTexture", {{"index", 0}}}}},
+                    {"KHR_materials_sheen", {{"sheenColorFactor", {1, 1, 1}}}}},
+                   {{"KHR_materials_clearcoat",
+                     {{"clearcoatFactor", 1.0}, {"clearcoatNormalTexture", {{"index", 0}}}}},
+                    {"KHR_materials_sheen", {{"sheenColorFactor", {1, 1, 1}}}}});
   b.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_materials_sheen"};
   const Scene s = readExtended(b);
   // One warning per kind: the sheen's (in extensionsUsed, so not again for the materials) and
-  // the clear coat's texture's (not again for the second material).
+  // the clear coat's normal texture's (not again for the second material; the extensions' other
+  // textures are read: gltf_extension_textures_test.cpp).
   ASSERT_EQ(s.warnings.size(), 2u);
   EXPECT_EQ(s.warnings[0],
             "test.gltf: extensionsUsed[1]: KHR_materials_sheen is not simulated (rendered without "
             "it)");
-  EXPECT_EQ(s.warnings[1],
-            "test.gltf: materials[0].extensions.KHR_materials_clearcoat.clearcoatTexture: not read "
-            "(the extension's factor alone is used)");
+  EXPECT_EQ(
+      s.warnings[1],
+      "test.gltf: materials[0].extensions.KHR_materials_clearcoat.clearcoatNormalTexture: not "
+      "read (the shading normal of the layers below is used)");
   EXPECT_EQ(s.materials[0].transmittance.y, 1.0f);  // the factor is read
   EXPECT_EQ(extendedErrorOf(b, true),
             "test.gltf: extensionsUsed[1]: KHR_materials_sheen is not simulated (rendered without "
@@ -175,6 +178,17 @@ TEST(GltfMaterialExtensions, BadValuesNameTheirJsonPath) {
       {{{"KHR_materials_specular", {{"specularColorFactor", {1, -1, 1}}}}},
        "materials[0].extensions.KHR_materials_specular.specularColorFactor[1]: expected a "
        "non-negative number"},
+      {{{"KHR_materials_transmission",
+         {{"transmissionFactor", 1}, {"transmissionTexture", {{"index", "a"}}}}}},
+       "materials[0].extensions.KHR_materials_transmission.transmissionTexture.index: expected a "
+       "non-negative integer"},
+      {{{"KHR_materials_specular", {{"specularTexture", {{"index", 0}, {"texCoord", -1}}}}}},
+       "materials[0].extensions.KHR_materials_specular.specularTexture.texCoord: expected a "
+       "non-negative integer"},
+      {{{"KHR_materials_clearcoat",
+         {{"clearcoatFactor", 1}, {"clearcoatTexture", {{"index", 3}}}}}},
+       "materials[0].extensions.KHR_materials_clearcoat.clearcoatTexture.index: texture 3 out of "
+       "range (the file has 0)"},
   };
   for (const auto& [extensions, expected] : cases) {
     EXPECT_EQ(extendedErrorOf(twoTriangles(extensions)), "test.gltf: " + expected);

@@ -11,6 +11,7 @@
 #include "render/environment_map.h"
 #include "render/light_bvh.h"
 #include "render/prepare_media.h"
+#include "texture.h"
 
 namespace pt {
 
@@ -406,7 +407,7 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
                        t->uRoughness != kNoTexture || t->vRoughness != kNoTexture ||
                        t->eta != kNoTexture || t->k != kNoTexture || t->thickness != kNoTexture ||
                        t->g != kNoTexture || t->emission != kNoTexture ||
-                       t->normalMap != kNoTexture;
+                       t->normalMap != kNoTexture || gltfLayerTextured(*t);
       fx.textures = fx.textures || any;
       fx.alphaCutouts = fx.alphaCutouts || t->alpha != kNoTexture;
       fx.bumpMaps = fx.bumpMaps || t->displacement != kNoTexture;
@@ -423,6 +424,11 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
       uses(t->g, kTextureUsesMedium);
       uses(t->emission, kTextureUsesEmission);
       uses(t->normalMap, kTextureUsesNormalMap);
+      uses(t->transmission, kTextureUsesGltfLayers);
+      uses(t->clearcoat, kTextureUsesGltfLayers);
+      uses(t->clearcoatRoughness, kTextureUsesGltfLayers);
+      uses(t->specular, kTextureUsesGltfLayers);
+      uses(t->specularColour, kTextureUsesGltfLayers);
       // A bump map steps by the footprint; alpha is tested in the traversal, at a point.
       uses(t->displacement, kTextureUsesFootprints);
       if (t->alpha != kNoTexture) {
@@ -433,6 +439,8 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
           (t->uRoughness != kNoTexture || t->vRoughness != kNoTexture)) {
         lightSampled = true;
       }
+      // So may gltf's extension textures (a coat's roughness, a transmission below 1).
+      if (m.type == kMaterialGltf && gltfLayerTextured(*t)) lightSampled = true;
     }
     if (m.type == kMaterialMirror && reflects) fx.mirror = true;
     if (m.type == kMaterialDiffuse && reflects) fx.diffuse = true;

@@ -46,6 +46,7 @@ inline MaterialTextures noMaterialTextures() {
   t.reflectance = t.transmittance = t.uRoughness = t.vRoughness = kNoTexture;
   t.eta = t.k = t.displacement = t.alpha = t.thickness = t.g = kNoTexture;
   t.emission = t.normalMap = kNoTexture;
+  t.transmission = t.clearcoat = t.clearcoatRoughness = t.specular = t.specularColour = kNoTexture;
   t.scale = 1.0f;
   t.normalScale = 1.0f;
   return t;

@@ -49,14 +49,14 @@ vec3 extensionColour(const tinygltf::Value& object, const char* key, vec3 fallba
   return c;
 }
 
-// The extension's textures are left out: warned once per texture kind.
+// Textures of an extension that are left out: warned once per texture kind.
 void warnTextures(const tinygltf::Value& object, const std::string& extension,
                   const std::vector<const char*>& keys, const std::string& where,
                   Context& context) {
   for (const char* key : keys) {
     if (!object.Has(key)) continue;
     context.warnOnce("texture " + extension + "." + key, where + "." + key,
-                     "not read (the extension's factor alone is used)");
+                     "not read (the shading normal of the layers below is used)");
   }
 }
 
@@ -104,7 +104,6 @@ MaterialExtensions readMaterialExtensions(const tinygltf::Material& m, const std
       const tinygltf::Value& o = extensionObject(value, where, context);
       e.transmission = unitFactor(extensionNumber(o, "transmissionFactor", 0.0, where, context),
                                   where + ".transmissionFactor", context);
-      warnTextures(o, name, {"transmissionTexture"}, where, context);
       e.flags |= kGltfTransmission;
     } else if (name == "KHR_materials_volume") {
       const tinygltf::Value& o = extensionObject(value, where, context);
@@ -117,7 +116,8 @@ MaterialExtensions readMaterialExtensions(const tinygltf::Material& m, const std
       }
       e.attenuationColour =
           extensionColour(o, "attenuationColor", vec3(1.0f), true, where, context);
-      // The thickness texture serves rasterizers; a path tracer has the mesh itself.
+      // thicknessTexture, like thicknessFactor's value, serves rasterizers: a path tracer has
+      // the mesh itself (ignored by design, not warned, as occlusionTexture is).
       volume = true;
     } else if (name == "KHR_materials_clearcoat") {
       const tinygltf::Value& o = extensionObject(value, where, context);
@@ -126,9 +126,9 @@ MaterialExtensions readMaterialExtensions(const tinygltf::Material& m, const std
       e.clearcoatRoughness =
           unitFactor(extensionNumber(o, "clearcoatRoughnessFactor", 0.0, where, context),
                      where + ".clearcoatRoughnessFactor", context);
-      warnTextures(o, name,
-                   {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"},
-                   where, context);
+      // Its textures: gltf_extension_textures.h, but for the coat's normal map: the layered
+      // BSDF has one shading frame, the base's.
+      warnTextures(o, name, {"clearcoatNormalTexture"}, where, context);
       if (e.clearcoat > 0.0) e.flags |= kGltfClearcoat;
     } else if (name == "KHR_materials_specular") {
       const tinygltf::Value& o = extensionObject(value, where, context);
@@ -136,7 +136,6 @@ MaterialExtensions readMaterialExtensions(const tinygltf::Material& m, const std
                               where + ".specularFactor", context);
       e.specularColour =
           extensionColour(o, "specularColorFactor", vec3(1.0f), false, where, context);
-      warnTextures(o, name, {"specularTexture", "specularColorTexture"}, where, context);
       e.flags |= kGltfSpecular;
     } else {
       context.warnOnce("extension " + name, where,

@@ -1,7 +1,8 @@
 // The KHR_materials_* extensions of a glTF material that the renderer simulates: _ior,
 // _emissive_strength, _transmission, _volume, _clearcoat and _specular (their factors; their
-// textures are warned and left out), each checked and read into MaterialExtensions. Any other
-// extension of the material is warned, once per kind.
+// textures: gltf_extension_textures.h, but clearcoatNormalTexture, warned and left out), each
+// checked and read into MaterialExtensions. Any other extension of the material is warned, once
+// per kind.
 #pragma once
 
 #include <limits>

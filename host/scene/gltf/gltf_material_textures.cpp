@@ -3,7 +3,9 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
+#include "scene/gltf/gltf_extension_textures.h"
 #include "scene/textures.h"
 
 namespace pt::gltf {
@@ -39,19 +41,26 @@ void readAlpha(const tinygltf::Material& m, const std::string& path, TextureRead
 }  // namespace
 
 MaterialTextures readMaterialTextures(const tinygltf::Model& model, int index,
-                                      const Material& material, TextureReader& textures,
+                                      const Material& material,
+                                      const MaterialExtensions& extensions, TextureReader& textures,
                                       Context& context, int& uvSet) {
   MaterialTextures t = noMaterialTextures();
   const std::string path = indexed("materials", std::size_t(index));
   const tinygltf::Material& m = model.materials[std::size_t(index)];
   const tinygltf::PbrMetallicRoughness& pbr = m.pbrMetallicRoughness;
   const std::string pbrPath = path + ".pbrMetallicRoughness";
-  // The set of the first texture read (the emissive one only where it emits).
+  const ExtensionTextureInfos extensionTextures = readExtensionTextureInfos(m, path, context);
+  // The set of the first texture read (the emissive one only where it emits, an extension's
+  // only where its factor is not 0).
   uvSet = 0;
-  for (const TextureRef& ref :
-       {textureRef(pbr.baseColorTexture), textureRef(pbr.metallicRoughnessTexture),
-        textureRef(m.normalTexture),
-        material.emission != vec3(0.0f) ? textureRef(m.emissiveTexture) : TextureRef{}}) {
+  std::vector<TextureRef> refs = {
+      textureRef(pbr.baseColorTexture), textureRef(pbr.metallicRoughnessTexture),
+      textureRef(m.normalTexture),
+      material.emission != vec3(0.0f) ? textureRef(m.emissiveTexture) : TextureRef{}};
+  for (const TextureRef& ref : readExtensionTextureRefs(extensionTextures, extensions)) {
+    refs.push_back(ref);
+  }
+  for (const TextureRef& ref : refs) {
     if (ref.index < 0) continue;
     const int set = TextureReader::texCoordOf(ref);
     uvSet = set == 1 ? 1 : 0;
@@ -87,6 +96,7 @@ MaterialTextures readMaterialTextures(const tinygltf::Model& model, int index,
     }
     t.normalScale = float(m.normalTexture.scale);
   }
+  bindExtensionTextures(extensionTextures, extensions, textures, t);
   readAlpha(m, path, textures, t);
   return t;
 }

@@ -2,10 +2,11 @@
 // colour's RGB (sRGB) and alpha, the metallic-roughness texture's G (roughness) and B
 // (metallic), linear, the emissive texture (sRGB) and the tangent-space normal map, each times
 // its factor; the alpha mode as a cut-out (MASK, at alphaCutoff) or stochastic coverage
-// (BLEND).
+// (BLEND); and the material extensions' textures (gltf_extension_textures.h).
 #pragma once
 
 #include "scene/gltf/gltf_context.h"
+#include "scene/gltf/gltf_material_extensions.h"
 #include "scene/gltf/gltf_textures.h"
 #include "scene/gltf/tinygltf.h"
 
@@ -13,12 +14,14 @@
 
 namespace pt::gltf {
 
-// The textures of materials[index] (index >= 0), whose factors readMaterial made `material`;
-// noMaterialTextures() where it has none. uvSet: the texture coordinate set they read (0 or
-// 1), the first read texture's; the triangles of the material keep that set, and a texture of
+// The textures of materials[index] (index >= 0), whose factors readMaterial made `material`
+// (and `extensions`, its extensions' factors); noMaterialTextures() where it has none. uvSet:
+// the texture coordinate set they read (0 or 1), the first read texture's (the core textures
+// first, then the extensions'); the triangles of the material keep that set, and a texture of
 // the other is left out (warned).
 MaterialTextures readMaterialTextures(const tinygltf::Model& model, int index,
-                                      const Material& material, TextureReader& textures,
+                                      const Material& material,
+                                      const MaterialExtensions& extensions, TextureReader& textures,
                                       Context& context, int& uvSet);
 
 }  // namespace pt::gltf

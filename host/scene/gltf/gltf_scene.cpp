@@ -97,9 +97,10 @@ Scene build(const tinygltf::Model& model, const std::string& file,
       extensions.emplace_back();
       scene.materials.push_back(readMaterial(model, material, context, &extensions.back()));
       if (material >= 0) {
-        setMaterialTextures(scene, it->second.material,
-                            readMaterialTextures(model, material, scene.materials.back(), textures,
-                                                 context, it->second.uvSet));
+        setMaterialTextures(
+            scene, it->second.material,
+            readMaterialTextures(model, material, scene.materials.back(), extensions.back(),
+                                 textures, context, it->second.uvSet));
       }
       const std::string name = material >= 0 ? model.materials[std::size_t(material)].name : "";
       scene.materialNames.push_back(

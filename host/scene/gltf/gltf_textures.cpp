@@ -220,8 +220,10 @@ uint TextureReader::texture(const TextureRef& ref, TextureChannels channels, vec
     if (!gltfImageHasAlpha(*image)) return built_[key] = kNoTexture;
     node = builder_.image(gltfImageChannel(*image, 3), desc, true);
   } else {
-    node = builder_.image(gltfImageChannel(*image, channels == TextureChannels::kGreen ? 1 : 2),
-                          desc, true);
+    const int channel = channels == TextureChannels::kRed     ? 0
+                        : channels == TextureChannels::kGreen ? 1
+                                                              : 2;
+    node = builder_.image(gltfImageChannel(*image, channel), desc, true);
   }
   scene_.textureNodes[node].value = factor;  // the image's scale, per channel
   if (skew != vec2(0.0f)) {

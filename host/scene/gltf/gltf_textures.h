@@ -24,8 +24,8 @@ namespace pt::gltf {
 
 // What a material reads of a texture's image: its RGB (decoded from sRGB or linear), or one
 // channel, linear, as a float texture (the metallic-roughness texture's G and B, the base
-// colour's alpha).
-enum class TextureChannels { kSrgb, kLinear, kGreen, kBlue, kAlpha };
+// colour's alpha, the material extensions' R, G and A).
+enum class TextureChannels { kSrgb, kLinear, kRed, kGreen, kBlue, kAlpha };
 
 // A texture reference of a material: textureInfo's fields (normalTexture's too).
 struct TextureRef {
