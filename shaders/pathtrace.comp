@@ -196,8 +196,8 @@ MaterialTextures materialTexturesAt(uint i) {
   uvec4 e = layers ? texelFetch(materialTextureTexels, at + 4) : uvec4(kNoTexture);
   uvec4 f = layers ? texelFetch(materialTextureTexels, at + 5) : uvec4(kNoTexture);
   return MaterialTextures(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, uintBitsToFloat(c.y), c.z,
-                          c.w, d.x, d.y, uintBitsToFloat(d.z), uintBitsToFloat(d.w), e.x, e.y,
-                          e.z, e.w, f.x, f.y, f.z, f.w);
+                          c.w, d.x, d.y, uintBitsToFloat(d.z), uintBitsToFloat(d.w), e.x, e.y, e.z,
+                          e.w, f.x, f.y, f.z, f.w);
 }
 TriangleUVs uvsAt(uint primitive) {
   int at = int(2u * primitive);
