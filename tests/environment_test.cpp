@@ -23,7 +23,7 @@
 #include "scene/pbrt/pbrt_scene.h"
 #include "scene/scene.h"
 #include "test_util.h"
-#include "vulkan/resources.h"
+#include "vulkan/device_limits.h"
 
 namespace pt {
 namespace {

@@ -12,7 +12,7 @@
 #include "scene/scene.h"
 #include "test_util.h"
 #include "vulkan/backend.h"
-#include "vulkan/context.h"
+#include "vulkan/device_limits.h"
 
 namespace pt {
 namespace {
@@ -231,9 +231,9 @@ TEST(VulkanLimits, BuffersBeyondMaxStorageBufferRangeFailClearly) {
   // A 4096 x 4096 film needs a 256 MiB accumulation buffer; lavapipe allows 128 MiB per
   // storage buffer. A device with a larger limit renders it instead (skip there).
   SceneData data = prepareConfigScene("cornell-box.json", 4096);
-  VulkanContext ctx(ContextOptions{});
-  if (ctx.limits.maxStorageBufferRange >= 4096ull * 4096ull * sizeof(AccumPixel)) {
-    GTEST_SKIP() << "device allows " << ctx.limits.maxStorageBufferRange << " bytes";
+  const DeviceLimits limits = queryDeviceLimits(ContextOptions{});
+  if (limits.maxStorageBufferRange >= 4096ull * 4096ull * sizeof(AccumPixel)) {
+    GTEST_SKIP() << "device allows " << limits.maxStorageBufferRange << " bytes";
   }
   Film film(4096, 4096);
   try {
@@ -249,9 +249,9 @@ TEST(VulkanLimits, BuffersBeyondMaxStorageBufferRangeFailClearly) {
 // a scene of that many texels would fill it.)
 TEST(VulkanLimits, TexturesBeyondTheBufferLimitFailClearly) {
   SceneData data = prepareConfigScene("cornell-box.json", 16);
-  VulkanContext ctx(ContextOptions{});
-  const uint64_t limit = std::min<uint64_t>(ctx.limits.maxStorageBufferRange,
-                                            16ull * ctx.limits.maxTexelBufferElements);
+  const DeviceLimits limits = queryDeviceLimits(ContextOptions{});
+  const uint64_t limit =
+      std::min<uint64_t>(limits.maxStorageBufferRange, 16ull * limits.maxTexelBufferElements);
   if (limit >= (1ull << 31)) GTEST_SKIP() << "device allows " << limit << " bytes";
   data.materialTextures.assign(data.materials.size(), MaterialTextures{});
   for (MaterialTextures& t : data.materialTextures) {

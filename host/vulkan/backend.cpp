@@ -12,6 +12,7 @@
 
 #include "common/check.h"
 #include "vulkan/context.h"
+#include "vulkan/device_limits.h"
 #include "vulkan/glsl_compiler.h"
 #include "vulkan/gpu_bvh.h"
 #include "vulkan/resources.h"

@@ -52,14 +52,6 @@ void checkTexelRange(const VulkanContext& ctx, const char* what, vk::DeviceSize 
   }
 }
 
-void checkEnvironmentTexels(const std::string& device, uint32_t limit, const std::string& file,
-                            size_t texels) {
-  if (texels <= limit) return;
-  throw InputError(file + ": the environment image needs " + std::to_string(texels) +
-                   " texels (its pixels and sampling tables), more than " + device +
-                   "'s maxTexelBufferElements, " + std::to_string(limit));
-}
-
 void checkRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size) {
   if (size > ctx.limits.maxStorageBufferRange) {
     throw InputError("scene too large for " + ctx.info().name + ": the " + what + " buffer is " +

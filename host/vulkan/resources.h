@@ -33,12 +33,6 @@ void makeTexelView(const VulkanContext& ctx, Buffer& b);
 // (InputError), like checkRange.
 void checkTexelRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size);
 
-// An environment image whose texels and sampling tables (`texels` of them) exceed the device's
-// maxTexelBufferElements (`limit`) is refused in one line naming its file (InputError), before
-// anything is uploaded.
-void checkEnvironmentTexels(const std::string& device, uint32_t limit, const std::string& file,
-                            size_t texels);
-
 // Storage buffers larger than the device allows would be silently cut short (lavapipe's
 // maxStorageBufferRange is 128 MiB): refuse them with the numbers instead (InputError).
 void checkRange(const VulkanContext& ctx, const char* what, vk::DeviceSize size);
