@@ -6,7 +6,9 @@ cd "$(dirname "$0")/.."
 tools/setup.sh
 # Unity builds: a fresh clone builds in 35-40 % less CPU time (CMakeLists.txt, README).
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON
-cmake --build build
+# One compile per core: Ninja's default on 2 cores is 3 jobs, and the third costs more than it
+# gives (the checked build: 259 s wall, 492 CPU-s with 3 jobs; 238 s, 436 CPU-s with 2).
+cmake --build build -j "$(nproc)"
 ctest --test-dir build --output-on-failure -j "$(nproc)"
 
 # The CPU side again under AddressSanitizer + UndefinedBehaviorSanitizer (docs/errors.md),
@@ -23,7 +25,7 @@ ctest --test-dir build --output-on-failure -j "$(nproc)"
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DPT_SANITIZE=ON -DCMAKE_UNITY_BUILD=ON \
   -DPT_CHECK_SHADERS=OFF
-cmake --build build-asan --target pt_tests
+cmake --build build-asan --target pt_tests -j "$(nproc)"
 # The sanitized tests run in two processes per core, GoogleTest's shards (GTEST_TOTAL_SHARDS),
 # not in a process per test as ctest runs them: a sanitized process takes 0.17 s to start and
 # exit (its instrumented globals, LeakSanitizer's scan), 520 times a run. Two per core, since
