@@ -16,6 +16,11 @@ cmake --build build -j "$(nproc)"
 # it sits on transparent huge pages. The lavapipe tests of media and glTF textures (ctest -R,
 # empty Mesa cache, medians of 3-4): 35.8 s -> 23.3 s wall. The compilers gain nothing from it
 # and the sanitized run below has ASan's own allocator.
+# The suite's compiled shaders (vulkan/spirv_cache.h) go to a cache of its own, emptied
+# first: each variant is compiled once per run whatever the user's cache holds, and then
+# shared by the tests' processes (the sanitized run's too).
+export PT_SHADER_CACHE_DIR="$PWD/build/shader-cache"
+rm -rf "$PT_SHADER_CACHE_DIR"
 # The Slurm test (a private cluster renders a job array; ctest -L slurm) spends its 25-35 s
 # mostly waiting (apt, the daemons, the queue: 8 CPU-s), so it runs beside the others rather
 # than in one of ctest's slots; exit status 77 is its "skipped".

@@ -5,7 +5,9 @@
 #include <glslang/Public/ResourceLimits.h>
 #include <glslang/Public/ShaderLang.h>
 #include <glslang/SPIRV/GlslangToSpv.h>
+#include <glslang/build_info.h>
 
+#include <spirv-tools/libspirv.h>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -15,6 +17,7 @@
 #include "common/check.h"
 #include "image/film_state.h"
 #include "shader_sources.h"  // kShaderSources, generated from shaders/
+#include "vulkan/spirv_cache.h"
 
 namespace pt {
 namespace {
@@ -92,6 +95,25 @@ std::vector<uint32_t> removeDeadCode(const std::vector<uint32_t>& spirv, const s
   return out;
 }
 
+// Everything a compiled variant depends on besides its entry and definitions, for the disk
+// cache's key: the compilers' versions, the embedded sources and the options above (change
+// kCompileOptions with them).
+const std::string& compilerIdentity() {
+  constexpr const char* kCompileOptions =
+      "vulkan1.1 spirv1.3 glsl100 spv-rules vulkan-rules no-spv-opt; "
+      "2x(dead-branch-elim aggressive-dce eliminate-dead-functions)";
+  static const std::string identity =
+      "glslang " + std::to_string(GLSLANG_VERSION_MAJOR) + "." +
+      std::to_string(GLSLANG_VERSION_MINOR) + "." + std::to_string(GLSLANG_VERSION_PATCH) +
+      GLSLANG_VERSION_FLAVOR + " generator " + std::to_string(glslang::GetSpirvGeneratorVersion()) +
+      "; " + spvSoftwareVersionDetailsString() + "; sources " + hexHash(shaderSourcesHash()) +
+      "; " + kCompileOptions;
+  return identity;
+}
+
+// The most variants the disk cache keeps (a few hundred KiB each).
+constexpr size_t kMaxCachedVariants = 256;
+
 }  // namespace
 
 const std::vector<uint32_t>& compileShader(std::string_view entry, const std::string& definitions) {
@@ -100,12 +122,23 @@ const std::vector<uint32_t>& compileShader(std::string_view entry, const std::st
       compiled;
   const std::lock_guard<std::mutex> lock(mutex);
   std::unique_ptr<std::vector<uint32_t>>& spirv = compiled[{std::string(entry), definitions}];
-  if (!spirv) {
-    static const bool initialized = glslang::InitializeProcess();
-    PT_CHECK(initialized, "glslang failed to initialize");
-    const std::string name(entry);
-    spirv = std::make_unique<std::vector<uint32_t>>(
-        removeDeadCode(glslToSpirv(entry, definitions), name));
+  if (spirv) return *spirv;
+  const std::string name(entry);
+  const std::optional<std::filesystem::path> cacheDir = spirvCacheDirectory();
+  const std::string key = compilerIdentity() + "\n" + name + "\n" + definitions;
+  if (cacheDir) {
+    if (std::optional<std::vector<uint32_t>> cached = readCachedSpirv(*cacheDir, key)) {
+      spirv = std::make_unique<std::vector<uint32_t>>(std::move(*cached));
+      return *spirv;
+    }
+  }
+  static const bool initialized = glslang::InitializeProcess();
+  PT_CHECK(initialized, "glslang failed to initialize");
+  spirv = std::make_unique<std::vector<uint32_t>>(
+      removeDeadCode(glslToSpirv(entry, definitions), name));
+  if (cacheDir) {
+    writeCachedSpirv(*cacheDir, key, *spirv);
+    cleanUpSpirvCache(*cacheDir, kMaxCachedVariants);
   }
   return *spirv;
 }

@@ -15,7 +15,9 @@ namespace pt {
 
 // SPIR-V (Vulkan 1.1) of shaders/`entry` with `definitions` ("#define NAME VALUE" lines; none
 // for raycast.comp) in front of its text. Compiled once per process for each distinct pair, then
-// reused. An error in the embedded shaders is a bug of this build: PT_CHECK with glslang's log.
+// reused; kept between processes in the disk cache of vulkan/spirv_cache.h, keyed by the pair,
+// the embedded sources and the compilers' versions. An error in the embedded shaders is a bug
+// of this build: PT_CHECK with glslang's log.
 const std::vector<uint32_t>& compileShader(std::string_view entry, const std::string& definitions);
 
 // A hash of every embedded shader source: film states record it, so that a render is only
