@@ -302,6 +302,79 @@ TEST(FilmStateFile, RefusesTruncatedCorruptAndForeignFiles) {
   }
 }
 
+// A photon-mapping render's state: the film holds its estimate (one sample a pixel) after the
+// iterations of its one range from 0, and every pixel's state.
+FilmState sppmState() {
+  FilmState state;
+  state.settings = {{"backend", "cpu"}, {"integrator", "sppm"}};
+  state.film = Film(5, 3);
+  state.ranges = {SampleRange{0, 6}};
+  for (int i = 0; i < 15; ++i) {
+    state.film.add(i % 5, i / 5, glm::vec3(float(i), 0.5f, 1e-20f));
+    state.sppm.push_back(SppmPixelRecord{0.5f / float(i + 1), float(i) * 1.5f,
+                                         glm::vec3(1e30f, float(i), 0.0f),
+                                         glm::vec3(-0.0f, 3.0f, float(i) / 7.0f), i % 4 == 0});
+  }
+  return state;
+}
+
+// `bytes` (a state file less its checksum) with the checksum a writer would give it.
+std::string withChecksum(const std::string& bytes) {
+  const uint64_t sum = hashBytes(bytes.data(), bytes.size());
+  std::string out = bytes;
+  for (int b = 0; b < 8; ++b) out.push_back(char(sum >> (8 * b)));
+  return out;
+}
+
+TEST(FilmStateFile, SppmStateRoundTripsAndIsChecked) {
+  test::TempDir dir;
+  const FilmState state = sppmState();
+  writeFilmState(state, dir / "s.ptstate");
+  const FilmState back = readFilmState(dir / "s.ptstate");
+  EXPECT_EQ(back.sppm, state.sppm);
+  EXPECT_EQ(back.ranges, state.ranges);
+  expectSameFilm(back.film, state.film);
+  const std::string good = test::readFile(dir / "s.ptstate");
+  EXPECT_NE(good.find("\nsppm 33\ndata "), std::string::npos);
+  const std::string body = good.substr(0, good.size() - 8);
+  auto messageFor = [&](const std::string& bytes) {
+    try {
+      readFilmState(dir.write("bad.ptstate", bytes));
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+      return std::string(e.what());
+    }
+    return std::string("(read)");
+  };
+  // The last pixel's invalid flag, 2 rather than 0 or 1.
+  std::string flag = body;
+  flag.back() = 2;
+  EXPECT_NE(messageFor(withChecksum(flag)).find("invalid flag"), std::string::npos);
+  // Iterations that do not start at 0, another record size, a record missing.
+  std::string from3 = body;
+  from3.replace(from3.find("samples 0:6"), 11, "samples 3:3");
+  EXPECT_NE(messageFor(withChecksum(from3)).find("an sppm state of samples 3:3"),
+            std::string::npos);
+  std::string size = body;
+  size.replace(size.find("sppm 33"), 7, "sppm 34");
+  EXPECT_NE(messageFor(withChecksum(size)).find("sppm state of 34 bytes per pixel"),
+            std::string::npos);
+  std::string shorter = body.substr(0, body.size() - 33);
+  const size_t data = shorter.find("\ndata ") + 6;
+  const size_t eol = shorter.find('\n', data);
+  const uint64_t length = std::stoull(shorter.substr(data, eol - data));
+  shorter.replace(data, eol - data, std::to_string(length - 33));
+  EXPECT_NE(messageFor(withChecksum(shorter)).find("ends early"), std::string::npos);
+  // Its states are not merged: slices of its iterations do not add up.
+  try {
+    mergeFilmStates({NamedFilmState{dir / "s.ptstate", readFilmState(dir / "s.ptstate")}});
+    ADD_FAILURE() << "merged an sppm state";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("s.ptstate: holds an sppm render"), std::string::npos)
+        << e.what();
+  }
+}
+
 // ---- Merging states -------------------------------------------------------------------------
 
 TEST(MergeFilmStates, RefusesOtherSettingsSizesAndOverlaps) {

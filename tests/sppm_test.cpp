@@ -19,6 +19,7 @@
 #include "cpu/integrator.h"
 #include "cpu/sppm.h"
 #include "cpu/sppm_grid.h"
+#include "image/film_state.h"
 #include "render/prepare.h"
 #include "render_compare.h"
 #include "scene/load_scene.h"
@@ -183,11 +184,12 @@ TEST(SppmPixelUpdate, RenderedRadiiFollowThePhotonCounts) {
   CpuRenderOptions options;
   options.spp = 8;
   options.threads = 2;
-  std::vector<SppmPixelReport> pixels;
-  renderSppm(scene, options, film, &pixels);
+  SppmPixels pixels;
+  options.sppmPixels = &pixels;
+  renderSppm(scene, options, film);
   ASSERT_EQ(pixels.size(), 144u);
   int withPhotons = 0;
-  for (const SppmPixelReport& p : pixels) {
+  for (const SppmPixelRecord& p : pixels) {
     if (p.n > 0.0f) {
       ++withPhotons;
       EXPECT_LT(p.radius, 20.0f);
@@ -237,6 +239,37 @@ TEST(SppmRender, AStopEndsAfterAWholeIteration) {
   const Image stopped = film.resolve();
   EXPECT_EQ(std::memcmp(one.pixels.data(), stopped.pixels.data(), one.pixels.size() * sizeof(vec3)),
             0);
+}
+
+TEST(SppmRender, ContinuedFromItsStateGivesTheSameBits) {
+  // Five iterations in one call, and two then three from the state the first call left: the
+  // same bits. A checkpoint after each iteration finds the film holding that iteration's
+  // estimate: after the second, the two-iteration image.
+  const SceneData scene = sppmTestScene(12, 3, kIntegratorSppm, 15.0f, 2000);
+  const Image five = renderImage(scene, 5);
+  const Image two = renderImage(scene, 2);
+  SppmPixels pixels;
+  Film film(12, 12);
+  CpuRenderOptions options;
+  options.threads = 2;
+  options.spp = 2;
+  options.sppmPixels = &pixels;
+  std::vector<Image> checkpoints;
+  options.checkpoint = [&](int done) {
+    EXPECT_EQ(done, int(checkpoints.size()) + 1);
+    checkpoints.push_back(film.resolve());
+  };
+  EXPECT_EQ(renderSppm(scene, options, film).samplesDone, 2);
+  ASSERT_EQ(checkpoints.size(), 2u);
+  EXPECT_EQ(checkpoints[1].pixels, two.pixels);
+  EXPECT_EQ(film.resolve().pixels, two.pixels);
+  ASSERT_EQ(pixels.size(), 144u);
+  options.firstSample = 2;
+  options.spp = 3;
+  options.checkpoint = nullptr;
+  EXPECT_EQ(renderSppm(scene, options, film).samplesDone, 3);
+  EXPECT_EQ(film.resolve().pixels, five.pixels);
+  EXPECT_NE(five.pixels, two.pixels);
 }
 
 std::string readText(const std::filesystem::path& path) {
@@ -378,15 +411,16 @@ TEST(SppmCli, ChosenRefusedAndChecked) {
     EXPECT_NE(x.err.find(message), std::string::npos) << args << ": " << x.err;
     EXPECT_EQ(std::count(x.err.begin(), x.err.end(), '\n'), 1) << x.err;  // one line
   };
-  refused(box + " --backend cpu --integrator sppm" + small + (dir / "c.exr").string() +
-              " --checkpoint " + (dir / "c.ptstate").string(),
-          "--checkpoint: the sppm integrator's pixels depend on every iteration before");
   refused((test::kConfigs / "fog-beam.json").string() + " --backend cpu --integrator sppm" + small +
               (dir / "d.exr").string(),
           "fog-beam.json: the sppm integrator does not render participating media");
   refused(box + " --backend cpu --integrator sppm --samples 0:1 --out " + (dir / "h.exr").string() +
               " --checkpoint " + (dir / "h.ptstate").string(),
-          "--checkpoint: the sppm integrator's pixels depend on every iteration before");
+          "--samples: the sppm integrator's pixels depend on every iteration before, so its "
+          "render cannot be split or merged");
+  refused(box + " --backend cpu --integrator sppm --task-index 0 --task-count 2" + small +
+              (dir / "h.exr").string() + " --checkpoint " + (dir / "h.ptstate").string(),
+          "--task-index: the sppm integrator's pixels depend on every iteration before");
   refused(box + " --backend cpu --sppm-radius 3" + small + (dir / "i.exr").string(),
           "--sppm-radius: a parameter of the sppm integrator (give --integrator sppm)");
   const test::PtResult converge =
@@ -460,6 +494,53 @@ TEST(SppmCli, ChosenRefusedAndChecked) {
   EXPECT_EQ(x.status, 2);
   EXPECT_NE(x.err.find("zero.pbrt:"), std::string::npos) << x.err;
   EXPECT_NE(x.err.find("'radius' of Integrator"), std::string::npos) << x.err;
+}
+
+// A render stopped at a checkpoint and resumed to more iterations gives the one run's image bit
+// for bit, from the state file's pixels; its state cannot be merged. `backend`: cpu or vulkan.
+void expectResumedEqualsOneRun(const std::string& backend) {
+  test::TempDir dir;
+  const std::string render = "render " + (test::kConfigs / "cornell-box.json").string() +
+                             " --backend " + backend + " --integrator sppm --width 12 --height 12";
+  const std::string radius = " --sppm-radius 15";
+  const test::PtResult one =
+      test::runPt(render + radius + " --spp 4 --out " + (dir / "one.pfm").string());
+  ASSERT_EQ(one.status, 0) << one.err;
+  const std::string state = (dir / "s.ptstate").string();
+  const test::PtResult first = test::runPt(render + radius + " --spp 2 --checkpoint " + state +
+                                           " --out " + (dir / "two.pfm").string());
+  ASSERT_EQ(first.status, 0) << first.err;
+  const test::PtResult twoAgain =
+      test::runPt(render + radius + " --spp 2 --out " + (dir / "two-again.pfm").string());
+  ASSERT_EQ(twoAgain.status, 0) << twoAgain.err;
+  EXPECT_EQ(test::readFile(dir / "two.pfm"), test::readFile(dir / "two-again.pfm"));
+  const FilmState saved = readFilmState(state);
+  EXPECT_EQ(saved.sppm.size(), 144u);
+  ASSERT_EQ(saved.ranges.size(), 1u);
+  EXPECT_EQ(saved.ranges[0], (SampleRange{0, 2}));
+  const test::PtResult resumed = test::runPt(render + radius + " --spp 4 --resume " + state +
+                                             " --out " + (dir / "four.pfm").string());
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_NE(resumed.err.find("2 of 4 samples per pixel done"), std::string::npos) << resumed.err;
+  EXPECT_EQ(test::readFile(dir / "one.pfm"), test::readFile(dir / "four.pfm"));
+  EXPECT_NE(test::readFile(dir / "one.pfm"), test::readFile(dir / "two.pfm"));
+  EXPECT_EQ(readFilmState(state).ranges, (std::vector<SampleRange>{{0, 4}}));
+  // Another radius is another render.
+  const test::PtResult other = test::runPt(render + " --sppm-radius 3 --spp 6 --resume " + state +
+                                           " --out " + (dir / "x.pfm").string());
+  EXPECT_EQ(other.status, 2);
+  EXPECT_NE(other.err.find("sppm_radius"), std::string::npos) << other.err;
+  const test::PtResult merge = test::runPt("merge " + state + " --out " + (dir / "m.exr").string());
+  EXPECT_EQ(merge.status, 2);
+  EXPECT_NE(merge.err.find("s.ptstate: holds an sppm render"), std::string::npos) << merge.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.exr"));
+}
+
+TEST(SppmCli, ResumedEqualsOneRun) {
+  expectResumedEqualsOneRun("cpu");
+}
+TEST(SppmCli, ResumedEqualsOneRunOnVulkan) {
+  expectResumedEqualsOneRun("vulkan");
 }
 
 // On the Vulkan backend (lavapipe here: the name keeps it out of the sanitized run, which hides

@@ -13,6 +13,7 @@
 #include "cli/progress.h"
 #include "common/check.h"
 #include "common/named_values.h"
+#include "cpu/sppm.h"
 
 namespace pt {
 namespace {
@@ -108,6 +109,13 @@ KeyValues imageSettings(const SceneData& data, const RenderSettings& settings,
   // The integrator where it is not the path tracer (states written before others stay valid).
   if (data.integrator != kIntegratorPath) {
     s.emplace_back("integrator", std::string(nameOf(kIntegratorNames, data.integrator)));
+  }
+  // Photon mapping's parameters, which every iteration's estimate depends on.
+  if (data.integrator == kIntegratorSppm) {
+    char radius[32];
+    std::snprintf(radius, sizeof radius, "%.9g", double(data.sppm.radius));
+    s.emplace_back("sppm_radius", std::string(radius));
+    s.emplace_back("sppm_photons", std::to_string(sppmPhotonsPerIteration(data)));
   }
   // The light BVH only where the render uses it: the power and uniform samplers differ in the
   // emitter table, which the states already compare, and states written before it stay valid.

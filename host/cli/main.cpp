@@ -189,18 +189,13 @@ int runRender(const RenderArgs& args) {
     throw InputError(std::string(args.overrides.sppmRadius ? "--sppm-radius" : "--sppm-photons") +
                      ": a parameter of the sppm integrator (give --integrator sppm)");
   }
-  // Photon mapping's iterations build on each other: one run.
-  if (data.integrator == kIntegratorSppm) {
-    const char* option = !states.empty() ? (args.resume.empty() ? "--checkpoint" : "--resume")
-                         : sliceArg      ? "--samples"
-                         : task          ? "--task-index"
-                                         : nullptr;
-    if (option) {
-      throw InputError(std::string(option) +
-                       ": the sppm integrator's pixels depend on every iteration before, so its "
-                       "render cannot be checkpointed, resumed, split or merged (render it in "
-                       "one run)");
-    }
+  // Photon mapping's iterations build on each other: a render is continued from its state
+  // (--checkpoint, --resume), never split.
+  if (data.integrator == kIntegratorSppm && (sliceArg || task)) {
+    throw InputError(std::string(sliceArg ? "--samples" : "--task-index") +
+                     ": the sppm integrator's pixels depend on every iteration before, so its "
+                     "render cannot be split or merged (render it in one job; --checkpoint and "
+                     "--resume continue it)");
   }
 
   const Camera& cam = data.params.camera;
@@ -277,6 +272,7 @@ int runRender(const RenderArgs& args) {
     state.film = std::move(resumed->film);
     state.ranges = resumed->ranges;
     state.open = std::move(resumed->open);
+    state.sppm = std::move(resumed->sppm);
     state.info = resumed->info;
   }
   auto setInfo = [&](const std::string& key, const std::string& value) {
@@ -341,6 +337,7 @@ int runRender(const RenderArgs& args) {
     options.progress = [&progress](double f) { progress.update(f); };
     options.stop = &interrupt.stopFlag();
     options.checkpoint = checkpointDue;
+    options.sppmPixels = &state.sppm;
     if (bdptStrategy) options.bdptStrategy = *bdptStrategy;
     const CpuRenderStats cpu = renderCpu(data, options, state.film);
     stats = cpu;
@@ -352,6 +349,7 @@ int runRender(const RenderArgs& args) {
     options.progress = [&progress](double f) { progress.update(f); };
     options.stop = &interrupt.stopFlag();
     options.checkpoint = checkpointDue;
+    options.sppmPixels = &state.sppm;
     options.openBatch = &carried;
     options.keepOpenBatch = !states.empty();
     VulkanRenderStats gpu = renderVulkan(data, options, state.film);

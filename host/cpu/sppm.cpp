@@ -26,11 +26,10 @@
 namespace pt {
 namespace {
 
-// One pixel's state across iterations, and what the iteration under way gathers for it.
+// What the iteration under way gathers for a pixel (its state across iterations is its
+// SppmPixelRecord).
 struct SppmPixel {
-  SppmPixelState state;
-  vec3 ldSum{0.0f};   // the direct light of the iterations done, summed
-  vec3 ldPass{0.0f};  // this iteration's
+  vec3 ldPass{0.0f};  // this iteration's direct light
   SppmVisiblePoint vp;
   bool hasVp = false;
   // The photons' flux this iteration, summed exactly (any order, the same bits), and their
@@ -103,7 +102,51 @@ void sppmTracePhoton(const SceneData& scene, const PathScene& ps, const SppmGrid
   }
 }
 
+SppmPixelState stateOf(const SppmPixelRecord& r) {
+  SppmPixelState p;
+  p.radius = r.radius;
+  p.n = r.n;
+  p.tau = r.tau;
+  return p;
+}
+
 }  // namespace
+
+SppmPixels& sppmStartState(const SceneData& scene, const RenderOptions& options, size_t pixelCount,
+                           SppmPixels& local) {
+  SppmPixels& pixels = options.sppmPixels ? *options.sppmPixels : local;
+  if (pixels.empty()) {
+    PT_CHECK(options.firstSample == 0u, "SPPM continues only from the state of its iterations");
+    const SppmPixelState start = sppmStartPixel(scene.sppm.radius);
+    pixels.assign(pixelCount, SppmPixelRecord{start.radius, start.n, start.tau, vec3(0.0f), false});
+  } else {
+    PT_CHECK(options.firstSample > 0u && pixels.size() == pixelCount,
+             "an SPPM state continued has a record a pixel and iterations done");
+  }
+  return pixels;
+}
+
+void sppmUpdateRecord(SppmPixelRecord& r, vec3 phi, uint32_t m, vec3 ld) {
+  const SppmPixelState next = sppmUpdatePixel(stateOf(r), phi, m);
+  r.radius = next.radius;
+  r.n = next.n;
+  r.tau = next.tau;
+  r.ldSum += ld;
+}
+
+void sppmEstimateToFilm(const SppmPixels& pixels, uint32_t iterations, uint32_t photons,
+                        Film& film) {
+  PT_CHECK(pixels.size() == film.pixelCount() && iterations > 0u);
+  film = Film(film.width, film.height);
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    const SppmPixelRecord& p = pixels[i];
+    // (A pixel that took invalid flux is counted as an invalid sample by the film.)
+    const vec3 L = p.invalid
+                       ? vec3(NAN)
+                       : sppmPixelRadiance(p.ldSum, stateOf(p), float(iterations), float(photons));
+    film.add(int(i % size_t(film.width)), int(i / size_t(film.width)), L);
+  }
+}
 
 uint32_t sppmPhotonsPerIteration(const SceneData& scene) {
   const int64_t n = scene.sppm.photonsPerIteration;
@@ -113,8 +156,8 @@ uint32_t sppmPhotonsPerIteration(const SceneData& scene) {
 
 void checkSppmFitsInMemory(int width, int height, const std::string& what) {
   // The film, the pixels' state and the grid's inputs (renderSppm's vectors below).
-  const size_t bytesPerPixel =
-      Film::bytesPerPixel() + sizeof(SppmPixel) + sizeof(vec3) + sizeof(float) + sizeof(char);
+  const size_t bytesPerPixel = Film::bytesPerPixel() + sizeof(SppmPixel) + sizeof(SppmPixelRecord) +
+                               sizeof(vec3) + sizeof(float) + sizeof(char);
   const uint64_t n = uint64_t(std::max(width, 0)) * uint64_t(std::max(height, 0));
   checkFitsInMemory(
       n * bytesPerPixel,
@@ -122,11 +165,9 @@ void checkSppmFitsInMemory(int width, int height, const std::string& what) {
       std::to_string(bytesPerPixel) + " bytes per pixel: the film and sppm's state");
 }
 
-CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& options, Film& film,
-                          std::vector<SppmPixelReport>* report) {
+CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& options, Film& film) {
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
-  PT_CHECK(options.firstSample == 0u, "SPPM's iterations cannot start midway");
   PT_CHECK(scene.params.mediaPresent == 0u, "SPPM renders no media (checkBdptScene)");
   const auto callStart = std::chrono::steady_clock::now();
   scene.cpuCopies();  // built here on a first render: set-up, not render time
@@ -139,8 +180,9 @@ CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& option
   const uint maxDepth = scene.params.maxDepth;
   const uint32_t photons = sppmPhotonsPerIteration(scene);
   const size_t pixelCount = film.pixelCount();
+  SppmPixels local;
+  SppmPixels& records = sppmStartState(scene, options, pixelCount, local);
   std::vector<SppmPixel> pixels(pixelCount);
-  for (SppmPixel& px : pixels) px.state = sppmStartPixel(scene.sppm.radius);
   std::vector<vec3> points(pixelCount);
   std::vector<float> radii(pixelCount);
   std::vector<char> present(pixelCount);
@@ -150,7 +192,8 @@ CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& option
   };
 
   int done = 0;
-  for (int iteration = 0; iteration < options.spp && !stopRequested(); ++iteration) {
+  for (int k = 0; k < options.spp && !stopRequested(); ++k) {
+    const uint32_t iteration = options.firstSample + uint32_t(k);
     // The camera pass: each pixel's path (the path tracer's, with its random numbers of
     // sample index `iteration`) to its visible point, and the direct light on the way.
     workers.forChunks(pixelCount, 64, [&](size_t begin, size_t end) {
@@ -166,7 +209,7 @@ CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& option
           return true;
         };
         const uvec2 pixel(uint32_t(i % size_t(film.width)), uint32_t(i / size_t(film.width)));
-        px.ldPass = sampleRadianceUntil(scene, pixel, uint32_t(iteration), rays, &visiblePoint);
+        px.ldPass = sampleRadianceUntil(scene, pixel, iteration, rays, &visiblePoint);
       }
       totalRays += rays;
     });
@@ -177,7 +220,7 @@ CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& option
       const SppmPixel& px = pixels[i];
       present[i] = px.hasVp && px.vp.beta != vec3(0.0f);
       points[i] = px.vp.s.p;
-      radii[i] = px.state.radius;
+      radii[i] = records[i].radius;
     }
     const SppmGrid grid(points, radii, present);
 
@@ -192,35 +235,28 @@ CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& option
     if (stopRequested()) break;
 
     // Every pixel's update from the photons it gathered.
-    for (SppmPixel& px : pixels) {
+    for (size_t i = 0; i < pixelCount; ++i) {
+      SppmPixel& px = pixels[i];
+      SppmPixelRecord& r = records[i];
       const vec3 phi(float(px.phi[0].toDouble()), float(px.phi[1].toDouble()),
                      float(px.phi[2].toDouble()));
-      px.state = sppmUpdatePixel(px.state, phi, px.m);
-      px.ldSum += px.ldPass;
+      sppmUpdateRecord(r, phi, px.m, px.ldPass);
+      r.invalid = r.invalid || px.invalid;
       px.phi = {};
       px.m = 0;
+      px.invalid = false;
     }
-    done = iteration + 1;
+    done = k + 1;
     if (options.progress) options.progress(double(done) / double(options.spp));
+    if (options.checkpoint) {
+      sppmEstimateToFilm(records, options.firstSample + uint32_t(done), photons, film);
+      options.checkpoint(done);
+    }
   }
 
   // Each pixel's estimate, as its one sample.
-  if (done > 0) {
-    for (size_t i = 0; i < pixelCount; ++i) {
-      const SppmPixel& px = pixels[i];
-      // (A pixel that took invalid flux is counted as an invalid sample by the film.)
-      const vec3 L = px.invalid
-                         ? vec3(NAN)
-                         : sppmPixelRadiance(px.ldSum, px.state, float(done), float(photons));
-      film.add(int(i % size_t(film.width)), int(i / size_t(film.width)), L);
-    }
-  }
-  if (report) {
-    report->resize(pixelCount);
-    for (size_t i = 0; i < pixelCount; ++i) {
-      const SppmPixel& px = pixels[i];
-      (*report)[i] = SppmPixelReport{px.state.radius, px.state.n, px.state.tau, px.ldSum};
-    }
+  if (options.firstSample + uint32_t(done) > 0u) {
+    sppmEstimateToFilm(records, options.firstSample + uint32_t(done), photons, film);
   }
   stats.samplesDone = done;
   finishCpuRenderStats(options, film, totalRays, start, callStart, stats);

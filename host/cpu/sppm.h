@@ -15,7 +15,9 @@
 
 #include "cpu/integrator.h"
 #include "image/image.h"
+#include "image/sppm_pixels.h"
 #include "render/prepare.h"
+#include "render/render_options.h"
 
 namespace pt {
 
@@ -23,27 +25,32 @@ namespace pt {
 // the image, as pbrt-v4.
 uint32_t sppmPhotonsPerIteration(const SceneData& scene);
 
-// The state of one pixel after a render, for tests: its radius, photon count and flux, and the
-// sum of its iterations' direct light.
-struct SppmPixelReport {
-  float radius = 0.0f;
-  float n = 0.0f;
-  vec3 tau{0.0f};
-  vec3 ldSum{0.0f};
-};
-
 // Throws InputError "<what>sppm with a WxH film needs ..." where the film and the state
 // renderSppm keeps for every pixel do not fit in the memory available: the command line checks
 // before it allocates either.
 void checkSppmFitsInMemory(int width, int height, const std::string& what);
 
-// Renders options.spp iterations (from sample index 0: iterations build on all before them, so
-// a render cannot be continued or split) and adds each pixel's estimate to the film as its one
-// sample. A stop (options.stop) ends it after the last whole iteration, stats.samplesDone of
-// them. The same seed gives the same bits whatever the thread count: the flux a pixel gathers is
-// summed exactly (ExactSum), so the order photons arrive in does not matter. `pixels`, where
-// given, receives every pixel's final state (row-major).
-CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& options, Film& film,
-                          std::vector<SppmPixelReport>* pixels = nullptr);
+// The state the render of `pixelCount` pixels starts from, in `local` or in the caller's
+// options.sppmPixels (RenderOptions: continued when it holds a state, firstSample then its
+// iterations; otherwise every pixel at the scene's initial radius, from iteration 0).
+SppmPixels& sppmStartState(const SceneData& scene, const RenderOptions& options, size_t pixelCount,
+                           SppmPixels& local);
+
+// A pixel's state after an iteration in which it gathered `m` photons of flux `phi`
+// (sppm_vertex.h's sppmUpdatePixel) and direct light `ld`.
+void sppmUpdateRecord(SppmPixelRecord& r, vec3 phi, uint32_t m, vec3 ld);
+
+// Sets `film` to every pixel's estimate after `iterations` iterations of `photons` photons,
+// one sample a pixel (an invalid one where the pixel took a NaN or infinite value).
+void sppmEstimateToFilm(const SppmPixels& pixels, uint32_t iterations, uint32_t photons,
+                        Film& film);
+
+// Renders options.spp iterations, from the state options.sppmPixels holds after
+// options.firstSample of them (RenderOptions), and sets the film to each pixel's estimate as
+// its one sample. A stop (options.stop) ends it after the last whole iteration, stats.samplesDone
+// of them this call. The same seed gives the same bits whatever the thread count, and however
+// the iterations are split between calls: the flux a pixel gathers is summed exactly
+// (ExactSum), so the order photons arrive in does not matter.
+CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& options, Film& film);
 
 }  // namespace pt

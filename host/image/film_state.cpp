@@ -9,13 +9,15 @@
 //   setting backend=cpu     one line per setting, in the order they were given
 //   settings-hash 0123456789abcdef
 //   info scene=...          one line per info entry
+//   sppm 33                 only for an sppm render: the bytes of its state per pixel
 //   data 123456             the body's length in bytes; the body follows this line
 //
 // The body holds, per pixel in row-major order: the valid and invalid sample counts (LEB128
 // varints), then per channel the ExactSum as a byte saying which of its limbs are non-zero
 // followed by those limbs (little-endian); then, with an open batch, per pixel its three
-// float sums and its invalid count (little-endian). The last 8 bytes are hashBytes() of
-// everything before them, little-endian.
+// float sums and its invalid count (little-endian); then, for an sppm render, per pixel its
+// radius, photon count, flux and direct-light sum (8 floats) and its invalid flag (a byte).
+// The last 8 bytes are hashBytes() of everything before them, little-endian.
 #include "image/film_state.h"
 
 #include <algorithm>
@@ -37,6 +39,7 @@ constexpr std::string_view kMagic = "pt film state ";
 constexpr int kVersion = 1;
 constexpr size_t kMaxHeaderBytes = 1 << 20;
 constexpr uint64_t kMaxPixels = uint64_t(1) << 28;
+constexpr uint64_t kSppmPixelBytes = 8 * 4 + 1;
 
 [[noreturn]] void failState(const fs::path& path, const std::string& what) {
   throw InputError(path.string() + ": " + what);
@@ -314,6 +317,17 @@ void writeFilmState(const FilmState& state, const fs::path& path) {
       putLittle(body, state.open.invalid[i], 4);
     }
   }
+  if (!state.sppm.empty()) {
+    PT_CHECK(state.sppm.size() == film.pixelCount() && state.open.empty() &&
+                 state.ranges.size() <= 1 && (state.ranges.empty() || state.ranges[0].first == 0),
+             "an sppm state has a record per pixel, iterations from 0 and no open batch");
+    for (const SppmPixelRecord& p : state.sppm) {
+      for (float f : {p.radius, p.n, p.tau.x, p.tau.y, p.tau.z, p.ldSum.x, p.ldSum.y, p.ldSum.z}) {
+        putLittle(body, std::bit_cast<uint32_t>(f), 4);
+      }
+      body.push_back(p.invalid ? 1 : 0);
+    }
+  }
 
   std::string header = std::string(kMagic) + std::to_string(kVersion) + "\n";
   header += "width " + std::to_string(film.width) + "\n";
@@ -333,6 +347,7 @@ void writeFilmState(const FilmState& state, const fs::path& path) {
     std::replace(oneLine.begin(), oneLine.end(), '\n', ' ');
     header += "info " + key + "=" + oneLine + "\n";
   }
+  if (!state.sppm.empty()) header += "sppm " + std::to_string(kSppmPixelBytes) + "\n";
   header += "data " + std::to_string(body.size()) + "\n";
 
   Bytes file(header.begin(), header.end());
@@ -352,7 +367,7 @@ FilmState readFilmState(const fs::path& path) {
 
   // The header, line by line up to "data N".
   FilmState state;
-  uint64_t width = 0, height = 0, dataSize = 0;
+  uint64_t width = 0, height = 0, dataSize = 0, sppmBytes = 0;
   bool haveSamples = false, haveData = false;
   std::string recordedHash;
   SampleRange openRange;
@@ -412,6 +427,12 @@ FilmState readFilmState(const fs::path& path) {
       recordedHash = std::string(value);
     } else if (key == "info") {
       splitKeyValue(value, state.info, path, "info entry");
+    } else if (key == "sppm") {
+      number(sppmBytes);
+      if (sppmBytes != kSppmPixelBytes) {
+        failState(path, "corrupt film state: sppm state of " + std::to_string(sppmBytes) +
+                            " bytes per pixel; this pt writes " + std::to_string(kSppmPixelBytes));
+      }
     } else if (key == "data") {
       number(dataSize);
       haveData = true;
@@ -456,7 +477,14 @@ FilmState readFilmState(const fs::path& path) {
     failState(path, "corrupt film state: the open batch " + openRange.toString() +
                         " does not end the sample ranges");
   }
-  const uint64_t inFilm = uint64_t(state.samplesPerPixel()) - openRange.count();
+  // An sppm render's film holds its estimate, one sample, after iterations [0, end).
+  if (sppmBytes != 0 && (openRange.count() > 0 || state.ranges.size() > 1 ||
+                         (!state.ranges.empty() && state.ranges[0].first != 0))) {
+    failState(path, "corrupt film state: an sppm state of samples " + rangesText(state.ranges) +
+                        (openRange.count() > 0 ? " with an open batch" : ""));
+  }
+  const uint64_t inFilm = sppmBytes != 0 ? (state.ranges.empty() ? 0u : 1u)
+                                         : uint64_t(state.samplesPerPixel()) - openRange.count();
   state.film = Film(int(width), int(height));
   Film& film = state.film;
   Reader in(path, bytes.data() + pos, bytes.data() + checked);
@@ -489,6 +517,20 @@ FilmState readFilmState(const fs::path& path) {
       if (open.invalid[i] > open.count) in.corrupt("an open batch count is out of range");
     }
   }
+  if (sppmBytes != 0) {
+    state.sppm.resize(film.pixelCount());
+    for (SppmPixelRecord& p : state.sppm) {
+      float f[8];
+      for (float& v : f) v = std::bit_cast<float>(uint32_t(in.little(4)));
+      p.radius = f[0];
+      p.n = f[1];
+      p.tau = glm::vec3(f[2], f[3], f[4]);
+      p.ldSum = glm::vec3(f[5], f[6], f[7]);
+      const unsigned char invalid = in.next();
+      if (invalid > 1) in.corrupt("an sppm pixel's invalid flag is neither 0 nor 1");
+      p.invalid = invalid != 0;
+    }
+  }
   if (!in.atEnd()) in.corrupt("unexpected bytes at the end of the data");
   return state;
 }
@@ -497,6 +539,11 @@ FilmState readFilmState(const fs::path& path) {
 
 void FilmStateMerger::add(NamedFilmState named) {
   FilmState& state = named.state;
+  if (!state.sppm.empty()) {
+    failState(named.path,
+              "holds an sppm render, whose pixels depend on every iteration before: sppm "
+              "renders cannot be split or merged (continue one with render --resume)");
+  }
   if (seen_.empty()) {
     film_ = Film(state.film.width, state.film.height);
   }

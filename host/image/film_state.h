@@ -13,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "image/image.h"
+#include "image/sppm_pixels.h"
 
 namespace pt {
 
@@ -67,6 +68,10 @@ struct FilmState {
   Film film;
   // Vulkan: the last range's tail, not yet in `film` (empty otherwise).
   OpenBatch open;
+  // Photon mapping (sppm): every pixel's state after the iterations of `ranges` (one range
+  // from 0), which a resumed render continues from; `film` then holds one sample a pixel, the
+  // estimate of those iterations. Empty for the other integrators.
+  SppmPixels sppm;
 
   uint32_t samplesPerPixel() const;  // sample indices in `ranges`
   Film combinedFilm() const;         // film with the open batch folded in: the image's sums
@@ -98,9 +103,11 @@ struct NamedFilmState {
 
 // Combines states of disjoint sample ranges rendered with the same settings, exactly: the
 // result does not depend on the order the states come in, and equals the state of one render
-// of all their samples. Open batches are folded in, but for the one that ends the merged
-// samples: it stays open, as it would in the one render's state. States are added one at a
-// time and their films merged at once, so that memory holds two films, not all of them.
+// of all their samples. An sppm render's state is refused (InputError naming the file): its
+// pixels depend on every iteration before, so slices of it do not add up. Open batches are folded
+// in, but for the one that ends the merged samples: it stays open, as it would in the one render's
+// state. States are added one at a time and their films merged at once, so that memory holds two
+// films, not all of them.
 class FilmStateMerger {
  public:
   void add(NamedFilmState named);

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <functional>
 
+#include "image/sppm_pixels.h"
+
 namespace pt {
 
 struct RenderOptions {
@@ -22,6 +24,12 @@ struct RenderOptions {
   // firstSample + done) of this call (after every pass on the CPU, after every fold of a batch
   // on Vulkan), so that a checkpoint of the film can be written from it.
   std::function<void(int done)> checkpoint;
+  // Photon mapping (kIntegratorSppm): every pixel's state between iterations. Empty, or not
+  // given, the render starts from iteration 0 (firstSample 0); otherwise it continues from
+  // its state after firstSample iterations. A given one is left at the state of the last
+  // whole iteration (at every checkpoint call too, when the film holds that iteration's
+  // estimate).
+  SppmPixels* sppmPixels = nullptr;
 };
 
 struct RenderStats {

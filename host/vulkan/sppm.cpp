@@ -94,7 +94,6 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
   const auto callStart = std::chrono::steady_clock::now();
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
-  PT_CHECK(options.firstSample == 0u, "SPPM's iterations cannot start midway");
   PT_CHECK(scene.params.mediaPresent == 0u, "SPPM renders no media (checkBdptScene)");
   ContextOptions contextOptions = options.context;
   contextOptions.int64Atomics = true;  // the photons' exact sums
@@ -155,9 +154,8 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
   commands.submitAndWait(ctx);
 
   const uint32_t photons = sppmPhotonsPerIteration(scene);
-  std::vector<SppmPixelState> state(pixels, sppmStartPixel(scene.sppm.radius));
-  std::vector<vec3> ldSum(pixels, vec3(0.0f));
-  std::vector<char> invalid(pixels, 0);
+  SppmPixels local;
+  SppmPixels& records = sppmStartState(scene, options, pixels, local);
   std::vector<vec3> gridAt(pixels);
   std::vector<float> radii(pixels);
   std::vector<char> present(pixels);
@@ -173,14 +171,15 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
   stats.device = ctx.info().name;
   const auto start = std::chrono::steady_clock::now();
   int done = 0;
-  for (int iteration = 0; iteration < options.spp && !stopRequested(); ++iteration) {
+  for (int k = 0; k < options.spp && !stopRequested(); ++k) {
+    const uint32_t iteration = options.firstSample + uint32_t(k);
     // The camera pass: every pixel's path to its visible point, and its direct light.
     commands.begin();
     cmd.fillBuffer(*buffers.accum().buffer, 0, VK_WHOLE_SIZE, 0);
     cmd.fillBuffer(*found.buffer, 0, VK_WHOLE_SIZE, 0);
     transferToCompute(cmd);
     cameraPass.bind(cmd);
-    pushPass(cmd, cameraPass, PassConstants{uint32_t(iteration), 1u, ~0u, 0u});
+    pushPass(cmd, cameraPass, PassConstants{iteration, 1u, ~0u, 0u});
     cmd.dispatch(groupsX, groupsY, 1);
     computeToTransfer(cmd);
     cmd.copyBuffer(*found.buffer, *readback.buffer, vk::BufferCopy(0, foundAt, foundSize));
@@ -196,7 +195,7 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
     for (size_t i = 0; i < pixels; ++i) {
       present[i] = foundBack[i].w != 0.0f;
       gridAt[i] = vec3(foundBack[i]);
-      radii[i] = state[i].radius;
+      radii[i] = records[i].radius;
     }
     const SppmGrid cells(gridAt, radii, present);
     auto* up = static_cast<char*>(upload.mapped);
@@ -228,7 +227,7 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
           const uint32_t count = std::min(photons - first, kSppmPhotonsPerDispatch);
           const uint32_t perRow = kSppmPhotonRowInvocations;
           const uint32_t rows = (count + perRow - 1) / perRow;
-          pushPass(cmd, photonPass, PassConstants{uint32_t(iteration), count, hit, first});
+          pushPass(cmd, photonPass, PassConstants{iteration, count, hit, first});
           cmd.dispatch(perRow / kWorkgroupSize, (rows + kWorkgroupSize - 1) / kWorkgroupSize, 1);
           first += count;
         }
@@ -265,12 +264,16 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
       }
       const uint64_t count = words[PT_SPPM_COUNT_WORD];
       const uint64_t m = count & ((uint64_t(1) << PT_SPPM_INVALID_SHIFT) - 1u);
-      if ((count >> PT_SPPM_INVALID_SHIFT) != 0 || ldBack[i].invalid != 0) invalid[i] = 1;
-      state[i] = sppmUpdatePixel(state[i], phi, uint32_t(m));
-      ldSum[i] += ldBack[i].sum;
+      SppmPixelRecord& r = records[i];
+      if ((count >> PT_SPPM_INVALID_SHIFT) != 0 || ldBack[i].invalid != 0) r.invalid = true;
+      sppmUpdateRecord(r, phi, uint32_t(m), ldBack[i].sum);
     }
-    done = iteration + 1;
+    done = k + 1;
     if (options.progress) options.progress(double(done) / double(options.spp));
+    if (options.checkpoint) {
+      sppmEstimateToFilm(records, options.firstSample + uint32_t(done), photons, film);
+      options.checkpoint(done);
+    }
   }
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -281,13 +284,8 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
   stats.maxLoopIterations = counters.maxLoopIterations;
 
   // Each pixel's estimate, as its one sample.
-  if (done > 0) {
-    for (size_t i = 0; i < pixels; ++i) {
-      const vec3 L = invalid[i]
-                         ? vec3(NAN)
-                         : sppmPixelRadiance(ldSum[i], state[i], float(done), float(photons));
-      film.add(int(i % size_t(film.width)), int(i / size_t(film.width)), L);
-    }
+  if (options.firstSample + uint32_t(done) > 0u) {
+    sppmEstimateToFilm(records, options.firstSample + uint32_t(done), photons, film);
   }
   stats.samplesDone = done;
   stats.stopped = done < options.spp;
