@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "common/check.h"
+#include "image/film_state.h"
 #include "image/image.h"
 #include "image/texture_image.h"
 #include "scene/load_scene.h"
@@ -216,6 +217,34 @@ Outcome fuzzImage(const std::uint8_t* data, std::size_t size) {
   return guarded([&] { readImage(path); });
 }
 
+// A film state as `pt render --resume` and `pt merge` read it; an accepted one must keep the
+// promises resume and merge rely on: one count a pixel, its samples those of its ranges (one
+// for an sppm render, whose records are one a pixel), an open batch ending the ranges.
+Outcome fuzzFilmState(const std::uint8_t* data, std::size_t size) {
+  const fs::path path = workDir() / "film.ptstate";
+  writeFile(path, data, size);
+  return guarded([&] {
+    const FilmState state = readFilmState(path);
+    const Film& film = state.film;
+    const size_t pixels = film.pixelCount();
+    PT_CHECK(film.width > 0 && film.height > 0 && film.sampleCount.size() == pixels &&
+                 film.invalidCount.size() == pixels && film.exact.size() == pixels,
+             "fuzz: an accepted film state's film is whole");
+    PT_CHECK(state.sppm.empty() || (state.sppm.size() == pixels && state.open.empty()),
+             "fuzz: an accepted sppm state has a record a pixel and no open batch");
+    PT_CHECK(state.open.empty() || (state.open.sum.size() == pixels &&
+                                    state.open.first + state.open.count == state.ranges.back().end),
+             "fuzz: an accepted open batch ends the ranges");
+    const uint64_t expected =
+        !state.sppm.empty() ? 1u : uint64_t(state.samplesPerPixel()) - state.open.count;
+    for (size_t i = 0; i < pixels; ++i) {
+      PT_CHECK(film.sampleCount[i] + film.invalidCount[i] == expected,
+               "fuzz: an accepted film state's pixels hold its ranges' samples");
+    }
+    state.combinedFilm().resolve();
+  });
+}
+
 // A pbrt-v4 scene through loadScene, as `pt render scene.pbrt` reads it, with "mesh.ply" to
 // include; an accepted scene must keep the Scene's promises (the renderer relies on them).
 Outcome fuzzPbrt(const std::uint8_t* data, std::size_t size) {
@@ -302,10 +331,11 @@ Outcome fuzzNanoVdb(const std::uint8_t* data, std::size_t size) {
 }
 
 const std::vector<Target>& targets() {
-  static const std::vector<Target> all = {
-      {"scene", fuzzScene},     {"obj", fuzzObj},      {"mtl", fuzzMtl},
-      {"ply", fuzzPly},         {"image", fuzzImage},  {"pbrt", fuzzPbrt},
-      {"texture", fuzzTexture}, {"nvdb", fuzzNanoVdb}, {"gltf", fuzzGltf}};
+  static const std::vector<Target> all = {{"scene", fuzzScene},     {"obj", fuzzObj},
+                                          {"mtl", fuzzMtl},         {"ply", fuzzPly},
+                                          {"image", fuzzImage},     {"pbrt", fuzzPbrt},
+                                          {"texture", fuzzTexture}, {"nvdb", fuzzNanoVdb},
+                                          {"gltf", fuzzGltf},       {"state", fuzzFilmState}};
   return all;
 }
 
