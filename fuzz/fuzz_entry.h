@@ -21,7 +21,8 @@ Outcome fuzzImage(const std::uint8_t* data, std::size_t size);  // readImage: EX
 Outcome fuzzPbrt(const std::uint8_t* data, std::size_t size);   // a .pbrt scene beside fixed meshes
 Outcome fuzzGltf(const std::uint8_t* data, std::size_t size);   // a .gltf or .glb scene
 Outcome fuzzNanoVdb(const std::uint8_t* data, std::size_t size);  // readNanoVdbMedium, packed
-Outcome fuzzFilmState(const std::uint8_t* data, std::size_t size);  // readFilmState, checked
+// readFilmState: the input is a film state file less its checksum (appended by the entry).
+Outcome fuzzFilmState(const std::uint8_t* data, std::size_t size);
 // readTextureImage: the first byte picks the extension (textureExtension), the rest is the file.
 Outcome fuzzTexture(const std::uint8_t* data, std::size_t size);
 const char* textureExtension(std::uint8_t selector);  // ".png", ".jpg", ... by selector % 7
