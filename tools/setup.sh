@@ -19,7 +19,7 @@ packages=(
 )
 # The fuzz build (-DPT_FUZZ=ON, clang and libFuzzer: docs/errors.md), Embree's buildbench
 # (tools/bvh-bench.sh), the plots of tools/accuracy.sh and tools/performance.sh (gnuplot).
-toolPackages=(clang-16 libfuzzer-16-dev embree-tools gnuplot-nox)
+toolPackages=(clang-16 libclang-rt-16-dev libfuzzer-16-dev embree-tools gnuplot-nox)
 
 case "${1:-}" in
   "") packages+=("${toolPackages[@]}") ;;
