@@ -10,7 +10,7 @@
 #ifdef PT_DEBUG_PRINTF
 #extension GL_EXT_debug_printf : enable
 #endif
-#ifdef PT_SPPM_PHOTONS
+#if defined(PT_SPPM_PHOTONS) || defined(PT_BDPT)
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
 #endif
@@ -381,8 +381,7 @@ MediumInterface loadMediumInterface(uint primitive) {
 #endif
 #if defined(PT_CHECK_LIGHT_PATHS) || defined(PT_SPPM)
 // The headers of bidirectional path tracing and photon mapping (docs/bdpt.md, docs/sppm.md):
-// SPPM's passes call them; the build also compiles them all here, every effect on, so that
-// BDPT's stay GLSL.
+// SPPM's passes call them; the build also compiles them all here, every effect on.
 #include "bdpt_camera.h"
 #include "bdpt_connect.h"
 #include "bdpt_vertex.h"
@@ -390,6 +389,13 @@ MediumInterface loadMediumInterface(uint primitive) {
 #endif
 #ifdef PT_SPPM
 #include "sppm.glsl"
+#endif
+#ifdef PT_BDPT
+#include "bdpt_connect.h"
+#include "bdpt_sample.h"
+#include "bdpt_splat.h"
+#include "bdpt_vertex.h"
+#include "bdpt.glsl"
 #endif
 
 // A ray whose first traversal gave up at an edge function of exactly zero (traceRayWith in
@@ -606,6 +612,10 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
 #ifdef PT_SPPM_PHOTONS
 void main() {
   sppmTracePhotons();
+}
+#elif defined(PT_BDPT)
+void main() {
+  bdptMain();
 }
 #else
 void main() {

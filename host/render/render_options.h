@@ -9,6 +9,15 @@
 
 namespace pt {
 
+// One strategy of bidirectional path tracing rendered alone, without its MIS weight (pbrt-v4's
+// visualizestrategies, for debugging; cpu/bdpt.h): s light vertices joined to t camera vertices.
+// Unset (-1): all of them, weighed.
+struct BdptStrategy {
+  int s = -1;
+  int t = -1;
+  bool all() const { return s < 0; }
+};
+
 struct RenderOptions {
   uint32_t firstSample = 0;  // sample indices [firstSample, firstSample + spp) are taken
   int spp = 1;
@@ -22,6 +31,7 @@ struct RenderOptions {
   // firstSample + done) of this call (after every pass on the CPU, after every fold of a batch
   // on Vulkan), so that a checkpoint of the film can be written from it.
   std::function<void(int done)> checkpoint;
+  BdptStrategy bdptStrategy;  // scenes rendered with kIntegratorBdpt
 };
 
 struct RenderStats {
