@@ -7,15 +7,12 @@
 // (t = 1) that land on any pixel alike, so the film's bits do not depend on the order the
 // invocations add in, and equal the CPU reference's sums of the same floats. The host folds the
 // sums into its film (host/vulkan/bdpt.cpp). What the host defines: PT_BDPT_MAX_VERTICES (the
-// subpaths' arrays), PT_BDPT_STRATEGY_S and _T (one strategy alone, or -1), PT_BDPT_SPLAT_SCALE
-// (bdpt_splat.h's scale).
+// subpaths' arrays) and PT_BDPT_SPLAT_SCALE (bdpt_splat.h's scale); pass.reserved is ~0u, or
+// the one strategy (s, t) rendered alone as s << 16 | t (a constant the shader does not take,
+// so that such a render compiles no variant of its own).
 #ifndef PT_BDPT_GLSL
 #define PT_BDPT_GLSL
 
-#ifndef PT_BDPT_STRATEGY_S
-#define PT_BDPT_STRATEGY_S -1
-#define PT_BDPT_STRATEGY_T -1
-#endif
 #ifndef PT_BDPT_SPLAT_SCALE
 #define PT_BDPT_SPLAT_SCALE 1.0
 #endif
@@ -131,16 +128,24 @@ void bdptMain() {
     bdptRandomWalk(radiance, walk, radiance ? maxDepth + 2u : maxDepth + 1u, filmPixel,
                    sampleIndex);
   }
-  if (start.found) bdptCorrectInfiniteStart(lightPath, start.pdfPos);
+  if (start.found && bdptIsInfiniteLight(start.vertex)) {
+    BdptVertex first = lightPath.v[0];
+    BdptVertex second = lightPath.v[1];
+    bdptCorrectInfiniteStart(first, second, lightPath.count, start.pdfPos);
+    lightPath.v[0].pdfFwd = first.pdfFwd;
+    lightPath.v[1].pdfFwd = second.pdfFwd;
+  }
 
   // Every strategy: the camera's into the pixel's own sample, light tracing's splats into the
   // pixels they land on.
   vec3 L = vec3(0.0);
-  bool weighed = PT_BDPT_STRATEGY_S < 0;
+  bool weighed = pass.reserved == ~0u;
+  int strategyS = weighed ? -1 : int(pass.reserved >> 16u);
+  int strategyT = weighed ? -1 : int(pass.reserved & 0xFFFFu);
   for (uint t = 1u; t <= cameraPath.count; ++t) {
     for (uint s = 0u; s <= lightPath.count; ++s) {
       gLoopIterations++;
-      if (!bdptTakesStrategy(s, t, maxDepth, PT_BDPT_STRATEGY_S, PT_BDPT_STRATEGY_T)) continue;
+      if (!bdptTakesStrategy(s, t, maxDepth, strategyS, strategyT)) continue;
       BdptStrategyRandom u = bdptStrategyRandom(sobol, filmPixel, sampleIndex, seed,
                                                 params.camera.lensRadius, s, t);
       BdptConnection c = bdptConnect(s, t, u.uChoose, u.uLight);

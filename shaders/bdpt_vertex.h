@@ -465,15 +465,17 @@ PT_INLINE BdptLightStart sampleBdptLightStart(PT_SCENE_PARAM vec2 uChoose, vec2 
 // Where the light subpath starts at infinity, pbrt-v4 corrects its first two densities once
 // the walk is done: its second vertex's is the disk point's density projected onto the surface
 // there, its first the solid-angle density of its direction (that light sampling from a point
-// of the scene would have).
-PT_INLINE void bdptCorrectInfiniteStart(PT_SCENE_PARAM PT_INOUT(BdptPath) path, float pdfPos) {
-  if (!bdptIsInfiniteLight(path.v[0])) return;
-  if (path.count > 1u) {
-    path.v[1].pdfFwd = pdfPos;
-    if (bdptOnSurface(path.v[1])) path.v[1].pdfFwd *= abs(dot(path.v[0].w, path.v[1].ng));
+// of the scene would have). first, second: the subpath's first two vertices (second only where
+// `count`, the subpath's vertices, is above 1). Vertices, not the subpath: GLSL would copy it.
+PT_INLINE void bdptCorrectInfiniteStart(PT_SCENE_PARAM PT_INOUT(BdptVertex) first,
+                                        PT_INOUT(BdptVertex) second, uint count, float pdfPos) {
+  if (!bdptIsInfiniteLight(first)) return;
+  if (count > 1u) {
+    second.pdfFwd = pdfPos;
+    if (bdptOnSurface(second)) second.pdfFwd *= abs(dot(first.w, second.ng));
   }
   // (Its direction alone matters: any vertex will do as the one it is seen from.)
-  path.v[0].pdfFwd = bdptPdfLightOrigin(PT_SCENE_ARG path.v[0], path.v[0]);
+  first.pdfFwd = bdptPdfLightOrigin(PT_SCENE_ARG first, first);
 }
 
 // ---- The random walk ----------------------------------------------------------------------------

@@ -650,7 +650,7 @@ struct PassConstants {
   uint sampleIndex;  // 4 bytes: the first sample index of this dispatch
   uint sampleCount;  // 4 bytes: samples per pixel in this dispatch, indices sampleIndex + i
   uint debugPixel;   // 4 bytes: y * width + x of the pixel whose path is printed, or ~0u
-  uint reserved;     // 4 bytes
+  uint reserved;     // 4 bytes: SPPM's photons: the first; BDPT: the strategy (bdpt.glsl)
 };                   // 16 bytes
 
 // Per-pixel accumulation on the device, in float; the host folds it into its double

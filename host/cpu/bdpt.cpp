@@ -138,7 +138,7 @@ float bdptSubpaths(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInde
       bdptRandomWalk(scene, ps, light,
                      BdptWalk{start.origin, start.direction, start.beta, start.pdfDir},
                      maxDepth + 1u, /*radiance=*/false, pixel, sampleIndex, rays);
-      bdptCorrectInfiniteStart(ps, light, start.pdfPos);
+      bdptCorrectInfiniteStart(ps, light.v[0], light.v[1], light.count, start.pdfPos);
     }
   }
   return cs.weight;

@@ -31,18 +31,20 @@ using A = vk::AccessFlagBits;
 constexpr double kFoldSeconds = 1.0;
 
 // The variant's definitions beyond the scene's effects (shaders/bdpt.glsl): the subpaths'
-// array size, the strategy rendered alone, the splats' weight scale as its float's bits.
+// array size, the splats' weight scale as its float's bits.
 std::string bdptDefinitions(const SceneData& scene, const VulkanRenderOptions& options) {
   const Camera& cam = scene.params.camera;
   const float scale = bdptSplatScale(cam, bdptInverseFilterIntegral(cam));
   uint32_t bits;
   std::memcpy(&bits, &scale, sizeof(bits));
-  const BdptStrategy& strategy = options.bdptStrategy;
   return pathtraceDefinitions(scene, options) + "#define PT_BDPT\n" +
          "#define PT_BDPT_MAX_VERTICES " + std::to_string(bdptMaxDepth(scene) + 2u) + "u\n" +
-         "#define PT_BDPT_STRATEGY_S " + std::to_string(strategy.all() ? -1 : strategy.s) + "\n" +
-         "#define PT_BDPT_STRATEGY_T " + std::to_string(strategy.all() ? -1 : strategy.t) + "\n" +
          "#define PT_BDPT_SPLAT_SCALE uintBitsToFloat(" + std::to_string(bits) + "u)\n";
+}
+
+// PassConstants::reserved for bdpt.glsl: ~0u for every strategy weighed, else s << 16 | t.
+uint32_t strategyConstant(const BdptStrategy& strategy) {
+  return strategy.all() ? ~0u : uint32_t(strategy.s) << 16 | uint32_t(strategy.t);
 }
 
 // The read-back film's sums and counts into the film (exactly: the device's limbs are
@@ -104,8 +106,9 @@ VulkanRenderStats renderBdptVulkan(const SceneData& scene, const VulkanRenderOpt
   const auto dispatch = [&](uint32_t sampleIndex, uint32_t samples, uint32_t groupsX,
                             uint32_t groupsY) {
     program.bind(cmd);
-    cmd.pushConstants<PassConstants>(*program.layout, vk::ShaderStageFlagBits::eCompute, 0,
-                                     PassConstants{sampleIndex, samples, ~0u, 0u});
+    cmd.pushConstants<PassConstants>(
+        *program.layout, vk::ShaderStageFlagBits::eCompute, 0,
+        PassConstants{sampleIndex, samples, ~0u, strategyConstant(options.bdptStrategy)});
     cmd.dispatch(groupsX, groupsY, 1);
   };
 
