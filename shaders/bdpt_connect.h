@@ -11,6 +11,10 @@
 // the same path, computed by pbrt-v4's recursion over the ratios of each vertex's two
 // densities; pbrt-v4 uses the balance heuristic (exponent 1) there. Delta vertices (specular
 // bounces, delta lights) are skipped as pbrt-v4 skips them, and their zero densities count as 1.
+//
+// Where a vertex index would be below 0 for a strategy that does not read it (t - 2 for t = 1,
+// say), it is clamped to 0 (max(t, 2u) - 2u): lavapipe runs both sides of a branch and both
+// operands of a selection, and would read outside the subpath's array.
 #ifndef PT_BDPT_CONNECT_H
 #define PT_BDPT_CONNECT_H
 
@@ -137,10 +141,10 @@ PT_INLINE BdptConnection bdptConnect(PT_SCENE_PARAM PT_BDPT_PATHS_PARAM uint s, 
   if (s == 0u) {
     // The camera subpath as a whole path: the light its last vertex emits.
     if (!bdptIsLight(pt)) return c;
-    c.L = bdptLe(PT_SCENE_ARG pt, cameraPath.v[t - 2u]) * pt.beta;
+    c.L = bdptLe(PT_SCENE_ARG pt, cameraPath.v[max(t, 2u) - 2u]) * pt.beta;
   } else if (t == 1u) {
     // A point on the lens seen from the light subpath's last vertex (light tracing).
-    BdptVertex qs = lightPath.v[s - 1u];
+    BdptVertex qs = lightPath.v[max(s, 1u) - 1u];
     if (!bdptIsConnectible(qs)) return c;
     CameraWiSample cs = sampleCameraWi(PT_PARAMS.camera, qs.p, uLight);
     if (!cs.found) return c;
@@ -157,7 +161,7 @@ PT_INLINE BdptConnection bdptConnect(PT_SCENE_PARAM PT_BDPT_PATHS_PARAM uint s, 
     return bdptSampleLightFrom(PT_SCENE_ARG pt, uChoose, uLight);
   } else {
     // A segment between the two subpaths' last vertices.
-    BdptVertex qs = lightPath.v[s - 1u];
+    BdptVertex qs = lightPath.v[max(s, 1u) - 1u];
     if (!bdptIsConnectible(qs) || !bdptIsConnectible(pt)) return c;
     vec3 d = qs.p - pt.p;
     float dist2 = dot(d, d);
@@ -198,8 +202,8 @@ PT_INLINE BdptConnectionDensities bdptConnectionDensities(
     PT_SCENE_PARAM PT_BDPT_PATHS_PARAM PT_IN(BdptVertex) pt, PT_IN(BdptVertex) qs, uint s, uint t) {
   BdptConnectionDensities r = BdptConnectionDensities(0.0f, 0.0f, 0.0f, 0.0f);
   // The predecessors (unused where they do not exist: any vertex stands in).
-  BdptVertex ptMinus = t > 1u ? cameraPath.v[t - 2u] : pt;
-  BdptVertex qsMinus = s > 1u ? lightPath.v[s - 2u] : qs;
+  BdptVertex ptMinus = t > 1u ? cameraPath.v[max(t, 2u) - 2u] : pt;
+  BdptVertex qsMinus = s > 1u ? lightPath.v[max(s, 2u) - 2u] : qs;
   if (s > 0u) {
     r.ptRev = bdptPdf(PT_SCENE_ARG qsMinus, qs, pt);
     if (t > 1u) r.ptMinusRev = bdptPdf(PT_SCENE_ARG qs, pt, ptMinus);
@@ -220,7 +224,7 @@ PT_INLINE float bdptMisWeight(PT_SCENE_PARAM PT_BDPT_PATHS_PARAM PT_IN(BdptVerte
                               uint t) {
   if (s + t == 2u) return 1.0f;
   BdptVertex pt = t == 1u ? sampled : cameraPath.v[t - 1u];
-  BdptVertex qs = s == 1u ? sampled : (s > 0u ? lightPath.v[s - 1u] : pt);
+  BdptVertex qs = s == 1u ? sampled : (s > 0u ? lightPath.v[max(s, 1u) - 1u] : pt);
   BdptConnectionDensities d = bdptConnectionDensities(PT_SCENE_ARG PT_BDPT_PATHS_ARG pt, qs, s, t);
   float sumRi = 0.0f;
   // The strategies that take fewer camera vertices (the connection vertices are never delta:
@@ -240,8 +244,8 @@ PT_INLINE float bdptMisWeight(PT_SCENE_PARAM PT_BDPT_PATHS_PARAM PT_IN(BdptVerte
     float pdfRev = i == s - 1u ? d.qsRev : (i == s - 2u ? d.qsMinusRev : lightPath.v[i].pdfRev);
     float pdfFwd = i == s - 1u ? qs.pdfFwd : lightPath.v[i].pdfFwd;
     bool delta = i == s - 1u ? false : lightPath.v[i].delta;
-    bool deltaBefore =
-        i > 0u ? lightPath.v[i - 1u].delta : bdptIsDeltaLight(i == s - 1u ? qs : lightPath.v[0]);
+    bool deltaBefore = i > 0u ? lightPath.v[max(i, 1u) - 1u].delta
+                              : bdptIsDeltaLight(i == s - 1u ? qs : lightPath.v[0]);
     ri *= bdptMisRatio(pdfRev, pdfFwd);
     if (!delta && !deltaBefore) sumRi += ri;
   }
