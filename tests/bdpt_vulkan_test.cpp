@@ -153,9 +153,10 @@ TEST(BdptVulkan, SameBitsRunToRun) {
   EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
 }
 
-// On the command line: bdpt renders with --backend vulkan, and slices of its samples (any sample
-// may start one: the device's film is exact) merge to the one-run image's bits.
-TEST(BdptCli, SplitAndMergedOnVulkan) {
+// On the command line: bdpt renders with --backend vulkan, slices of its samples (any sample
+// may start one: the device's film is exact) merge to the one-run image's bits, and a slice's
+// checkpoint resumed to the whole gives them too.
+TEST(BdptCli, SplitMergedAndResumedOnVulkan) {
   test::TempDir dir;
   const std::string render = "render " + (test::kConfigs / "cornell-box.json").string() +
                              " --backend vulkan --integrator bdpt --max-depth 4 --width 16 "
@@ -174,10 +175,19 @@ TEST(BdptCli, SplitAndMergedOnVulkan) {
       test::runPt("merge " + (dir / "b.ptstate").string() + " " + (dir / "c.ptstate").string() +
                   " --out " + (dir / "merged.exr").string());
   ASSERT_EQ(merged.status, 0) << merged.err;
+  // The first slice's state continued to three samples.
+  const test::PtResult resumed =
+      test::runPt(render + "--samples 0:3 --resume " + (dir / "b.ptstate").string() + " --out " +
+                  (dir / "resumed.exr").string());
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_NE(resumed.err.find("1 of 3 samples per pixel done"), std::string::npos) << resumed.err;
   const Image x = readImage(dir / "one.exr");
-  const Image y = readImage(dir / "merged.exr");
-  ASSERT_EQ(x.pixels.size(), y.pixels.size());
-  EXPECT_EQ(std::memcmp(x.pixels.data(), y.pixels.data(), x.pixels.size() * sizeof(vec3)), 0);
+  for (const char* name : {"merged.exr", "resumed.exr"}) {
+    const Image y = readImage(dir / name);
+    ASSERT_EQ(x.pixels.size(), y.pixels.size());
+    EXPECT_EQ(std::memcmp(x.pixels.data(), y.pixels.data(), x.pixels.size() * sizeof(vec3)), 0)
+        << name;
+  }
 }
 
 }  // namespace
