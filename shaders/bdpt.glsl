@@ -105,28 +105,18 @@ void bdptMain() {
   uint maxDepth = min(params.maxDepth, kBdptMaxDepth);
   gTruncated = false;
 
-  // The subpaths' first vertices: the camera's, and a light's emission.
-  CameraSample cs = cameraSampleOf(params.camera, sobol, filmPixel, sampleIndex, seed);
-  cameraPath.v[0] = bdptCameraVertex(params.camera, cs.lensOffset, vec3(1.0),
-                                     VertexKey(filmPixel, sampleIndex, kDimPixel));
+  // The subpaths' first vertices, the camera's and a light's emission, and their random walks,
+  // the camera's then the light's, from one call site.
+  BdptStarts starts = bdptStarts(sobol, filmPixel, sampleIndex, seed);
+  BdptLightStart start = starts.light;
+  cameraPath.v[0] = starts.cameraVertex;
   cameraPath.count = 1u;
-  uint lightDim = bdptLightDim(0u);
-  BdptLightStart start = sampleBdptLightStart(
-      random2(sobol, filmPixel, sampleIndex, lightDim + kDimLightChoose, seed),
-      random2(sobol, filmPixel, sampleIndex, lightDim + kDimLightPoint, seed),
-      random2(sobol, filmPixel, sampleIndex, lightDim + kDimBsdf, seed),
-      VertexKey(filmPixel, sampleIndex, lightDim));
   lightPath.v[0] = start.vertex;
   lightPath.count = start.found ? 1u : 0u;
-  // Their random walks, the camera's then the light's, from one call site.
   for (uint side = 0u; side < 2u && (side == 0u || start.found); ++side) {
     bool radiance = side == 0u;
-    BdptWalk walk =
-        radiance ? BdptWalk(cs.origin, cs.direction, vec3(1.0),
-                            cameraDirectionPdf(params.camera, cs.lensOffset, cs.direction))
-                 : BdptWalk(start.origin, start.direction, start.beta, start.pdfDir);
-    bdptRandomWalk(radiance, walk, radiance ? maxDepth + 2u : maxDepth + 1u, filmPixel,
-                   sampleIndex);
+    bdptRandomWalk(radiance, radiance ? starts.cameraWalk : bdptLightWalk(start),
+                   radiance ? maxDepth + 2u : maxDepth + 1u, filmPixel, sampleIndex);
   }
   if (start.found && bdptIsInfiniteLight(start.vertex)) {
     BdptVertex first = lightPath.v[0];
@@ -156,7 +146,8 @@ void bdptMain() {
         HitData blocker;
         if (bdptTrace(c.from, c.to - c.from, 1.0, /*anyHit=*/true, blocker)) continue;
       }
-      vec3 value = bdptStrategyL(c, t, cs.weight) * bdptStrategyWeight(c, s, t, weighed);
+      vec3 value =
+          bdptStrategyL(c, t, starts.camera.weight) * bdptStrategyWeight(c, s, t, weighed);
       if (t != 1u) {
         L += value;
         continue;

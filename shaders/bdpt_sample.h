@@ -9,6 +9,7 @@
 
 #include "bdpt_connect.h"
 #include "bdpt_vertex.h"
+#include "filter.h"
 #include "path_vertex.h"
 #include "sampling.h"
 #include "shared_types.h"
@@ -25,6 +26,48 @@ struct BdptWalk {
   vec3 beta;
   float pdf;
 };
+
+// The starts of a pixel sample's two subpaths (film pixel `pixel`): the camera sample (its ray
+// through a point of the pixel's filter and of the lens, its filter weight), the camera's vertex
+// and the walk that leaves it; a light's emission (pbrt-v4's GenerateCameraSubpath and
+// GenerateLightSubpath before their walks), with the light subpath's first dimensions.
+struct BdptStarts {
+  CameraSample camera;
+  BdptVertex cameraVertex;
+  BdptWalk cameraWalk;
+  BdptLightStart light;
+};
+
+PT_INLINE BdptStarts bdptStarts(PT_SCENE_PARAM bool sobol, uvec2 pixel, uint sampleIndex,
+                                uint seed) {
+  BdptStarts b;
+  VertexKey key;
+  key.pixel = pixel;
+  key.sampleIndex = sampleIndex;
+  key.dim = kDimPixel;
+  b.camera = cameraSampleOf(PT_PARAMS.camera, sobol, pixel, sampleIndex, seed);
+  b.cameraVertex = bdptCameraVertex(PT_PARAMS.camera, b.camera.lensOffset, vec3(1.0f), key);
+  b.cameraWalk.origin = b.camera.origin;
+  b.cameraWalk.direction = b.camera.direction;
+  b.cameraWalk.beta = vec3(1.0f);
+  b.cameraWalk.pdf = cameraDirectionPdf(PT_PARAMS.camera, b.camera.lensOffset, b.camera.direction);
+  key.dim = bdptLightDim(0u);
+  b.light = sampleBdptLightStart(
+      PT_SCENE_ARG random2(sobol, pixel, sampleIndex, key.dim + kDimLightChoose, seed),
+      random2(sobol, pixel, sampleIndex, key.dim + kDimLightPoint, seed),
+      random2(sobol, pixel, sampleIndex, key.dim + kDimBsdf, seed), key);
+  return b;
+}
+
+// The walk that leaves a light subpath's start.
+PT_INLINE BdptWalk bdptLightWalk(PT_IN(BdptLightStart) start) {
+  BdptWalk w;
+  w.origin = start.origin;
+  w.direction = start.direction;
+  w.beta = start.beta;
+  w.pdf = start.pdfDir;
+  return w;
+}
 
 // The walk's ray found shading point s (on a triangle of emitter `emitter`): its vertex v, made
 // from prev, whose reverse density the step sets (pbrt-v4's RandomWalk after the intersection).

@@ -113,35 +113,25 @@ float bdptSubpaths(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInde
   const PathScene ps = scene.pathScene();
   const uvec2 pixel = imagePixel + uvec2(params.camera.cropX, params.camera.cropY);
   const bool sobol = params.samplerType == kSamplerSobol;
-  const uint seed = params.seed;
+  const BdptStarts starts = bdptStarts(ps, sobol, pixel, sampleIndex, params.seed);
 
-  // The camera subpath: the camera ray through a point of the pixel (and of the lens), then
-  // the random walk, up to maxDepth + 2 vertices.
-  const CameraSample cs = cameraSampleOf(params.camera, sobol, pixel, sampleIndex, seed);
-  camera.v[0] = bdptCameraVertex(params.camera, cs.lensOffset, vec3(1.0f),
-                                 VertexKey{pixel, sampleIndex, kDimPixel});
+  // The camera subpath: the camera's vertex, then the random walk, up to maxDepth + 2 vertices.
+  camera.v[0] = starts.cameraVertex;
   camera.count = 1;
-  bdptRandomWalk(scene, ps, camera,
-                 BdptWalk{cs.origin, cs.direction, vec3(1.0f),
-                          cameraDirectionPdf(params.camera, cs.lensOffset, cs.direction)},
-                 maxDepth + 2u, /*radiance=*/true, pixel, sampleIndex, rays);
+  bdptRandomWalk(scene, ps, camera, starts.cameraWalk, maxDepth + 2u, /*radiance=*/true, pixel,
+                 sampleIndex, rays);
 
   // The light subpath: a light's emission, then the random walk, up to maxDepth + 1 vertices.
   light.count = 0;
-  {
-    const VertexKey key{pixel, sampleIndex, bdptLightDim(0)};
-    const BounceRandom u = bounceRandomSimd(sobol, pixel, sampleIndex, key.dim, seed);
-    const BdptLightStart start = sampleBdptLightStart(ps, u.lightChoose, u.lightPoint, u.bsdf, key);
-    if (start.found) {
-      light.v[0] = start.vertex;
-      light.count = 1;
-      bdptRandomWalk(scene, ps, light,
-                     BdptWalk{start.origin, start.direction, start.beta, start.pdfDir},
-                     maxDepth + 1u, /*radiance=*/false, pixel, sampleIndex, rays);
-      bdptCorrectInfiniteStart(ps, light.v[0], light.v[1], light.count, start.pdfPos);
-    }
+  const BdptLightStart& start = starts.light;
+  if (start.found) {
+    light.v[0] = start.vertex;
+    light.count = 1;
+    bdptRandomWalk(scene, ps, light, bdptLightWalk(start), maxDepth + 1u, /*radiance=*/false, pixel,
+                   sampleIndex, rays);
+    bdptCorrectInfiniteStart(ps, light.v[0], light.v[1], light.count, start.pdfPos);
   }
-  return cs.weight;
+  return starts.camera.weight;
 }
 
 void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
