@@ -4,7 +4,9 @@
 // its steps at a path vertex are path_vertex.h's, which the CPU calls too, as it shares the
 // layouts (shared_types.h), random numbers (sampling.h), BSDFs (bsdf.h), lights and textures.
 // What is this file's own: the traversal (bvh.glsl), the exact retrace of rays the fast test
-// gave up on, the path regeneration loop, lavapipe's loop cap, and the accumulation.
+// gave up on, the path regeneration loop, lavapipe's loop cap, and the accumulation. The other
+// integrators' variants replace main: SPPM's passes (sppm.glsl) and bidirectional path tracing
+// (PT_BDPT, bdpt.glsl).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #ifdef PT_DEBUG_PRINTF
