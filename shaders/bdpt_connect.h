@@ -11,6 +11,10 @@
 // the same path, computed by pbrt-v4's recursion over the ratios of each vertex's two
 // densities; pbrt-v4 uses the balance heuristic (exponent 1) there. Delta vertices (specular
 // bounces, delta lights) are skipped as pbrt-v4 skips them, and their zero densities count as 1.
+//
+// Where a vertex index would be below 0 for a strategy that does not read it (t - 2 for t = 1,
+// say), it is clamped to 0 (max(t, 2u) - 2u): lavapipe runs both sides of a branch and both
+// operands of a selection, and would read outside the subpath's array.
 #ifndef PT_BDPT_CONNECT_H
 #define PT_BDPT_CONNECT_H
 
@@ -22,6 +26,12 @@
 
 #ifdef __cplusplus
 namespace pt {
+#endif
+
+#ifndef __cplusplus
+// The shader's two subpaths (PT_BDPT_PATHS_PARAM): one pixel sample's, per invocation.
+BdptPath lightPath;
+BdptPath cameraPath;
 #endif
 
 // One connection before its shadow ray: the path's contribution without its MIS weight, given
@@ -119,22 +129,22 @@ PT_INLINE BdptConnection bdptSampleLightFrom(PT_SCENE_PARAM PT_IN(BdptVertex) pt
   return c;
 }
 
-// Strategy (s, t) for the subpaths `light` and `camera` (s <= light.count, 1 <= t <=
-// camera.count, not s = t = 1): the contribution before its weight and shadow ray.
+// Strategy (s, t) for the subpaths lightPath and cameraPath (s <= lightPath.count, 1 <= t <=
+// cameraPath.count, not s = t = 1): the contribution before its weight and shadow ray.
 // uChoose, uLight: the numbers of the light sample (s = 1) or the lens point (t = 1, .. uLight).
-PT_INLINE BdptConnection bdptConnect(PT_SCENE_PARAM PT_IN(BdptPath) light, PT_IN(BdptPath) camera,
-                                     uint s, uint t, vec2 uChoose, vec2 uLight) {
-  BdptVertex pt = camera.v[t - 1u];
+PT_INLINE BdptConnection bdptConnect(PT_SCENE_PARAM PT_BDPT_PATHS_PARAM uint s, uint t,
+                                     vec2 uChoose, vec2 uLight) {
+  BdptVertex pt = cameraPath.v[t - 1u];
   BdptConnection c = noBdptConnection(pt);
   // A camera subpath that left the scene ends at the infinite light: only s = 0 takes it.
   if (t > 1u && s != 0u && pt.type == kBdptLight) return c;
   if (s == 0u) {
     // The camera subpath as a whole path: the light its last vertex emits.
     if (!bdptIsLight(pt)) return c;
-    c.L = bdptLe(PT_SCENE_ARG pt, camera.v[t - 2u]) * pt.beta;
+    c.L = bdptLe(PT_SCENE_ARG pt, cameraPath.v[max(t, 2u) - 2u]) * pt.beta;
   } else if (t == 1u) {
     // A point on the lens seen from the light subpath's last vertex (light tracing).
-    BdptVertex qs = light.v[s - 1u];
+    BdptVertex qs = lightPath.v[max(s, 1u) - 1u];
     if (!bdptIsConnectible(qs)) return c;
     CameraWiSample cs = sampleCameraWi(PT_PARAMS.camera, qs.p, uLight);
     if (!cs.found) return c;
@@ -151,7 +161,7 @@ PT_INLINE BdptConnection bdptConnect(PT_SCENE_PARAM PT_IN(BdptPath) light, PT_IN
     return bdptSampleLightFrom(PT_SCENE_ARG pt, uChoose, uLight);
   } else {
     // A segment between the two subpaths' last vertices.
-    BdptVertex qs = light.v[s - 1u];
+    BdptVertex qs = lightPath.v[max(s, 1u) - 1u];
     if (!bdptIsConnectible(qs) || !bdptIsConnectible(pt)) return c;
     vec3 d = qs.p - pt.p;
     float dist2 = dot(d, d);
@@ -188,14 +198,12 @@ struct BdptConnectionDensities {
 };
 
 // pt, qs: the connection's vertices (the sampled one where s or t is 1).
-PT_INLINE BdptConnectionDensities bdptConnectionDensities(PT_SCENE_PARAM PT_IN(BdptPath) light,
-                                                          PT_IN(BdptPath) camera,
-                                                          PT_IN(BdptVertex) pt,
-                                                          PT_IN(BdptVertex) qs, uint s, uint t) {
+PT_INLINE BdptConnectionDensities bdptConnectionDensities(
+    PT_SCENE_PARAM PT_BDPT_PATHS_PARAM PT_IN(BdptVertex) pt, PT_IN(BdptVertex) qs, uint s, uint t) {
   BdptConnectionDensities r = BdptConnectionDensities(0.0f, 0.0f, 0.0f, 0.0f);
   // The predecessors (unused where they do not exist: any vertex stands in).
-  BdptVertex ptMinus = t > 1u ? camera.v[t - 2u] : pt;
-  BdptVertex qsMinus = s > 1u ? light.v[s - 2u] : qs;
+  BdptVertex ptMinus = t > 1u ? cameraPath.v[max(t, 2u) - 2u] : pt;
+  BdptVertex qsMinus = s > 1u ? lightPath.v[max(s, 2u) - 2u] : qs;
   if (s > 0u) {
     r.ptRev = bdptPdf(PT_SCENE_ARG qsMinus, qs, pt);
     if (t > 1u) r.ptMinusRev = bdptPdf(PT_SCENE_ARG qs, pt, ptMinus);
@@ -212,32 +220,32 @@ PT_INLINE BdptConnectionDensities bdptConnectionDensities(PT_SCENE_PARAM PT_IN(B
 // The power heuristic's weight of strategy (s, t) against every other strategy that could
 // have sampled the same path (pbrt-v4's MISWeight): 1 / (1 + sum of the other strategies'
 // density ratios, squared). `sampled`: the vertex strategy s = 1 or t = 1 sampled.
-PT_INLINE float bdptMisWeight(PT_SCENE_PARAM PT_IN(BdptPath) light, PT_IN(BdptPath) camera,
-                              PT_IN(BdptVertex) sampled, uint s, uint t) {
+PT_INLINE float bdptMisWeight(PT_SCENE_PARAM PT_BDPT_PATHS_PARAM PT_IN(BdptVertex) sampled, uint s,
+                              uint t) {
   if (s + t == 2u) return 1.0f;
-  BdptVertex pt = t == 1u ? sampled : camera.v[t - 1u];
-  BdptVertex qs = s == 1u ? sampled : (s > 0u ? light.v[s - 1u] : pt);
-  BdptConnectionDensities d = bdptConnectionDensities(PT_SCENE_ARG light, camera, pt, qs, s, t);
+  BdptVertex pt = t == 1u ? sampled : cameraPath.v[t - 1u];
+  BdptVertex qs = s == 1u ? sampled : (s > 0u ? lightPath.v[max(s, 1u) - 1u] : pt);
+  BdptConnectionDensities d = bdptConnectionDensities(PT_SCENE_ARG PT_BDPT_PATHS_ARG pt, qs, s, t);
   float sumRi = 0.0f;
   // The strategies that take fewer camera vertices (the connection vertices are never delta:
   // a strategy connects only at vertices that are not).
   float ri = 1.0f;
   for (uint i = t - 1u; i > 0u; --i) {
-    float pdfRev = i == t - 1u ? d.ptRev : (i == t - 2u ? d.ptMinusRev : camera.v[i].pdfRev);
-    float pdfFwd = i == t - 1u ? pt.pdfFwd : camera.v[i].pdfFwd;
-    bool delta = i == t - 1u ? false : camera.v[i].delta;
+    float pdfRev = i == t - 1u ? d.ptRev : (i == t - 2u ? d.ptMinusRev : cameraPath.v[i].pdfRev);
+    float pdfFwd = i == t - 1u ? pt.pdfFwd : cameraPath.v[i].pdfFwd;
+    bool delta = i == t - 1u ? false : cameraPath.v[i].delta;
     ri *= bdptMisRatio(pdfRev, pdfFwd);
-    if (!delta && !camera.v[i - 1u].delta) sumRi += ri;
+    if (!delta && !cameraPath.v[i - 1u].delta) sumRi += ri;
   }
   // Those that take fewer light vertices.
   ri = 1.0f;
   for (uint j = s; j > 0u; --j) {
     uint i = j - 1u;
-    float pdfRev = i == s - 1u ? d.qsRev : (i == s - 2u ? d.qsMinusRev : light.v[i].pdfRev);
-    float pdfFwd = i == s - 1u ? qs.pdfFwd : light.v[i].pdfFwd;
-    bool delta = i == s - 1u ? false : light.v[i].delta;
-    bool deltaBefore =
-        i > 0u ? light.v[i - 1u].delta : bdptIsDeltaLight(i == s - 1u ? qs : light.v[0]);
+    float pdfRev = i == s - 1u ? d.qsRev : (i == s - 2u ? d.qsMinusRev : lightPath.v[i].pdfRev);
+    float pdfFwd = i == s - 1u ? qs.pdfFwd : lightPath.v[i].pdfFwd;
+    bool delta = i == s - 1u ? false : lightPath.v[i].delta;
+    bool deltaBefore = i > 0u ? lightPath.v[max(i, 1u) - 1u].delta
+                              : bdptIsDeltaLight(i == s - 1u ? qs : lightPath.v[0]);
     ri *= bdptMisRatio(pdfRev, pdfFwd);
     if (!delta && !deltaBefore) sumRi += ri;
   }

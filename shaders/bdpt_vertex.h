@@ -32,7 +32,13 @@ namespace pt {
 // bound. A camera subpath has up to maxDepth + 2 vertices (the camera's, and one found past the
 // last scattering event), a light subpath up to maxDepth + 1.
 PT_CONST uint kBdptMaxDepth = 32u;
+#ifdef PT_BDPT_MAX_VERTICES
+// The shader's arrays take the scene's maxdepth + 2 vertices (the host defines it): a
+// scene's subpaths never need more, and each invocation holds two of them.
+PT_CONST uint kBdptMaxVertices = PT_BDPT_MAX_VERTICES;
+#else
 PT_CONST uint kBdptMaxVertices = kBdptMaxDepth + 2u;
+#endif
 
 PT_CONST uint kBdptCamera = 0u;   // the camera's lens point (the pinhole)
 PT_CONST uint kBdptLight = 1u;    // a light's point, or a direction at infinity
@@ -71,6 +77,28 @@ struct BdptPath {
   BdptVertex v[kBdptMaxVertices];
   uint count;
 };
+
+// The two subpaths of a pixel sample, as the functions that read them both take them: const
+// references in C++; in GLSL, which would copy arrays passed by value at every call, the
+// shader's globals lightPath and cameraPath (shaders/bdpt.glsl).
+#ifdef __cplusplus
+#define PT_BDPT_PATHS_PARAM const BdptPath &lightPath, const BdptPath &cameraPath,
+#define PT_BDPT_PATHS_ARG lightPath, cameraPath,
+#else
+#define PT_BDPT_PATHS_PARAM
+#define PT_BDPT_PATHS_ARG
+#endif
+
+// The random-number dimension of camera subpath vertex k >= 1: the path tracer's scattering
+// event k - 1, so that strategy (1, t) draws its light sample with the numbers the path
+// tracer's light sample at the same vertex draws. Light subpath vertex j: kDimLightSubpath
+// onwards.
+PT_INLINE uint bdptCameraDim(uint k) {
+  return kDimFirstBounce + kDimsPerBounce * (k - 1u);
+}
+PT_INLINE uint bdptLightDim(uint j) {
+  return kDimLightSubpath + kDimsPerBounce * j;
+}
 
 PT_INLINE bool bdptOnSurface(PT_IN(BdptVertex) v) {
   return v.ng != vec3(0.0f);
@@ -437,15 +465,17 @@ PT_INLINE BdptLightStart sampleBdptLightStart(PT_SCENE_PARAM vec2 uChoose, vec2 
 // Where the light subpath starts at infinity, pbrt-v4 corrects its first two densities once
 // the walk is done: its second vertex's is the disk point's density projected onto the surface
 // there, its first the solid-angle density of its direction (that light sampling from a point
-// of the scene would have).
-PT_INLINE void bdptCorrectInfiniteStart(PT_SCENE_PARAM PT_INOUT(BdptPath) path, float pdfPos) {
-  if (!bdptIsInfiniteLight(path.v[0])) return;
-  if (path.count > 1u) {
-    path.v[1].pdfFwd = pdfPos;
-    if (bdptOnSurface(path.v[1])) path.v[1].pdfFwd *= abs(dot(path.v[0].w, path.v[1].ng));
+// of the scene would have). first, second: the subpath's first two vertices (second only where
+// `count`, the subpath's vertices, is above 1). Vertices, not the subpath: GLSL would copy it.
+PT_INLINE void bdptCorrectInfiniteStart(PT_SCENE_PARAM PT_INOUT(BdptVertex) first,
+                                        PT_INOUT(BdptVertex) second, uint count, float pdfPos) {
+  if (!bdptIsInfiniteLight(first)) return;
+  if (count > 1u) {
+    second.pdfFwd = pdfPos;
+    if (bdptOnSurface(second)) second.pdfFwd *= abs(dot(first.w, second.ng));
   }
   // (Its direction alone matters: any vertex will do as the one it is seen from.)
-  path.v[0].pdfFwd = bdptPdfLightOrigin(PT_SCENE_ARG path.v[0], path.v[0]);
+  first.pdfFwd = bdptPdfLightOrigin(PT_SCENE_ARG first, first);
 }
 
 // ---- The random walk ----------------------------------------------------------------------------

@@ -4,13 +4,15 @@
 // its steps at a path vertex are path_vertex.h's, which the CPU calls too, as it shares the
 // layouts (shared_types.h), random numbers (sampling.h), BSDFs (bsdf.h), lights and textures.
 // What is this file's own: the traversal (bvh.glsl), the exact retrace of rays the fast test
-// gave up on, the path regeneration loop, lavapipe's loop cap, and the accumulation.
+// gave up on, the path regeneration loop, lavapipe's loop cap, and the accumulation. The other
+// integrators' variants replace main: SPPM's passes (sppm.glsl) and bidirectional path tracing
+// (PT_BDPT, bdpt.glsl).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #ifdef PT_DEBUG_PRINTF
 #extension GL_EXT_debug_printf : enable
 #endif
-#ifdef PT_SPPM_PHOTONS
+#if defined(PT_SPPM_PHOTONS) || defined(PT_BDPT)
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
 #endif
@@ -381,8 +383,7 @@ MediumInterface loadMediumInterface(uint primitive) {
 #endif
 #if defined(PT_CHECK_LIGHT_PATHS) || defined(PT_SPPM)
 // The headers of bidirectional path tracing and photon mapping (docs/bdpt.md, docs/sppm.md):
-// SPPM's passes call them; the build also compiles them all here, every effect on, so that
-// BDPT's stay GLSL.
+// SPPM's passes call them; the build also compiles them all here, every effect on.
 #include "bdpt_camera.h"
 #include "bdpt_connect.h"
 #include "bdpt_vertex.h"
@@ -390,6 +391,13 @@ MediumInterface loadMediumInterface(uint primitive) {
 #endif
 #ifdef PT_SPPM
 #include "sppm.glsl"
+#endif
+#ifdef PT_BDPT
+#include "bdpt_connect.h"
+#include "bdpt_sample.h"
+#include "bdpt_splat.h"
+#include "bdpt_vertex.h"
+#include "bdpt.glsl"
 #endif
 
 // A ray whose first traversal gave up at an edge function of exactly zero (traceRayWith in
@@ -606,6 +614,10 @@ bool extendPath(inout Path path, uvec2 pixel, inout Retrace retrace) {
 #ifdef PT_SPPM_PHOTONS
 void main() {
   sppmTracePhotons();
+}
+#elif defined(PT_BDPT)
+void main() {
+  bdptMain();
 }
 #else
 void main() {

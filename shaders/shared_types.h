@@ -622,6 +622,14 @@ PT_CONST uint kEnvironmentLatLong = 1u;  // equirectangular: u = phi / 2 pi, v =
 #define PT_SPPM_FLUX_WORDS 16u
 #define PT_SPPM_COUNT_WORD 15u
 #define PT_SPPM_INVALID_SHIFT 40u
+// Bidirectional path tracing's pass (shaders/bdpt.glsl) binds its film besides: per pixel, the
+// exact sums of what its samples and the splats that land on it add (red, green, blue: five
+// limbs each, exact_sum_atomic.glsl), then its sample count plus 2^PT_BDPT_INVALID_SHIFT for
+// each sample or splat that came out NaN or infinite.
+#define PT_BINDING_BDPT_FILM 18
+#define PT_BDPT_FILM_WORDS 16u
+#define PT_BDPT_COUNT_WORD 15u
+#define PT_BDPT_INVALID_SHIFT 40u
 
 // The one specialization constant: the traversal stack's size, rows of four entries
 // (bvh.glsl), from the tree. The effect set is not specialized but compiled in: the host
@@ -642,7 +650,7 @@ struct PassConstants {
   uint sampleIndex;  // 4 bytes: the first sample index of this dispatch
   uint sampleCount;  // 4 bytes: samples per pixel in this dispatch, indices sampleIndex + i
   uint debugPixel;   // 4 bytes: y * width + x of the pixel whose path is printed, or ~0u
-  uint reserved;     // 4 bytes
+  uint reserved;     // 4 bytes: SPPM's photons: the first; BDPT: the strategy (bdpt.glsl)
 };                   // 16 bytes
 
 // Per-pixel accumulation on the device, in float; the host folds it into its double

@@ -161,16 +161,11 @@ int runRender(const RenderArgs& args) {
   const SceneData data = prepareScene(std::move(scene), settings);
 
   // The integrators besides the path tracer, for what they render: bidirectional path tracing
-  // (cpu/bdpt.h, the CPU reference's alone) and photon mapping (cpu/sppm.h, vulkan/sppm.h),
-  // whose photons start as BDPT's light subpaths.
+  // (cpu/bdpt.h, vulkan/bdpt.h) and photon mapping (cpu/sppm.h, vulkan/sppm.h), whose photons
+  // start as BDPT's light subpaths.
   const std::optional<BdptStrategy> bdptStrategy = parseBdptStrategy(args.overrides.strategy);
   const std::string integrator(nameOf(kIntegratorNames, data.integrator));
   if (data.integrator != kIntegratorPath) {
-    if (args.backend != "cpu" && data.integrator != kIntegratorSppm) {
-      throw InputError(args.scene + ": the " + integrator +
-                       " integrator runs on the CPU only: its GPU version is not there yet "
-                       "(render with --backend cpu, or --integrator path)");
-    }
     checkBdptScene(data, args.scene, integrator);
     if (!args.debugPixel.empty()) throw InputError("--debug-pixel: the path integrator's only");
   }
@@ -225,7 +220,8 @@ int runRender(const RenderArgs& args) {
   // a slice starts at a batch boundary, or it would not merge to the one-run image's bits.
   const SampleRange job{0, uint32_t(data.spp)};
   SampleRange target = job;
-  const uint32_t unit = onCpu ? 1u : vulkanBatchSize(vulkan);
+  // BDPT's device film is exact, folded whole passes at a time: any sample starts a slice.
+  const uint32_t unit = onCpu || data.integrator == kIntegratorBdpt ? 1u : vulkanBatchSize(vulkan);
   if (sliceArg) {
     target = *sliceArg;
     if (target.first % unit != 0) {
@@ -350,6 +346,7 @@ int runRender(const RenderArgs& args) {
     options.stop = &interrupt.stopFlag();
     options.checkpoint = checkpointDue;
     options.sppmPixels = &state.sppm;
+    if (bdptStrategy) options.bdptStrategy = *bdptStrategy;
     options.openBatch = &carried;
     options.keepOpenBatch = !states.empty();
     VulkanRenderStats gpu = renderVulkan(data, options, state.film);

@@ -83,7 +83,7 @@ inline constexpr NameTable<uint, 3> kStrategyNames{{
 
 // The light transport algorithms (pbrt-v4's Integrator types of the same names).
 inline constexpr uint kIntegratorPath = 0;  // path tracing: light and BSDF sampling, MIS
-inline constexpr uint kIntegratorBdpt = 1;  // bidirectional path tracing (CPU only, docs/bdpt.md)
+inline constexpr uint kIntegratorBdpt = 1;  // bidirectional path tracing (docs/bdpt.md)
 inline constexpr uint kIntegratorSppm = 2;  // stochastic progressive photon mapping (both
                                             // backends, docs/sppm.md): consistent, not unbiased
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bdpt_connect.h"
+#include "bdpt_sample.h"
 #include "bdpt_vertex.h"
 #include "bvh/traverse.h"
 #include "bvh/workers.h"
@@ -23,16 +24,6 @@
 
 namespace pt {
 namespace {
-
-// The random-number dimension of camera subpath vertex k >= 1: the path tracer's scattering
-// event k - 1, so that strategy (1, t) draws its light sample with the numbers the path
-// tracer's light sample at the same vertex draws.
-uint bdptCameraDim(uint k) {
-  return kDimFirstBounce + kDimsPerBounce * (k - 1u);
-}
-uint bdptLightDim(uint j) {
-  return kDimLightSubpath + kDimsPerBounce * j;
-}
 
 // Whether something lies on the segment from `from` to `to` (t in [0, 1)), cut-outs passed by
 // with the number u.
@@ -46,12 +37,12 @@ bool bdptSegmentBlocked(const SceneData& scene, vec3 from, vec3 to, vec2 u) {
   return anyHit(scene.wideBvh(), ray, 1.0f, test, &filter);
 }
 
-// A subpath's random walk from its first vertex (path.count == 1) along `ray`, with throughput
-// beta and the ray's solid-angle density pdf, until it has maxVertices vertices, leaves the
-// scene or is absorbed (pbrt-v4's RandomWalk). A camera subpath (radiance) that leaves the
-// scene ends at the infinite light, where there is one.
-void bdptRandomWalk(const SceneData& scene, const PathScene& ps, BdptPath& path, Ray ray, vec3 beta,
-                    float pdf, uint maxVertices, bool radiance, uvec2 pixel, uint32_t sampleIndex,
+// A subpath's random walk from its first vertex (path.count == 1), until it has maxVertices
+// vertices, leaves the scene or is absorbed (pbrt-v4's RandomWalk; its steps bdpt_sample.h's
+// bdptWalkStep). A camera subpath (radiance) that leaves the scene ends at the infinite light,
+// where there is one.
+void bdptRandomWalk(const SceneData& scene, const PathScene& ps, BdptPath& path, BdptWalk walk,
+                    uint maxVertices, bool radiance, uvec2 pixel, uint32_t sampleIndex,
                     uint64_t& rays) {
   const RenderParams& params = scene.params;
   const bool sobol = params.samplerType == kSamplerSobol;
@@ -62,29 +53,25 @@ void bdptRandomWalk(const SceneData& scene, const PathScene& ps, BdptPath& path,
     const VertexKey key{pixel, sampleIndex, radiance ? bdptCameraDim(k) : bdptLightDim(k)};
     // Find the closest surface along the ray.
     ++rays;
-    const std::optional<Hit> hit = closestSurface(scene, ray, test, pixel, sampleIndex, key.dim);
+    const std::optional<Hit> hit =
+        closestSurface(scene, Ray{walk.origin, walk.direction}, test, pixel, sampleIndex, key.dim);
     if (!hit) {
       if (radiance && params.environmentEmitter != kNoEmitter) {
-        path.v[path.count++] = bdptEnvironmentVertex(ps, ray.origin, ray.direction, beta, pdf, key);
+        path.v[path.count++] =
+            bdptEnvironmentVertex(ps, walk.origin, walk.direction, walk.beta, walk.pdf, key);
       }
       break;
     }
-    // The vertex there, its density converted to the area measure.
     const Triangle& tri = scene.bvh.triangles[hit->triangle];
-    const SurfacePoint s = surfacePointAt(ps, hit->triangle, tri, hit->barycentrics, -ray.direction,
-                                          noRayDifferential());
-    path.v[path.count++] = bdptSurfaceVertex(s, tri.emitter, key, beta, pdf, path.v[k - 1u]);
-    if (path.count >= maxVertices) break;
-
-    // Sample the BSDF for the next direction (the lobe with the roulette dimension's second
-    // number, as the path tracer), and the reverse density at the previous vertex.
-    const BounceRandom u = bounceRandomSimd(sobol, pixel, sampleIndex, key.dim, params.seed);
-    vec3 wi;
-    if (!bdptScatter(ps, path.v[k], path.v[k - 1u], u.roulette.y, u.bsdf, radiance, beta, pdf,
-                     wi)) {
-      break;
-    }
-    ray = Ray{nextRayOrigin(s, wi), wi};
+    const SurfacePoint s = surfacePointAt(ps, hit->triangle, tri, hit->barycentrics,
+                                          -walk.direction, noRayDifferential());
+    const bool last = k + 1u >= maxVertices;
+    const BounceRandom u =
+        last ? BounceRandom{} : bounceRandomSimd(sobol, pixel, sampleIndex, key.dim, params.seed);
+    const bool more = bdptWalkStep(ps, s, tri.emitter, key, last, u.roulette.y, u.bsdf, radiance,
+                                   walk, path.v[k - 1u], path.v[k]);
+    path.count++;
+    if (!more) break;
   }
 }
 
@@ -112,11 +99,12 @@ uint bdptMaxDepth(const SceneData& scene) {
   return std::min(scene.params.maxDepth, kBdptMaxDepth);
 }
 
+float bdptInverseFilterIntegral(const Camera& camera) {
+  return static_cast<float>(1.0 / filterIntegral(camera));
+}
+
 BdptSplatter::BdptSplatter(const Camera& camera)
-    : cam(camera),
-      box(camera.filterType == kFilterBox),
-      boxWeight(1.0f / (4.0f * camera.filterRadiusX * camera.filterRadiusY)),
-      inverseIntegral(static_cast<float>(1.0 / filterIntegral(camera))) {}
+    : cam(camera), scale(bdptSplatScale(camera, bdptInverseFilterIntegral(camera))) {}
 
 float bdptSubpaths(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex, BdptPath& camera,
                    BdptPath& light, uint64_t& rays) {
@@ -125,33 +113,25 @@ float bdptSubpaths(const SceneData& scene, uvec2 imagePixel, uint32_t sampleInde
   const PathScene ps = scene.pathScene();
   const uvec2 pixel = imagePixel + uvec2(params.camera.cropX, params.camera.cropY);
   const bool sobol = params.samplerType == kSamplerSobol;
-  const uint seed = params.seed;
+  const BdptStarts starts = bdptStarts(ps, sobol, pixel, sampleIndex, params.seed);
 
-  // The camera subpath: the camera ray through a point of the pixel (and of the lens), then
-  // the random walk, up to maxDepth + 2 vertices.
-  const CameraSample cs = cameraSampleOf(params.camera, sobol, pixel, sampleIndex, seed);
-  camera.v[0] = bdptCameraVertex(params.camera, cs.lensOffset, vec3(1.0f),
-                                 VertexKey{pixel, sampleIndex, kDimPixel});
+  // The camera subpath: the camera's vertex, then the random walk, up to maxDepth + 2 vertices.
+  camera.v[0] = starts.cameraVertex;
   camera.count = 1;
-  bdptRandomWalk(scene, ps, camera, Ray{cs.origin, cs.direction}, vec3(1.0f),
-                 cameraDirectionPdf(params.camera, cs.lensOffset, cs.direction), maxDepth + 2u,
-                 /*radiance=*/true, pixel, sampleIndex, rays);
+  bdptRandomWalk(scene, ps, camera, starts.cameraWalk, maxDepth + 2u, /*radiance=*/true, pixel,
+                 sampleIndex, rays);
 
   // The light subpath: a light's emission, then the random walk, up to maxDepth + 1 vertices.
   light.count = 0;
-  {
-    const VertexKey key{pixel, sampleIndex, bdptLightDim(0)};
-    const BounceRandom u = bounceRandomSimd(sobol, pixel, sampleIndex, key.dim, seed);
-    const BdptLightStart start = sampleBdptLightStart(ps, u.lightChoose, u.lightPoint, u.bsdf, key);
-    if (start.found) {
-      light.v[0] = start.vertex;
-      light.count = 1;
-      bdptRandomWalk(scene, ps, light, Ray{start.origin, start.direction}, start.beta, start.pdfDir,
-                     maxDepth + 1u, /*radiance=*/false, pixel, sampleIndex, rays);
-      bdptCorrectInfiniteStart(ps, light, start.pdfPos);
-    }
+  const BdptLightStart& start = starts.light;
+  if (start.found) {
+    light.v[0] = start.vertex;
+    light.count = 1;
+    bdptRandomWalk(scene, ps, light, bdptLightWalk(start), maxDepth + 1u, /*radiance=*/false, pixel,
+                   sampleIndex, rays);
+    bdptCorrectInfiniteStart(ps, light.v[0], light.v[1], light.count, start.pdfPos);
   }
-  return cs.weight;
+  return starts.camera.weight;
 }
 
 void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
@@ -170,35 +150,20 @@ void bdptSample(const SceneData& scene, uvec2 imagePixel, uint32_t sampleIndex,
   // MIS weight.
   for (uint t = 1; t <= camera.count; ++t) {
     for (uint s = 0; s <= light.count; ++s) {
-      const int depth = int(s + t) - 2;
-      if ((s == 1 && t == 1) || depth < 0 || depth > int(maxDepth)) continue;
-      if (!strategy.all() && (int(s) != strategy.s || int(t) != strategy.t)) continue;
-      // The light sample of s = 1 takes the numbers of camera vertex t - 1's light sample; the
-      // lens point of t = 1 those of light vertex s - 1's (a pinhole needs none).
-      vec2 uChoose(0.0f), uLight(0.0f);
-      if (s == 1) {
-        const BounceRandom u =
-            bounceRandomSimd(sobol, pixel, sampleIndex, bdptCameraDim(t - 1), params.seed);
-        uChoose = u.lightChoose;
-        uLight = u.lightPoint;
-      } else if (t == 1 && params.camera.lensRadius > 0.0f) {
-        uLight =
-            random2(sobol, pixel, sampleIndex, bdptLightDim(s - 1) + kDimLightPoint, params.seed);
-      }
-      const BdptConnection c = bdptConnect(ps, light, camera, s, t, uChoose, uLight);
+      if (!bdptTakesStrategy(s, t, maxDepth, strategy.s, strategy.t)) continue;
+      const BdptStrategyRandom u = bdptStrategyRandom(sobol, pixel, sampleIndex, params.seed,
+                                                      params.camera.lensRadius, s, t);
+      const BdptConnection c = bdptConnect(ps, light, camera, s, t, u.uChoose, u.uLight);
       if (!c.found) continue;
       if (c.visibility) {
         ++rays;
-        if (bdptSegmentBlocked(scene, c.from, c.to, uLight)) continue;
+        if (bdptSegmentBlocked(scene, c.from, c.to, u.uLight)) continue;
       }
       BdptContribution out;
       out.s = int(s);
       out.t = int(t);
-      // The camera's strategies carry its sample's filter weight (filter.h: 1 but for
-      // mitchell's negative lobes), as the path tracer's samples do; splats take the filter's
-      // value where they land instead (BdptSplatter).
-      out.L = t == 1 ? c.L : c.L * filterWeight;
-      out.weight = strategy.all() ? bdptMisWeight(ps, light, camera, c.sampled, s, t) : 1.0f;
+      out.L = bdptStrategyL(c, t, filterWeight);
+      out.weight = bdptStrategyWeight(ps, light, camera, c, s, t, strategy.all());
       out.splat = t == 1;
       out.filmPoint = c.filmPoint;
       sink(out);

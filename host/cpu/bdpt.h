@@ -10,6 +10,7 @@
 #include <functional>
 #include <string>
 
+#include "bdpt_splat.h"
 #include "bdpt_vertex.h"
 #include "cpu/integrator.h"
 #include "image/image.h"
@@ -40,12 +41,8 @@ struct BdptContribution {
   vec2 filmPoint{0.0f};
 };
 
-// How a light-tracing splat at a film point spreads over the image's pixels (pbrt-v4's
-// RGBFilm::AddSplat and GetPixelRGB): every pixel whose filter reaches the point takes it
-// weighed by the filter's value at (point - the pixel's centre) over the filter's integral
-// (filter.h's filterValue, camera_filter.h's filterIntegral). The box keeps the half-open
-// square [c - r, c + r) about each centre c, so that a point on the border between pixels
-// lands in one of them, with the weight 1 / (4 rx ry).
+// How a light-tracing splat at a film point spreads over the image's pixels: bdpt_splat.h's
+// footprint and weights, over the image (the crop's pixels).
 struct BdptSplatter {
   explicit BdptSplatter(const Camera& camera);
 
@@ -53,41 +50,25 @@ struct BdptSplatter {
   // (the whole film's coordinates).
   template <typename F>
   void forPixels(vec2 filmPoint, F&& f) const {
-    const float rx = cam.filterRadiusX;
-    const float ry = cam.filterRadiusY;
-    int x0, x1, y0, y1;  // film pixels, inclusive
-    if (box) {
-      x0 = int(std::floor(filmPoint.x - rx - 0.5f)) + 1;
-      x1 = int(std::floor(filmPoint.x + rx - 0.5f));
-      y0 = int(std::floor(filmPoint.y - ry - 0.5f)) + 1;
-      y1 = int(std::floor(filmPoint.y + ry - 0.5f));
-    } else {
-      x0 = int(std::ceil(filmPoint.x - rx - 0.5f));
-      x1 = int(std::floor(filmPoint.x + rx - 0.5f));
-      y0 = int(std::ceil(filmPoint.y - ry - 0.5f));
-      y1 = int(std::floor(filmPoint.y + ry - 0.5f));
-    }
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) {
+    const BdptSplatPixels p = bdptSplatPixels(cam, filmPoint);
+    for (int y = p.low.y; y <= p.high.y; ++y) {
+      for (int x = p.low.x; x <= p.high.x; ++x) {
         const int ix = x - int(cam.cropX);
         const int iy = y - int(cam.cropY);
         if (ix < 0 || iy < 0 || ix >= int(cam.width) || iy >= int(cam.height)) continue;
-        if (box) {
-          f(ix, iy, boxWeight);
-          continue;
-        }
-        const float w =
-            filterValue(cam, filmPoint - vec2(float(x) + 0.5f, float(y) + 0.5f)) * inverseIntegral;
+        const float w = bdptSplatWeight(cam, scale, filmPoint, x, y);
         if (w != 0.0f) f(ix, iy, w);
       }
     }
   }
 
   const Camera& cam;
-  bool box;
-  float boxWeight;        // 1 / (4 rx ry), as float
-  float inverseIntegral;  // 1 / filterIntegral
+  float scale;  // bdptSplatScale
 };
+
+// 1 / the camera's filter's integral (camera_filter.h), rounded to float: what bdptSplatScale
+// takes.
+float bdptInverseFilterIntegral(const Camera& camera);
 
 // Traces the camera and light subpaths of pixel sample (pixel, sampleIndex) of the image (the
 // crop's pixel); returns the camera sample's filter weight (filter.h's FilmSample::weight),

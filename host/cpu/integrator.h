@@ -22,18 +22,8 @@
 
 namespace pt {
 
-// One strategy of bidirectional path tracing rendered alone, without its MIS weight (pbrt-v4's
-// visualizestrategies, for debugging; cpu/bdpt.h): s light vertices joined to t camera vertices.
-// Unset (-1): all of them, weighed.
-struct BdptStrategy {
-  int s = -1;
-  int t = -1;
-  bool all() const { return s < 0; }
-};
-
 struct CpuRenderOptions : RenderOptions {
-  int threads = 0;            // 0: every CPU this process may run on (its affinity mask)
-  BdptStrategy bdptStrategy;  // scenes rendered with kIntegratorBdpt
+  int threads = 0;  // 0: every CPU this process may run on (its affinity mask)
 };
 
 struct CpuRenderStats : RenderStats {

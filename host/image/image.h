@@ -177,6 +177,15 @@ struct Film {
     invalidCount[i] += invalid;
   }
 
+  // Adds pixel i's sums summed exactly elsewhere (the Vulkan backend's BDPT film: its samples
+  // and splats), with `valid` samples and `invalid` NaN or infinite samples or splats.
+  void addExactSums(size_t i, const std::array<ExactSum, 3>& sums, uint64_t valid,
+                    uint64_t invalid) {
+    for (int c = 0; c < 3; ++c) exact[i][c].add(sums[c]);
+    sampleCount[i] += valid;
+    invalidCount[i] += invalid;
+  }
+
   // Adds other's samples (sizes must match, PT_CHECK). Exact: merging in any order gives the
   // same film.
   void merge(const Film& other);

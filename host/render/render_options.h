@@ -11,6 +11,15 @@
 
 namespace pt {
 
+// One strategy of bidirectional path tracing rendered alone, without its MIS weight (pbrt-v4's
+// visualizestrategies, for debugging; cpu/bdpt.h): s light vertices joined to t camera vertices.
+// Unset (-1): all of them, weighed.
+struct BdptStrategy {
+  int s = -1;
+  int t = -1;
+  bool all() const { return s < 0; }
+};
+
 struct RenderOptions {
   uint32_t firstSample = 0;  // sample indices [firstSample, firstSample + spp) are taken
   int spp = 1;
@@ -30,6 +39,7 @@ struct RenderOptions {
   // whole iteration (at every checkpoint call too, when the film holds that iteration's
   // estimate).
   SppmPixels* sppmPixels = nullptr;
+  BdptStrategy bdptStrategy;  // scenes rendered with kIntegratorBdpt
 };
 
 struct RenderStats {

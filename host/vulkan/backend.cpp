@@ -11,6 +11,7 @@
 #include <cstring>
 
 #include "common/check.h"
+#include "vulkan/bdpt.h"
 #include "vulkan/context.h"
 #include "vulkan/device_limits.h"
 #include "vulkan/glsl_compiler.h"
@@ -119,6 +120,31 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
   buffers.readback =
       makeBuffer(ctx, buffers.accumSize + sizeof(DeviceCounters), U::eTransferDst, true);
   return buffers;
+}
+
+namespace {
+
+ContextOptions withInt64Atomics(ContextOptions options) {
+  options.int64Atomics = true;
+  return options;
+}
+
+}  // namespace
+
+ExactSumDeviceScene::ExactSumDeviceScene(const ContextOptions& options, const SceneData& scene)
+    : ctx(withInt64Atomics(options)), commands(ctx) {
+  commands.begin();
+  buffers = uploadScene(ctx, scene, commands.cmd, staging);
+}
+
+void finishExactSumStats(const ExactSumDeviceScene& device, const Film& film, int samplesDone,
+                         std::chrono::steady_clock::time_point callStart,
+                         VulkanRenderStats& stats) {
+  stats.samplesDone = samplesDone;
+  stats.invalidSamples = film.totalInvalid();
+  stats.validationErrors = device.ctx.validationErrors();
+  stats.wallSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - callStart).count();
 }
 
 // ---- Pipeline: shaders/pathtrace.comp compiled for the scene's effect set -----------------
@@ -335,8 +361,8 @@ std::string pathtraceDefinitions(const SceneData& scene, const VulkanRenderOptio
   // analytic lights, the pixel filters other than the box and the thin lens take the variant
   // without those (PT_NO_BSDF_MATERIALS: the same image).
   const Camera& camera = scene.params.camera;
-  // SPPM's passes call BDPT's light start, which reads the analytic lights.
-  const bool full = all || scene.integrator == kIntegratorSppm || fx.hasBsdfMaterials() ||
+  // SPPM's passes call BDPT's light start, which reads the analytic lights, as BDPT does.
+  const bool full = all || scene.integrator != kIntegratorPath || fx.hasBsdfMaterials() ||
                     fx.shadingNormals || fx.deltaLights || fx.environment || fx.twoSidedEmitters ||
                     fx.sphereLights || fx.textures || fx.alphaCutouts || fx.bumpMaps ||
                     camera.filterType != kFilterBox || camera.lensRadius > 0.0f;
@@ -353,6 +379,7 @@ std::string pathtraceDefinitions(const SceneData& scene, const VulkanRenderOptio
 VulkanRenderStats renderVulkan(const SceneData& scene, const VulkanRenderOptions& options,
                                Film& film) {
   if (scene.integrator == kIntegratorSppm) return renderSppmVulkan(scene, options, film);
+  if (scene.integrator == kIntegratorBdpt) return renderBdptVulkan(scene, options, film);
   const auto start = std::chrono::steady_clock::now();
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));

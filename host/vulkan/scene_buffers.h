@@ -1,13 +1,17 @@
 // The device buffers of one render of shaders/pathtrace.comp and its pipeline, for the Vulkan
-// backend's integrators (vulkan/backend.cpp's path tracer, vulkan/sppm.cpp's photon mapping):
+// backend's integrators (vulkan/backend.cpp's path tracer, vulkan/sppm.cpp's photon mapping,
+// vulkan/bdpt.cpp's bidirectional path tracing):
 // the flat scene arrays uploaded, the accumulation and the counters.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "image/image.h"
 #include "render/prepare.h"
+#include "vulkan/backend.h"
 #include "vulkan/context.h"
 #include "vulkan/resources.h"
 
@@ -30,6 +34,23 @@ struct RenderBuffers {
 // `staging` (filled here, kept alive by the caller until the commands have run).
 RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
                           const vk::raii::CommandBuffer& cmd, Buffer& staging);
+
+// What the integrators that sum exactly on the device (vulkan/sppm.cpp, vulkan/bdpt.cpp) start
+// from: the device with 64-bit buffer atomics, a command buffer begun, and the scene's upload
+// recorded into it (submitted with the caller's next commands).
+struct ExactSumDeviceScene {
+  ExactSumDeviceScene(const ContextOptions& options, const SceneData& scene);
+
+  VulkanContext ctx;
+  Commands commands;
+  Buffer staging;
+  RenderBuffers buffers;
+};
+
+// The statistics those integrators end with: samplesDone, the film's invalid samples, the
+// validation errors and the wall time since callStart.
+void finishExactSumStats(const ExactSumDeviceScene& device, const Film& film, int samplesDone,
+                         std::chrono::steady_clock::time_point callStart, VulkanRenderStats& stats);
 
 // shaders/pathtrace.comp compiled with `definitions` (pathtraceDefinitions and a variant's),
 // binding the render's buffers as PT_BINDING_* and then `extra` from PT_BINDING_COUNT on.

@@ -95,16 +95,12 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
   const Camera& cam = scene.params.camera;
   PT_CHECK(film.width == int(cam.width) && film.height == int(cam.height));
   PT_CHECK(scene.params.mediaPresent == 0u, "SPPM renders no media (checkBdptScene)");
-  ContextOptions contextOptions = options.context;
-  contextOptions.int64Atomics = true;  // the photons' exact sums
-  VulkanContext ctx(contextOptions);
-  const Commands commands(ctx);
+  // The scene (its upload recorded), SPPM's buffers and the two passes' pipelines.
+  const ExactSumDeviceScene device(options.context, scene);  // the photons' exact sums
+  const VulkanContext& ctx = device.ctx;
+  const Commands& commands = device.commands;
   const vk::raii::CommandBuffer& cmd = commands.cmd;
-
-  // The scene, SPPM's buffers and the two passes' pipelines.
-  commands.begin();
-  Buffer staging;
-  const RenderBuffers buffers = uploadScene(ctx, scene, cmd, staging);
+  const RenderBuffers& buffers = device.buffers;
   const std::string definitions = pathtraceDefinitions(scene, options) + "#define PT_SPPM\n";
   const std::string cameraDefinitions = definitions + "#define PT_SPPM_CAMERA\n";
   const std::string photonDefinitions = definitions + "#define PT_SPPM_PHOTONS\n";
@@ -287,13 +283,9 @@ VulkanRenderStats renderSppmVulkan(const SceneData& scene, const VulkanRenderOpt
   if (options.firstSample + uint32_t(done) > 0u) {
     sppmEstimateToFilm(records, options.firstSample + uint32_t(done), photons, film);
   }
-  stats.samplesDone = done;
   stats.stopped = done < options.spp;
   if (options.progress && !stats.stopped) options.progress(1.0);
-  stats.invalidSamples = film.totalInvalid();
-  stats.validationErrors = ctx.validationErrors();
-  stats.wallSeconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - callStart).count();
+  finishExactSumStats(device, film, done, callStart, stats);
   return stats;
 }
 
