@@ -318,6 +318,7 @@ std::string pathtraceDefinitions(const SceneData& scene, const VulkanRenderOptio
   flag("PT_FX_COATED_DIFFUSE", fx.coatedDiffuse);
   flag("PT_FX_GLTF", fx.gltf);
   flag("PT_FX_GLTF_LAYERS", fx.gltfLayers);
+  flag("PT_FX_GLTF_SHEEN", fx.gltfSheen);
   flag("PT_FX_SHADING_NORMALS", fx.shadingNormals);
   flag("PT_FX_DELTA_LIGHTS", fx.deltaLights);
   flag("PT_FX_ENVIRONMENT", fx.environment);
