@@ -160,6 +160,15 @@ uint gLoopIterations = 0u;  // this invocation's count, for the statistics
 uint gRays = 0u;
 bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 
+// The sheen's albedo table (sheen_albedo.h), uploaded after the materials where a scene has a
+// sheen, from texel PT_SHEEN_ALBEDO_TEXEL on.
+#ifndef PT_SHEEN_ALBEDO_TEXEL
+#define PT_SHEEN_ALBEDO_TEXEL 0
+#endif
+float sheenAlbedoNode(int i) {
+  return uintBitsToFloat(texelFetch(materialTexels, PT_SHEEN_ALBEDO_TEXEL + (i >> 2))[i & 3]);
+}
+
 #ifndef PT_NO_BSDF_MATERIALS
 // bsdf.h, for the material types in use, its loops counted.
 #define PT_HAS_CONDUCTOR kConductor

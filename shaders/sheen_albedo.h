@@ -3,7 +3,9 @@
 // layers below the sheen. Tabulated by our own quadrature of the lobe (tools/sheen-albedo.cpp,
 // sheen_albedo_table.h) at kSheenAlbedoCos x kSheenAlbedoRoughness nodes, evenly spaced in the
 // square root of the cosine (the albedo of a smooth sheen changes fastest at grazing angles) and
-// in the roughness, and interpolated bilinearly.
+// in the roughness, and interpolated bilinearly. C++ reads the table as an array; the shader
+// reads it from the scene's material buffer, after the materials (a large constant array costs
+// lavapipe minutes of compilation), through sheenAlbedoNode(i), which its includer defines.
 #ifndef PT_SHEEN_ALBEDO_H
 #define PT_SHEEN_ALBEDO_H
 
@@ -16,14 +18,14 @@ namespace pt {
 PT_CONST int kSheenAlbedoCos = 32;
 PT_CONST int kSheenAlbedoRoughness = 32;
 
+#ifdef __cplusplus
 #include "sheen_albedo_table.h"
 
-#ifdef __cplusplus
 inline constexpr float kSheenAlbedo[kSheenAlbedoCos * kSheenAlbedoRoughness] = {
     PT_SHEEN_ALBEDO_TABLE};
-#else
-const float kSheenAlbedo[kSheenAlbedoCos * kSheenAlbedoRoughness] =
-    float[kSheenAlbedoCos * kSheenAlbedoRoughness](PT_SHEEN_ALBEDO_TABLE);
+inline float sheenAlbedoNode(int i) {
+  return kSheenAlbedo[i];
+}
 #endif
 
 PT_INLINE float sheenAlbedo(float cosThetaO, float roughness) {
@@ -34,8 +36,9 @@ PT_INLINE float sheenAlbedo(float cosThetaO, float roughness) {
   float fx = x - float(i);
   float fy = y - float(j);
   int at = j * kSheenAlbedoCos + i;
-  float low = mix(kSheenAlbedo[at], kSheenAlbedo[at + 1], fx);
-  float high = mix(kSheenAlbedo[at + kSheenAlbedoCos], kSheenAlbedo[at + kSheenAlbedoCos + 1], fx);
+  float low = mix(sheenAlbedoNode(at), sheenAlbedoNode(at + 1), fx);
+  float high =
+      mix(sheenAlbedoNode(at + kSheenAlbedoCos), sheenAlbedoNode(at + kSheenAlbedoCos + 1), fx);
   return mix(low, high, fy);
 }
 
