@@ -47,6 +47,7 @@ PT_INLINE float charlieL(float alpha, float x) {
   return a / (1.0f + b * pow(x, c)) + d * x + e;
 }
 PT_INLINE float charlieLambda(float alpha, float cosTheta) {
+  cosTheta = clamp(cosTheta, 0.0f, 1.0f);  // a sampled direction's z may round above 1
   if (cosTheta < 0.5f) return exp(charlieL(alpha, cosTheta));
   return exp(2.0f * charlieL(alpha, 0.5f) - charlieL(alpha, 1.0f - cosTheta));
 }
