@@ -2003,6 +2003,9 @@ TEST(BsdfHardCases, NoInvalidValues) {
         vec3 wi = rng.direction();
         if (i % 4 == 1) wi = normalize(vec3(wi.x, wi.y, wi.z * 1e-6f));
         if (s.flags != 0u && i % 2 == 0) wi = s.wi;
+        // glTF's layers at a direction as the microfacet samplers can return one, its z rounded
+        // above 1 (the sheen's Lambda was NaN there).
+        if (m.type == kMaterialGltf && i % 8 == 3) wi = vec3(-1.8e-4f, -1.1e-4f, 1.00000012f);
         const vec3 f = bsdfF(m, wo, wi, streamFor(uint(i), kStreamEval));
         const float pdf = bsdfPdf(m, wo, wi, streamFor(uint(i), kStreamLightPdf));
         if (!isFinite(f) || min(f.x, min(f.y, f.z)) < 0.0f || !std::isfinite(pdf) || pdf < 0.0f) {
