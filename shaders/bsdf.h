@@ -12,8 +12,11 @@
 #ifndef PT_BSDF_H
 #define PT_BSDF_H
 
+#include "gltf_material_fields.h"
 #include "sampling.h"
 #include "shared_types.h"
+#include "sheen.h"
+#include "sheen_albedo.h"
 
 #ifdef __cplusplus
 namespace pt {
@@ -33,6 +36,14 @@ namespace pt {
 // the shader compiles in only for scenes with a material that uses one.
 #ifndef PT_HAS_GLTF_LAYERS
 #define PT_HAS_GLTF_LAYERS true
+#endif
+// Of those, KHR_materials_sheen, and a clear coat with a normal of its own (kGltfCoatNormal):
+// compiled in only for scenes that have them.
+#ifndef PT_HAS_GLTF_SHEEN
+#define PT_HAS_GLTF_SHEEN true
+#endif
+#ifndef PT_HAS_GLTF_COAT_NORMAL
+#define PT_HAS_GLTF_COAT_NORMAL true
 #endif
 
 // Counts an iteration of the layered BSDF's loops where the shader keeps count of its loops
@@ -825,6 +836,42 @@ PT_INLINE float coatedDiffusePdf(CoatedDiffuse c, vec3 wo, vec3 wi, RandomStream
   return 0.1f * kInv4Pi + 0.9f * (pdfSum / n);
 }
 
+// ---- Shading frame ------------------------------------------------------------------------
+// z along the normal n (unit); x along `tangent` made orthogonal to n, as pbrt-v4's frame from
+// dpdu (a triangle without UVs takes pbrt-v4's default UVs, whose dpdu is v1 - v0); any
+// orthonormal pair where the tangent is parallel to n.
+
+struct ShadingFrame {
+  vec3 x;
+  vec3 y;
+  vec3 z;
+};
+
+PT_INLINE ShadingFrame makeShadingFrame(vec3 n, vec3 tangent) {
+  vec3 t = tangent - dot(n, tangent) * n;
+  float len2 = dot(t, t);
+  if (!(len2 > 1e-20f)) {
+    t = localToWorld(vec3(1.0f, 0.0f, 0.0f), n);
+  } else {
+    t = t / sqrt(len2);
+  }
+  return ShadingFrame(t, cross(n, t), n);
+}
+// The shading normal at barycentrics b (weights of v0, v1, v2): the vertex normals
+// interpolated and normalized; ng where they cancel.
+PT_INLINE vec3 interpolatedNormal(TriangleNormals t, vec3 b, vec3 ng) {
+  vec3 n = b.x * t.n0 + b.y * t.n1 + b.z * t.n2;
+  float len2 = dot(n, n);
+  return len2 > 0.0f ? n / sqrt(len2) : ng;
+}
+
+PT_INLINE vec3 toLocal(ShadingFrame f, vec3 w) {
+  return vec3(dot(w, f.x), dot(w, f.y), dot(w, f.z));
+}
+PT_INLINE vec3 fromLocal(ShadingFrame f, vec3 w) {
+  return w.x * f.x + w.y * f.y + w.z * f.z;
+}
+
 // ---- glTF metallic-roughness ---------------------------------------------------------------
 // The glTF 2.0 specification's material (its appendix B): mix(dielectric_brdf, metal_brdf,
 // metallic), where metal_brdf is the Trowbridge-Reitz specular lobe (alpha = roughness^2)
@@ -935,7 +982,8 @@ PT_INLINE BsdfSample gltfSample(GltfSurface s, vec3 wo, float uc, vec2 u) {
 // KHR_materials_transmission, _volume, _clearcoat and _specular on top of the material above,
 // layered as the extensions' specifications layer them:
 //
-//   coated   = mix(material, clearcoat_brdf, clearcoat Fc(N.V)),  Fc Schlick's of f0 0.04
+//   coated   = mix(sheened, clearcoat_brdf, clearcoat Fc(Nc.V)),  Fc Schlick's of f0 0.04
+//   sheened  = sheenColor sheen_brdf / s + min(1 - S E(N.V), 1 - S E(N.L)) material
 //   material = mix(dielectric, metal_brdf, metallic)
 //   dielectric = fresnel_mix(F(N.V), base = mix(diffuse, specular_btdf baseColor, transmission),
 //                            layer = specular_brdf)
@@ -951,7 +999,18 @@ PT_INLINE BsdfSample gltfSample(GltfSurface s, vec3 wo, float uc, vec2 u) {
 // refracted part is tinted by the base colour, in place of the layer's Fresnel mix. Material
 // fields (kMaterialGltf with nSamples != 0): nSamples the kGltf* flags, transmittance (the
 // transmission factor, the clearcoat factor, the clearcoat's alpha), k the specular colour, eta.y
-// the specular factor; the rest as the material above.
+// the specular factor; the sheen and the coat's normal where gltf_material_fields.h says; the rest
+// as the material above.
+//
+// The sheen (KHR_materials_sheen) is sheen.h's lobe with the albedo scaling of the extension's
+// specification: the layers below lose S E, S = max(sheenColor), E the lobe's directional albedo
+// (sheen_albedo.h), the smaller of the scalings of wo and wi, so that f stays reciprocal. Where
+// E exceeds 1 (low sheen roughness at grazing angles: the Charlie lobe is not normalized) the
+// lobe is divided by s = max(1, E(N.V), E(N.L)) and its share taken as min(E, 1), so that no
+// parameter set gains energy. It is sampled cosine-weighted. Nc, the coat's own normal
+// (kGltfCoatNormal: its clearcoatNormalTexture at the hit, in the base's local frame), turns
+// the coat's lobe (f about Nc times Nc.L / N.L, so that the integrators' N.L weighs it by its own
+// cosine) and its Fresnel weight, which then takes Nc.V; the layers below keep N.
 
 struct GltfLayers {
   GltfSurface s;
@@ -962,20 +1021,61 @@ struct GltfLayers {
   float eta;           // the index of refraction
   float clearcoat;
   TrowbridgeReitz coat;
+  bool sheen;  // KHR_materials_sheen
+  vec3 sheenColour;
+  float sheenRoughness;
+  float sheenAlpha;
+  bool coatNormal;         // the coat has its own normal: coatFrame's z
+  ShadingFrame coatFrame;  // in the base's local frame
+  float coatCosThetaO;     // with coatNormal: Nc.wo (wo turned above the base), set per wo
 };
 
 PT_INLINE GltfLayers gltfLayersOf(Material m) {
   GltfSurface s = gltfSurfaceOf(m);
   vec3 f0 = min(vec3(s.f0) * m.k, vec3(1.0f)) * m.eta.y;
   bool refracts = (m.nSamples & kGltfVolume) != 0u;
+  bool sheen = PT_HAS_GLTF_SHEEN && (m.nSamples & kGltfSheen) != 0u;
+  float sheenRoughness = sheen ? gltfSheenRoughness(m) : 0.0f;
+  bool coatNormal = PT_HAS_GLTF_COAT_NORMAL && (m.nSamples & kGltfCoatNormal) != 0u;
+  ShadingFrame coatFrame =
+      ShadingFrame(vec3(1.0f, 0.0f, 0.0f), vec3(0.0f, 1.0f, 0.0f), vec3(0.0f, 0.0f, 1.0f));
+  if (coatNormal) coatFrame = makeShadingFrame(gltfCoatNormal(m), vec3(1.0f, 0.0f, 0.0f));
   return GltfLayers(s, f0, m.eta.y, m.transmittance.x, refracts, m.eta.x, m.transmittance.y,
-                    TrowbridgeReitz(m.transmittance.z, m.transmittance.z));
+                    TrowbridgeReitz(m.transmittance.z, m.transmittance.z), sheen,
+                    sheen ? gltfSheenColour(m) : vec3(0.0f), sheenRoughness,
+                    sheenAlpha(sheenRoughness), coatNormal, coatFrame, 0.0f);
+}
+// l for wo turned above the base (o): the coat's cosine where it has its own normal.
+PT_INLINE GltfLayers gltfLayersFacing(GltfLayers l, vec3 o) {
+  if (PT_HAS_GLTF_COAT_NORMAL && l.coatNormal) l.coatCosThetaO = dot(o, l.coatFrame.z);
+  return l;
 }
 
 // What each lobe is weighed by for wo (cosThetaO = |wo.z|), before its own Fresnel term where it
-// has one: the clear coat's Fc (scalar), the base's 1 - clearcoat Fc (the rest is below).
+// has one: the clear coat's Fc (scalar; of Nc.V where the coat has its own normal, 1 where wo is
+// behind it), the base's 1 - clearcoat Fc (the rest is below).
 PT_INLINE float gltfCoatWeight(GltfLayers l, float cosThetaO) {
-  return l.clearcoat * (0.04f + 0.96f * schlickWeight(cosThetaO));
+  float c = PT_HAS_GLTF_COAT_NORMAL && l.coatNormal ? l.coatCosThetaO : cosThetaO;
+  return l.clearcoat * (0.04f + 0.96f * schlickWeight(c));
+}
+// The sheen's directional albedo for a cosine, at most 1 (see above), and the scaling it leaves
+// the layers below (1 - S E).
+PT_INLINE float gltfSheenAlbedo(GltfLayers l, float cosTheta) {
+  return min(sheenAlbedo(cosTheta, l.sheenRoughness), 1.0f);
+}
+PT_INLINE float gltfSheenScaling(GltfLayers l, float cosTheta) {
+  return 1.0f - maxComponent(l.sheenColour) * gltfSheenAlbedo(l, cosTheta);
+}
+// f of the layers below the sheen (delta lobes' weights too) for wo and wi (their cosines),
+// scaled by the sheen.
+PT_INLINE vec3 gltfBelowSheen(GltfLayers l, vec3 f, float cosThetaO, float cosThetaI) {
+  if (!(PT_HAS_GLTF_SHEEN && l.sheen)) return f;
+  return f * min(gltfSheenScaling(l, cosThetaO), gltfSheenScaling(l, cosThetaI));
+}
+// The sheen lobe's f for o and i above the base, its coat's share included.
+PT_INLINE vec3 gltfSheenF(GltfLayers l, float coatWeight, vec3 o, vec3 i) {
+  float e = max(max(sheenAlbedo(o.z, l.sheenRoughness), sheenAlbedo(i.z, l.sheenRoughness)), 1.0f);
+  return (1.0f - coatWeight) * l.sheenColour * (sheenLobe(l.sheenAlpha, o, i) / e);
 }
 PT_INLINE vec3 gltfLayerFresnel(GltfLayers l, float cosThetaO) {
   return l.f0 + (vec3(l.f90) - l.f0) * schlickWeight(cosThetaO);
@@ -1002,13 +1102,22 @@ PT_INLINE vec3 gltfTransmissionWeight(GltfLayers l, float cosThetaO) {
 }
 
 // The probabilities of sampling the coat, the specular lobe, the diffuse lobe and the
-// transmission for wo (x, y, z, w): their weights' largest channels, normalized.
-PT_INLINE vec4 gltfLobeProbabilities(GltfLayers l, float cosThetaO) {
+// transmission for wo (x, y, z, w), and the sheen (pSheen): their weights' largest channels,
+// normalized (those below the sheen scaled by it).
+PT_INLINE vec4 gltfLobeProbabilities(GltfLayers l, float cosThetaO, PT_OUT(float) pSheen) {
   vec4 p = vec4(gltfCoatWeight(l, cosThetaO),
                 maxComponent(gltfLayeredSpecularWeight(l, cosThetaO, cosThetaO)),
                 maxComponent(gltfLayeredDiffuseWeight(l, cosThetaO)),
                 maxComponent(gltfTransmissionWeight(l, cosThetaO)));
-  float sum = p.x + p.y + p.z + p.w;
+  pSheen = 0.0f;
+  if (PT_HAS_GLTF_SHEEN && l.sheen) {
+    float e = gltfSheenAlbedo(l, cosThetaO);
+    float scaling = 1.0f - maxComponent(l.sheenColour) * e;
+    p = vec4(p.x, p.y * scaling, p.z * scaling, p.w * scaling);
+    pSheen = (1.0f - p.x) * maxComponent(l.sheenColour) * e;
+  }
+  float sum = p.x + p.y + p.z + p.w + pSheen;
+  pSheen = sum > 0.0f ? pSheen / sum : 0.0f;
   return sum > 0.0f ? p / sum : vec4(0.0f);
 }
 
@@ -1037,16 +1146,22 @@ PT_INLINE vec3 gltfRefractionF(GltfLayers l, vec3 wo, vec3 wi, bool radiance) {
   return sameHemisphere(wo, wi) ? f : f * l.s.baseColor;
 }
 
+// o and i (above the base's surface) in the coat's frame, where the coat has its own normal.
+PT_INLINE vec3 gltfInCoatFrame(GltfLayers l, vec3 w) {
+  return PT_HAS_GLTF_COAT_NORMAL && l.coatNormal ? toLocal(l.coatFrame, w) : w;
+}
+
 PT_INLINE vec3 gltfLayeredF(GltfLayers l, vec3 wo, vec3 wi, bool radiance) {
   float cosThetaO = absCosTheta(wo);
   if (cosThetaO == 0.0f || wi.z == 0.0f) return vec3(0.0f);
+  // The other lobes are two-sided: wo turned above the surface, wi with it.
+  vec3 o = wo.z < 0.0f ? -wo : wo;
+  vec3 i = wo.z < 0.0f ? -wi : wi;
+  l = gltfLayersFacing(l, o);
   vec3 f = vec3(0.0f);
   if (l.refracts && l.transmission > 0.0f) {
     f += gltfTransmissionWeight(l, cosThetaO) * gltfRefractionF(l, wo, wi, radiance);
   }
-  // The other lobes are two-sided: wo turned above the surface, wi with it.
-  vec3 o = wo.z < 0.0f ? -wo : wo;
-  vec3 i = wo.z < 0.0f ? -wi : wi;
   bool baseSmooth = effectivelySmooth(l.s.d);
   if (i.z > 0.0f) {
     f += gltfLayeredDiffuseWeight(l, cosThetaO) * kInvPi;
@@ -1054,11 +1169,24 @@ PT_INLINE vec3 gltfLayeredF(GltfLayers l, vec3 wo, vec3 wi, bool radiance) {
       vec3 wm = normalize(o + i);
       f += gltfLayeredSpecularWeight(l, cosThetaO, abs(dot(o, wm))) * gltfMicrofacet(l.s.d, o, i);
     }
-    if (l.clearcoat > 0.0f && !effectivelySmooth(l.coat)) {
-      f += vec3(gltfCoatWeight(l, cosThetaO) * gltfMicrofacet(l.coat, o, i));
-    }
   } else if (!l.refracts && !baseSmooth) {
     f += gltfTransmissionWeight(l, cosThetaO) * gltfMicrofacet(l.s.d, o, gltfMirrored(i));
+  }
+  // The sheen over the layers so far, scaled by what it takes from them.
+  float coatWeight = gltfCoatWeight(l, cosThetaO);
+  if (PT_HAS_GLTF_SHEEN && l.sheen) {
+    f = gltfBelowSheen(l, f, cosThetaO, abs(i.z));
+    if (i.z > 0.0f) f += gltfSheenF(l, coatWeight, o, i);
+  }
+  if (i.z > 0.0f && l.clearcoat > 0.0f && !effectivelySmooth(l.coat)) {
+    if (PT_HAS_GLTF_COAT_NORMAL && l.coatNormal) {
+      // The coat's lobe is f about Nc, whose cosine is Nc.L: in the base's frame, where the
+      // integrators weigh f by N.L, it is f Nc.L / N.L.
+      vec3 ic = toLocal(l.coatFrame, i);
+      f += vec3(coatWeight * gltfMicrofacet(l.coat, toLocal(l.coatFrame, o), ic) * (ic.z / i.z));
+    } else {
+      f += vec3(coatWeight * gltfMicrofacet(l.coat, o, i));
+    }
   }
   return f;
 }
@@ -1066,16 +1194,21 @@ PT_INLINE vec3 gltfLayeredF(GltfLayers l, vec3 wo, vec3 wi, bool radiance) {
 PT_INLINE float gltfLayeredPdf(GltfLayers l, vec3 wo, vec3 wi) {
   float cosThetaO = absCosTheta(wo);
   if (cosThetaO == 0.0f || wi.z == 0.0f) return 0.0f;
-  vec4 p = gltfLobeProbabilities(l, cosThetaO);
-  float pdf = 0.0f;
-  if (l.refracts && p.w > 0.0f) pdf += p.w * dielectricPdf(l.s.d, l.eta, wo, wi, kSampleAll);
   vec3 o = wo.z < 0.0f ? -wo : wo;
   vec3 i = wo.z < 0.0f ? -wi : wi;
+  l = gltfLayersFacing(l, o);
+  float pSheen;
+  vec4 p = gltfLobeProbabilities(l, cosThetaO, pSheen);
+  float pdf = 0.0f;
+  if (l.refracts && p.w > 0.0f) pdf += p.w * dielectricPdf(l.s.d, l.eta, wo, wi, kSampleAll);
   bool baseSmooth = effectivelySmooth(l.s.d);
   if (i.z > 0.0f) {
     pdf += p.z * i.z * kInvPi;
     if (!baseSmooth) pdf += p.y * gltfMicrofacetPdf(l.s.d, o, i);
-    if (p.x > 0.0f && !effectivelySmooth(l.coat)) pdf += p.x * gltfMicrofacetPdf(l.coat, o, i);
+    if (p.x > 0.0f && !effectivelySmooth(l.coat)) {
+      pdf += p.x * gltfMicrofacetPdf(l.coat, gltfInCoatFrame(l, o), gltfInCoatFrame(l, i));
+    }
+    if (PT_HAS_GLTF_SHEEN && l.sheen) pdf += pSheen * i.z * kInvPi;
   } else if (!l.refracts && !baseSmooth) {
     pdf += p.w * gltfMicrofacetPdf(l.s.d, o, gltfMirrored(i));
   }
@@ -1085,43 +1218,63 @@ PT_INLINE float gltfLayeredPdf(GltfLayers l, vec3 wo, vec3 wi) {
 PT_INLINE BsdfSample gltfLayeredSample(GltfLayers l, vec3 wo, float uc, vec2 u, bool radiance) {
   float cosThetaO = absCosTheta(wo);
   if (cosThetaO == 0.0f) return noBsdfSample();
-  vec4 p = gltfLobeProbabilities(l, cosThetaO);
   vec3 o = wo.z < 0.0f ? -wo : wo;
+  l = gltfLayersFacing(l, o);
+  float pSheen;
+  vec4 p = gltfLobeProbabilities(l, cosThetaO, pSheen);
   vec3 i;
   float etap = 1.0f;
   bool baseSmooth = effectivelySmooth(l.s.d);
   if (uc < p.x) {
     // The clear coat.
-    if (effectivelySmooth(l.coat)) {
+    if (PT_HAS_GLTF_COAT_NORMAL && l.coatNormal) {
+      // About its own normal: nothing where wo is behind it or wi falls below the base.
+      vec3 oc = toLocal(l.coatFrame, o);
+      if (oc.z <= 0.0f) return noBsdfSample();
+      bool coatSmooth = effectivelySmooth(l.coat);
+      i = fromLocal(l.coatFrame, coatSmooth ? vec3(-oc.x, -oc.y, oc.z)
+                                            : reflectAbout(oc, trSampleWm(l.coat, oc, u)));
+      if (coatSmooth) {
+        if (i.z <= 0.0f) return noBsdfSample();
+        return BsdfSample(vec3(gltfCoatWeight(l, cosThetaO) / i.z), p.x, wo.z < 0.0f ? -i : i,
+                          kBsdfReflection | kBsdfSpecular, 1.0f, false);
+      }
+    } else if (effectivelySmooth(l.coat)) {
       return BsdfSample(vec3(gltfCoatWeight(l, cosThetaO) / cosThetaO), p.x,
                         vec3(-wo.x, -wo.y, wo.z), kBsdfReflection | kBsdfSpecular, 1.0f, false);
+    } else {
+      i = reflectAbout(o, trSampleWm(l.coat, o, u));
     }
-    i = reflectAbout(o, trSampleWm(l.coat, o, u));
   } else if (uc < p.x + p.y) {
     if (baseSmooth) {
-      return BsdfSample(gltfLayeredSpecularWeight(l, cosThetaO, cosThetaO) / cosThetaO, p.y,
-                        vec3(-wo.x, -wo.y, wo.z), kBsdfReflection | kBsdfSpecular, 1.0f, false);
+      vec3 w = gltfLayeredSpecularWeight(l, cosThetaO, cosThetaO) / cosThetaO;
+      return BsdfSample(gltfBelowSheen(l, w, cosThetaO, cosThetaO), p.y, vec3(-wo.x, -wo.y, wo.z),
+                        kBsdfReflection | kBsdfSpecular, 1.0f, false);
     }
     i = reflectAbout(o, trSampleWm(l.s.d, o, u));
   } else if (uc < p.x + p.y + p.z) {
     i = sampleCosineHemisphere(u);
+  } else if (PT_HAS_GLTF_SHEEN && l.sheen && uc < p.x + p.y + p.z + pSheen) {
+    i = sampleCosineHemisphere(u);  // the sheen
   } else if (!(p.w > 0.0f)) {
     return noBsdfSample();  // uc beyond the probabilities' sum, rounded below 1
   } else if (l.refracts) {
     // The interface, in wo's own orientation; uc rescaled to its share for its own choice.
-    float ur = min((uc - (p.x + p.y + p.z)) / max(p.w, 1e-30f), 0.99999994f);
+    float ur = min((uc - (p.x + p.y + p.z + pSheen)) / max(p.w, 1e-30f), 0.99999994f);
     BsdfSample bs = dielectricSample(l.s.d, l.eta, wo, ur, u, radiance, kSampleAll);
     if (bs.flags == 0u) return noBsdfSample();
     if ((bs.flags & kBsdfSpecular) != 0u) {
       vec3 tint = (bs.flags & kBsdfTransmission) != 0u ? l.s.baseColor : vec3(1.0f);
-      return BsdfSample(gltfTransmissionWeight(l, cosThetaO) * tint * bs.f, p.w * bs.pdf, bs.wi,
+      vec3 w = gltfTransmissionWeight(l, cosThetaO) * tint * bs.f;
+      return BsdfSample(gltfBelowSheen(l, w, cosThetaO, absCosTheta(bs.wi)), p.w * bs.pdf, bs.wi,
                         bs.flags, bs.eta, false);
     }
     i = wo.z < 0.0f ? -bs.wi : bs.wi;
     etap = bs.eta;
   } else if (baseSmooth) {
     // Thin-walled: straight through.
-    return BsdfSample(gltfTransmissionWeight(l, cosThetaO) / cosThetaO, p.w, -wo,
+    vec3 w = gltfTransmissionWeight(l, cosThetaO) / cosThetaO;
+    return BsdfSample(gltfBelowSheen(l, w, cosThetaO, cosThetaO), p.w, -wo,
                       kBsdfTransmission | kBsdfSpecular, 1.0f, false);
   } else {
     // Thin-walled: the specular lobe's direction, mirrored through the surface.
@@ -1144,7 +1297,7 @@ PT_INLINE BsdfSample gltfLayeredSample(GltfLayers l, vec3 wo, float uc, vec2 u, 
 // Whether the layered material has a lobe light sampling can find, or a delta lobe.
 PT_INLINE bool gltfLayeredHasNonSpecular(GltfLayers l) {
   return !effectivelySmooth(l.s.d) || (l.s.metallic < 1.0f && l.transmission < 1.0f) ||
-         (l.clearcoat > 0.0f && !effectivelySmooth(l.coat));
+         (l.clearcoat > 0.0f && !effectivelySmooth(l.coat)) || (PT_HAS_GLTF_SHEEN && l.sheen);
 }
 PT_INLINE bool gltfLayeredHasSpecular(GltfLayers l) {
   return effectivelySmooth(l.s.d) || (l.refracts && l.eta == 1.0f && l.transmission > 0.0f) ||
@@ -1274,42 +1427,6 @@ PT_INLINE BsdfSample bsdfSampleTransport(Material m, vec3 wo, float uc, vec2 u, 
 // Radiance transport, what path tracing samples.
 PT_INLINE BsdfSample bsdfSample(Material m, vec3 wo, float uc, vec2 u, RandomStream rng) {
   return bsdfSampleTransport(m, wo, uc, u, true, rng);
-}
-
-// ---- Shading frame ------------------------------------------------------------------------
-// z along the normal n (unit); x along `tangent` made orthogonal to n, as pbrt-v4's frame from
-// dpdu (a triangle without UVs takes pbrt-v4's default UVs, whose dpdu is v1 - v0); any
-// orthonormal pair where the tangent is parallel to n.
-
-struct ShadingFrame {
-  vec3 x;
-  vec3 y;
-  vec3 z;
-};
-
-PT_INLINE ShadingFrame makeShadingFrame(vec3 n, vec3 tangent) {
-  vec3 t = tangent - dot(n, tangent) * n;
-  float len2 = dot(t, t);
-  if (!(len2 > 1e-20f)) {
-    t = localToWorld(vec3(1.0f, 0.0f, 0.0f), n);
-  } else {
-    t = t / sqrt(len2);
-  }
-  return ShadingFrame(t, cross(n, t), n);
-}
-// The shading normal at barycentrics b (weights of v0, v1, v2): the vertex normals
-// interpolated and normalized; ng where they cancel.
-PT_INLINE vec3 interpolatedNormal(TriangleNormals t, vec3 b, vec3 ng) {
-  vec3 n = b.x * t.n0 + b.y * t.n1 + b.z * t.n2;
-  float len2 = dot(n, n);
-  return len2 > 0.0f ? n / sqrt(len2) : ng;
-}
-
-PT_INLINE vec3 toLocal(ShadingFrame f, vec3 w) {
-  return vec3(dot(w, f.x), dot(w, f.y), dot(w, f.z));
-}
-PT_INLINE vec3 fromLocal(ShadingFrame f, vec3 w) {
-  return w.x * f.x + w.y * f.y + w.z * f.z;
 }
 
 #ifdef __cplusplus

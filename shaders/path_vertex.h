@@ -283,7 +283,8 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
       uv.uv = interpolatedUV(uvs, b);
       footprintUVs = footprints;
       if (footprints || (PT_HAS_BUMP_MAPS && textures.displacement != kNoTexture) ||
-          (PT_TEXTURE_USES(kTextureUsesNormalMap) && textures.normalMap != kNoTexture)) {
+          (PT_TEXTURE_USES(kTextureUsesNormalMap) && textures.normalMap != kNoTexture) ||
+          (PT_TEXTURE_USES(kTextureUsesCoatNormal) && textures.clearcoatNormal != kNoTexture)) {
         derivatives = triangleDerivatives(tri, uvs);
       }
       if (footprints) {
@@ -301,7 +302,8 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
   vec3 n = cosOut >= 0.0f ? ng : -ng;
   vec3 ns = ng;
 #ifndef PT_NO_BSDF_MATERIALS
-  TriangleNormals normals;
+  // (Zeros unless loaded: read only where shadingNormals, but GCC cannot tell.)
+  TriangleNormals normals = TriangleNormals(vec3(0.0f), 0u, vec3(0.0f), 0u, vec3(0.0f), 0u);
   if (shadingNormals) {
     normals = loadNormals(PT_SCENE_ARG tri.primitive);
     ns = interpolatedNormal(normals, b, ng);
@@ -330,11 +332,26 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
       n = dot(ns, wo) >= 0.0f ? ns : -ns;
     }
   }
+  // A glTF clear coat's own normal (with its kTextureUsesCoatNormal): its clearcoatNormalTexture
+  // (scale in textures.scale) on the normal before the base's normal map, or without one that
+  // normal itself (the coat is not normal-mapped by the base's normalTexture).
+  bool coatNormal = PT_HAS_TEXTURES && PT_TEXTURE_USES(kTextureUsesCoatNormal) && textured &&
+                    s.material.type == kMaterialGltf &&
+                    (s.material.nSamples & kGltfClearcoat) != 0u &&
+                    (textures.clearcoatNormal != kNoTexture || textures.normalMap != kNoTexture);
+  bool coatMapped = coatNormal && textures.clearcoatNormal != kNoTexture;
+  bool normalMapped = PT_HAS_TEXTURES && PT_TEXTURE_USES(kTextureUsesNormalMap) && textured &&
+                      textures.normalMap != kNoTexture;
+  vec4 tangent = vec4(0.0f);
+  if ((coatMapped || normalMapped) && vertexNormals) tangent = interpolatedTangent(normals, b);
+  vec3 coatNs = ns;
+  if (coatMapped) {
+    coatNs = normalMappedNormal(PT_SCENE_TEXTURES textures.clearcoatNormal, textures.scale,
+                                derivatives, tangent, uv, ns);
+  }
   // A normal map (glTF's normalTexture) replaces it (texture.h), in the frame of the vertices'
   // tangents where the mesh has them.
-  if (PT_HAS_TEXTURES && PT_TEXTURE_USES(kTextureUsesNormalMap) && textured &&
-      textures.normalMap != kNoTexture) {
-    vec4 tangent = vertexNormals ? interpolatedTangent(normals, b) : vec4(0.0f);
+  if (normalMapped) {
     ns = normalMappedNormal(PT_SCENE_TEXTURES textures.normalMap, textures.normalScale, derivatives,
                             tangent, uv, ns);
     shadingNormals = true;
@@ -365,6 +382,8 @@ PT_INLINE SurfacePoint surfacePointAt(PT_SCENE_PARAM uint index, Triangle tri, v
     // inside from outside by it.
     s.frame = makeShadingFrame(ns, tri.v1 - tri.v0);
     s.woLocal = toLocal(s.frame, wo);
+    // The coat's normal in that frame, for the layered BSDF (bsdf.h).
+    if (coatNormal) s.material = gltfWithCoatNormal(s.material, toLocal(s.frame, coatNs));
   }
 #endif
   return s;

@@ -44,6 +44,7 @@ layout(local_size_x = kWorkgroupSize, local_size_y = kWorkgroupSize) in;
 #define PT_FX_COATED_DIFFUSE true
 #define PT_FX_GLTF true
 #define PT_FX_GLTF_LAYERS true
+#define PT_FX_GLTF_SHEEN true
 #define PT_FX_SHADING_NORMALS true
 #define PT_FX_DELTA_LIGHTS true
 #define PT_FX_ENVIRONMENT true
@@ -92,6 +93,7 @@ const bool kDiffuseTransmission = PT_FX_DIFFUSE_TRANSMISSION;
 const bool kCoatedDiffuse = PT_FX_COATED_DIFFUSE;
 const bool kGltf = PT_FX_GLTF;
 const bool kGltfLayers = PT_FX_GLTF_LAYERS;
+const bool kGltfSheens = PT_FX_GLTF_SHEEN;
 const bool kShadingNormals = PT_FX_SHADING_NORMALS;
 const bool kDeltaLights = PT_FX_DELTA_LIGHTS;
 const bool kEnvironment = PT_FX_ENVIRONMENT;
@@ -160,6 +162,15 @@ uint gLoopIterations = 0u;  // this invocation's count, for the statistics
 uint gRays = 0u;
 bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 
+// The sheen's albedo table (sheen_albedo.h), uploaded after the materials where a scene has a
+// sheen, from texel PT_SHEEN_ALBEDO_TEXEL on.
+#ifndef PT_SHEEN_ALBEDO_TEXEL
+#define PT_SHEEN_ALBEDO_TEXEL 0
+#endif
+float sheenAlbedoNode(int i) {
+  return uintBitsToFloat(texelFetch(materialTexels, PT_SHEEN_ALBEDO_TEXEL + (i >> 2))[i & 3]);
+}
+
 #ifndef PT_NO_BSDF_MATERIALS
 // bsdf.h, for the material types in use, its loops counted.
 #define PT_HAS_CONDUCTOR kConductor
@@ -169,6 +180,8 @@ bool gDebug = false;  // this invocation prints its path (--debug-pixel)
 #define PT_HAS_COATED_DIFFUSE kCoatedDiffuse
 #define PT_HAS_GLTF kGltf
 #define PT_HAS_GLTF_LAYERS kGltfLayers
+#define PT_HAS_GLTF_SHEEN kGltfSheens
+#define PT_HAS_GLTF_COAT_NORMAL ((kTextureFeatures & kTextureUsesCoatNormal) != 0u)
 #define PT_LOOP_TICK() gLoopIterations++
 #include "bsdf.h"
 #include "lights.h"
@@ -194,7 +207,8 @@ MaterialTextures materialTexturesAt(uint i) {
   uvec4 c = texelFetch(materialTextureTexels, at + 2);
   uvec4 d = texelFetch(materialTextureTexels, at + 3);
   // glTF's extension textures: read only in the shaders of scenes that have one.
-  bool layers = (kTextureFeatures & kTextureUsesGltfLayers) != 0u;
+  bool layers = (kTextureFeatures & (kTextureUsesGltfLayers | kTextureUsesGltfSheen |
+                                     kTextureUsesCoatNormal)) != 0u;
   uvec4 e = layers ? texelFetch(materialTextureTexels, at + 4) : uvec4(kNoTexture);
   uvec4 f = layers ? texelFetch(materialTextureTexels, at + 5) : uvec4(kNoTexture);
   return MaterialTextures(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, uintBitsToFloat(c.y), c.z,

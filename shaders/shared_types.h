@@ -118,6 +118,8 @@ PT_CONST uint kGltfTransmission = 1u;  // KHR_materials_transmission
 PT_CONST uint kGltfVolume = 2u;        // KHR_materials_volume: the transmission refracts
 PT_CONST uint kGltfClearcoat = 4u;     // KHR_materials_clearcoat
 PT_CONST uint kGltfSpecular = 8u;      // KHR_materials_specular
+PT_CONST uint kGltfSheen = 16u;        // KHR_materials_sheen (gltf_material_fields.h)
+PT_CONST uint kGltfCoatNormal = 32u;   // the clear coat has its own shading normal (a hit's)
 PT_CONST uint kMaterialTypeCount = 9u;
 
 // One material. The first two rows are all that diffuse and mirror surfaces read; the others
@@ -146,7 +148,8 @@ struct Material {
   float g;             //  4 bytes: coateddiffuse: Henyey-Greenstein asymmetry of the medium
   uint maxDepth;       //  4 bytes: coateddiffuse: random-walk length
   uint nSamples;       //  4 bytes: coateddiffuse: random walks per evaluation; gltf: kGltf*
-  uint reserved1;      //  4 bytes: zero
+                       //           (and gltf_material_fields.h's sheen roughness)
+  uint reserved1;      //  4 bytes: zero; gltf: the coat's normal (gltf_material_fields.h)
 };                     // 96 bytes
 PT_CONST uint kMaterialTexels = 6u;  // 16-byte texels per Material (the GPU reads them so)
 
@@ -428,10 +431,12 @@ struct MaterialTextures {
   uint clearcoatRoughness;
   uint specular;
   uint specularColour;
-  uint reserved0;  // zero
-  uint reserved1;  // zero
-  uint reserved2;  // zero
-};                 // 96 bytes
+  // KHR_materials_sheen's colour (RGB) and roughness (float), KHR_materials_clearcoat's normal
+  // map (RGB, linear; its scale in `scale`, which only diffusetransmission uses otherwise).
+  uint sheenColour;
+  uint sheenRoughness;
+  uint clearcoatNormal;
+};  // 96 bytes
 PT_CONST uint kMaterialTextureTexels = 6u;
 PT_CONST uint kRemapRoughness = 1u;   // roughness textures give pbrt-v4's roughness, not alpha
 PT_CONST uint kSquareRoughness = 2u;  // roughness textures give gltf's roughness: alpha = r^2
@@ -456,6 +461,8 @@ PT_CONST uint kTextureUsesImages = 1u << 9u;       // an image lookup
 PT_CONST uint kTextureUsesEwa = 1u << 10u;         // an image filtered by kTextureEwa
 PT_CONST uint kTextureUsesFootprints = 1u << 11u;  // filtering over the ray's footprint (paths
                                                    // carry differentials: differentials.h)
+PT_CONST uint kTextureUsesGltfSheen = 1u << 12u;   // gltf's sheen textures (colour, roughness)
+PT_CONST uint kTextureUsesCoatNormal = 1u << 13u;  // a gltf clear coat with a normal of its own
 PT_CONST uint kTextureUsesAll = 0xFFFFFFFFu;
 
 // ---- Camera and per-render parameters --------------------------------------------------

@@ -22,6 +22,8 @@
 #ifndef PT_TEXTURE_H
 #define PT_TEXTURE_H
 
+#include "gltf_material_fields.h"
+#include "octahedral.h"
 #include "sampling.h"
 #include "shared_types.h"
 
@@ -455,10 +457,13 @@ PT_INLINE float evalFloatTexture(PT_TEXTURES_PARAM uint first, vec2 uv) {
 
 // Whether a material reads a texture of gltf's extensions (compiled only where one is used).
 PT_INLINE bool gltfLayerTextured(MaterialTextures t) {
-  return PT_TEXTURE_USES(kTextureUsesGltfLayers) &&
-         (t.transmission != kNoTexture || t.clearcoat != kNoTexture ||
-          t.clearcoatRoughness != kNoTexture || t.specular != kNoTexture ||
-          t.specularColour != kNoTexture);
+  return (PT_TEXTURE_USES(kTextureUsesGltfLayers) &&
+          (t.transmission != kNoTexture || t.clearcoat != kNoTexture ||
+           t.clearcoatRoughness != kNoTexture || t.specular != kNoTexture ||
+           t.specularColour != kNoTexture)) ||
+         (PT_TEXTURE_USES(kTextureUsesGltfSheen) &&
+          (t.sheenColour != kNoTexture || t.sheenRoughness != kNoTexture)) ||
+         (PT_TEXTURE_USES(kTextureUsesCoatNormal) && t.clearcoatNormal != kNoTexture);
 }
 
 // Whether a material reads any texture (and so the hit's texture coordinates).
@@ -470,16 +475,19 @@ PT_INLINE bool anyTexture(MaterialTextures t) {
          t.normalMap != kNoTexture || gltfLayerTextured(t);
 }
 
-// gltf's extension textures, parameters 9 to 13 of resolveMaterialAt: transmission, clear coat,
-// the coat's roughness, specular, specular colour (kNoTexture where the shader has none).
+// gltf's extension textures, parameters 9 to 15 of resolveMaterialAt: transmission, clear coat,
+// the coat's roughness, specular, specular colour, sheen colour, sheen roughness (kNoTexture
+// where the shader has none).
 PT_INLINE uint gltfLayerTexture(MaterialTextures t, uint i) {
   return i == 9u    ? t.transmission
          : i == 10u ? t.clearcoat
          : i == 11u ? t.clearcoatRoughness
          : i == 12u ? t.specular
-                    : t.specularColour;
+         : i == 13u ? t.specularColour
+         : i == 14u ? t.sheenColour
+                    : t.sheenRoughness;
 }
-// The value of parameter i (9 to 13) in the fields gltfLayersOf reads (shaders/bsdf.h): each
+// The value of parameter i (9 to 15) in the fields gltfLayersOf reads (shaders/bsdf.h): each
 // texture is its factor times the texel (the reader's scale), as the extensions define them.
 PT_INLINE Material gltfLayerTextureApplied(Material m, uint i, vec3 value) {
   float x = clamp(value.x, 0.0f, 1.0f);
@@ -491,8 +499,12 @@ PT_INLINE Material gltfLayerTextureApplied(Material m, uint i, vec3 value) {
     m.transmittance.z = x * x;  // the coat's alpha: its roughness squared
   } else if (i == 12u) {
     m.eta.y = x;
-  } else {
+  } else if (i == 13u) {
     m.k = max(value, vec3(0.0f));
+  } else if (i == 14u) {
+    m = gltfWithSheenColour(m, clamp(value, vec3(0.0f), vec3(1.0f)));
+  } else {
+    m = gltfWithSheenRoughness(m, x);
   }
   return m;
 }
@@ -510,10 +522,12 @@ PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextu
   bool square = (t.flags & kSquareRoughness) != 0u;
   // The parameters in this order, each texture evaluated by one call of evalTextureAt (see "One
   // call site" above). The emission (i = 8) only where some material has an emission texture,
-  // gltf's extension textures (i = 9 to 13) only where some material has one of them.
-  uint parameters = PT_TEXTURE_USES(kTextureUsesGltfLayers) ? 14u
-                    : PT_TEXTURE_USES(kTextureUsesEmission) ? 9u
-                                                            : 8u;
+  // gltf's extension textures (i = 9 to 13) only where some material has one of them, its sheen
+  // textures (14 and 15) where one has them.
+  uint parameters = PT_TEXTURE_USES(kTextureUsesGltfSheen)    ? 16u
+                    : PT_TEXTURE_USES(kTextureUsesGltfLayers) ? 14u
+                    : PT_TEXTURE_USES(kTextureUsesEmission)   ? 9u
+                                                              : 8u;
   for (uint i = 0u; i < parameters; ++i) {
     PT_TEXTURE_LOOP_TICK();
     uint texture = i == 0u ? (PT_TEXTURE_USES(kTextureUsesReflectance) ? t.reflectance : kNoTexture)
@@ -525,8 +539,9 @@ PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextu
                    : i == 5u ? (PT_TEXTURE_USES(kTextureUsesRoughness) ? t.vRoughness : kNoTexture)
                    : i == 6u ? (PT_TEXTURE_USES(kTextureUsesMedium) ? t.thickness : kNoTexture)
                    : i == 7u ? (PT_TEXTURE_USES(kTextureUsesMedium) ? t.g : kNoTexture)
-                   : PT_TEXTURE_USES(kTextureUsesGltfLayers) && i > 8u ? gltfLayerTexture(t, i)
-                                                                       : t.emission;
+                   : PT_TEXTURE_USES(kTextureUsesGltfLayers | kTextureUsesGltfSheen) && i > 8u
+                       ? gltfLayerTexture(t, i)
+                       : t.emission;
     if (texture == kNoTexture) continue;
     vec3 value = evalTextureAt(PT_TEXTURES_ARG texture, uv);
     if (i == 0u) {
@@ -563,7 +578,7 @@ PT_INLINE Material resolveMaterialAt(PT_TEXTURES_PARAM Material m, MaterialTextu
           m.type == kMaterialGltf ? clamp(value.x, 0.0f, 1.0f) : max(value.x, 1.17549435e-38f);
     } else if (i == 7u) {
       m.g = clamp(value.x, -0.999f, 0.999f);
-    } else if (PT_TEXTURE_USES(kTextureUsesGltfLayers) && i > 8u) {
+    } else if (PT_TEXTURE_USES(kTextureUsesGltfLayers | kTextureUsesGltfSheen) && i > 8u) {
       m = gltfLayerTextureApplied(m, i, value);
     } else {
       m.emission = max(value, vec3(0.0f));
@@ -709,27 +724,13 @@ PT_INLINE vec3 bumpedNormal(PT_TEXTURES_PARAM uint displacement, TriangleDerivat
 inline uint packTangent(vec3 t, float w) {
   float l1 = abs(t.x) + abs(t.y) + abs(t.z);
   if (!(l1 > 0.0f) || !(l1 < 3.0e38f)) return 0u;
-  vec3 o = t / l1;
-  float x = o.x, y = o.y;
-  if (o.z < 0.0f) {
-    x = (1.0f - abs(o.y)) * (o.x >= 0.0f ? 1.0f : -1.0f);
-    y = (1.0f - abs(o.x)) * (o.y >= 0.0f ? 1.0f : -1.0f);
-  }
-  const auto quantize = [](float v) { return uint(clamp(v, -1.0f, 1.0f) * 16383.0f + 16383.5f); };
-  return 0x80000000u | (w < 0.0f ? 0x40000000u : 0u) | quantize(x) << 15u | quantize(y);
+  return 0x80000000u | (w < 0.0f ? 0x40000000u : 0u) | packOctahedral(t);
 }
 #endif
 // The direction of a packed tangent (unit; zero where there is none).
 PT_INLINE vec3 unpackTangent(uint packed) {
   if (packed == 0u) return vec3(0.0f);
-  float x = float((packed >> 15u) & 0x7FFFu) / 16383.0f - 1.0f;
-  float y = float(packed & 0x7FFFu) / 16383.0f - 1.0f;
-  vec3 t = vec3(x, y, 1.0f - abs(x) - abs(y));
-  if (t.z < 0.0f) {
-    t.x = (1.0f - abs(y)) * (x >= 0.0f ? 1.0f : -1.0f);
-    t.y = (1.0f - abs(x)) * (y >= 0.0f ? 1.0f : -1.0f);
-  }
-  return normalize(t);
+  return unpackOctahedral(packed);
 }
 // A triangle's tangent at barycentrics b (the vertices' interpolated, not made unit) and, in w,
 // the sign of its bitangent (v0's); w = 0 where the triangle has no tangents.

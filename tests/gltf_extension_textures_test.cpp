@@ -1,6 +1,8 @@
 // The textures of glTF's material extensions (host/scene/gltf/gltf_extension_textures.h):
-// transmissionTexture (R), clearcoatTexture (R), clearcoatRoughnessTexture (G), specularTexture
-// (A) and specularColorTexture (RGB, sRGB), each times its factor, bound with its texture
+// transmissionTexture (R), clearcoatTexture (R), clearcoatRoughnessTexture (G),
+// clearcoatNormalTexture (RGB, linear, its scale), specularTexture (A), specularColorTexture (RGB,
+// sRGB), sheenColorTexture (RGB, sRGB) and sheenRoughnessTexture (A), each times its factor, bound
+// with its texture
 // coordinate set and KHR_texture_transform as the core textures are; rendered as the factors
 // they stand for where constant, and over the regions they cover where not, on both backends.
 #include <gtest/gtest.h>
@@ -37,7 +39,8 @@ float byteValue(std::uint8_t c) {
 }
 
 // Every extension texture of one material, each bound to its parameter with its channel times
-// its factor; clearcoatNormalTexture alone is warned, the volume's thicknessTexture is not.
+// its factor (the coat's normal map as read, its scale apart); nothing warned (the volume's
+// thicknessTexture is ignored by design).
 TEST(GltfExtensionTextures, EachIsBoundWithItsChannelTimesItsFactor) {
   GltfBuilder b;
   const int t = test::addTexture(b, test::png(2, 1, 4, kTwoTexels));
@@ -52,24 +55,28 @@ TEST(GltfExtensionTextures, EachIsBoundWithItsChannelTimesItsFactor) {
               {"clearcoatTexture", info},
               {"clearcoatRoughnessFactor", 0.6},
               {"clearcoatRoughnessTexture", info},
-              {"clearcoatNormalTexture", info}}},
+              {"clearcoatNormalTexture", {{"index", t}, {"scale", 0.7}}}}},
             {"KHR_materials_specular",
              {{"specularFactor", 0.9},
               {"specularTexture", info},
               {"specularColorFactor", {2.0, 1.0, 0.5}},
-              {"specularColorTexture", info}}}}}});
+              {"specularColorTexture", info}}},
+            {"KHR_materials_sheen",
+             {{"sheenColorFactor", {0.9, 0.6, 0.3}},
+              {"sheenColorTexture", info},
+              {"sheenRoughnessFactor", 0.4},
+              {"sheenRoughnessTexture", info}}}}}});
   b.scene({test::addSquare(b, m)});
   const Scene scene = loadGltfSceneBytes(b.gltf(), "test.gltf");
-  ASSERT_EQ(scene.warnings.size(), 1u);
-  EXPECT_EQ(scene.warnings[0],
-            "test.gltf: materials[0].extensions.KHR_materials_clearcoat.clearcoatNormalTexture: "
-            "not read (the shading normal of the layers below is used)");
+  EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
   ASSERT_EQ(scene.materialTextures.size(), 1u);
   const MaterialTextures& mt = scene.materialTextures[0];
-  for (uint texture :
-       {mt.transmission, mt.clearcoat, mt.clearcoatRoughness, mt.specular, mt.specularColour}) {
+  for (uint texture : {mt.transmission, mt.clearcoat, mt.clearcoatRoughness, mt.specular,
+                       mt.specularColour, mt.sheenColour, mt.sheenRoughness, mt.clearcoatNormal}) {
     ASSERT_NE(texture, kNoTexture);
   }
+  EXPECT_EQ(mt.scale, 0.7f);  // the coat normal map's scale
+  EXPECT_EQ(mt.normalMap, kNoTexture);
   for (int texel : {0, 1}) {
     const float s = texel == 0 ? 0.25f : 0.75f;
     const std::uint8_t* c = &kTwoTexels[std::size_t(4 * texel)];
@@ -82,10 +89,26 @@ TEST(GltfExtensionTextures, EachIsBoundWithItsChannelTimesItsFactor) {
     EXPECT_NEAR(colour.x, 2.0f * srgbToLinear(byteValue(c[0])), 1e-6f);
     EXPECT_NEAR(colour.y, 1.0f * srgbToLinear(byteValue(c[1])), 1e-6f);
     EXPECT_NEAR(colour.z, 0.5f * srgbToLinear(byteValue(c[2])), 1e-6f);
+    const vec3 sheen = extensionTextureAt(scene, mt.sheenColour, s);
+    EXPECT_NEAR(sheen.x, 0.9f * srgbToLinear(byteValue(c[0])), 1e-6f);
+    EXPECT_NEAR(sheen.y, 0.6f * srgbToLinear(byteValue(c[1])), 1e-6f);
+    EXPECT_NEAR(sheen.z, 0.3f * srgbToLinear(byteValue(c[2])), 1e-6f);
+    EXPECT_NEAR(extensionTextureAt(scene, mt.sheenRoughness, s).x, 0.4f * byteValue(c[3]), 1e-6f);
+    const vec3 normal = extensionTextureAt(scene, mt.clearcoatNormal, s);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(normal[k], byteValue(c[k]), 1e-6f) << k;
   }
   // The factors stay in the material: a texture multiplies them, it does not replace them.
-  EXPECT_EQ(scene.materials[0].transmittance.x, 0.5f);
-  EXPECT_EQ(scene.materials[0].eta.y, 0.9f);
+  const Material& material = scene.materials[0];
+  EXPECT_EQ(material.transmittance.x, 0.5f);
+  EXPECT_EQ(material.eta.y, 0.9f);
+  EXPECT_NE(material.nSamples & kGltfSheen, 0u);
+  EXPECT_EQ(gltfSheenColour(material), vec3(0.9f, 0.6f, 0.3f));
+  EXPECT_NEAR(gltfSheenRoughness(material), 0.4f, 1e-5f);
+  // The sheen textures and the coat's normal are what the shader compiles in for the scene.
+  const uint features =
+      prepareScene(Scene(scene), RenderSettings{.width = 8, .height = 8}).effects.textureFeatures;
+  EXPECT_NE(features & kTextureUsesGltfSheen, 0u);
+  EXPECT_NE(features & kTextureUsesCoatNormal, 0u);
 }
 
 // A specular texture without an alpha channel is the factor alone (the specification's alpha of

@@ -1,14 +1,15 @@
 // glTF's material extensions as the reader reads them (host/scene/gltf/
 // gltf_material_extensions.h, gltf_volume_media.h): KHR_materials_transmission, _volume,
-// _clearcoat and _specular into the material's fields, the volume's attenuation as an absorbing
-// medium inside the mesh, the extensions' textures and the unsimulated extensions warned (errors
-// with --strict), bad values refused with their JSON path.
+// _clearcoat, _specular and _sheen into the material's fields, the volume's attenuation as an
+// absorbing medium inside the mesh, the unsimulated extensions warned (errors with --strict), bad
+// values refused with their JSON path.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "gltf_material_fields.h"
 #include "scene/gltf/gltf_scene.h"
 #include "scene/gltf/gltf_volume_media.h"
 #include "tests/gltf_builder.h"
@@ -132,31 +133,43 @@ TEST(GltfMaterialExtensions, AttenuationIsAnAbsorbingMediumInsideTheMesh) {
   EXPECT_TRUE(thin.media.empty());
 }
 
-TEST(GltfMaterialExtensions, TexturesAndUnsimulatedExtensionsWarnOnceAndAreErrorsWithStrict) {
-  GltfBuilder b =
-      twoTriangles({{"KHR_materials_clearcoat",
-                     {{"clearcoatFactor", 1.0}, {"clearcoatNormalTexture", {{"index", 0}}}}},
-                    {"KHR_materials_sheen", {{"sheenColorFactor", {1, 1, 1}}}}},
-                   {{"KHR_materials_clearcoat",
-                     {{"clearcoatFactor", 1.0}, {"clearcoatNormalTexture", {{"index", 0}}}}},
-                    {"KHR_materials_sheen", {{"sheenColorFactor", {1, 1, 1}}}}});
-  b.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_materials_sheen"};
+// KHR_materials_sheen's factors: the colour and the roughness in gltf_material_fields.h's
+// fields, flagged; a colour of 0 (the default) is no sheen.
+TEST(GltfMaterialExtensions, SheenFactorsIntoTheMaterialsFields) {
+  const GltfBuilder b =
+      twoTriangles({{"KHR_materials_sheen",
+                     {{"sheenColorFactor", {0.9, 0.5, 0.25}}, {"sheenRoughnessFactor", 0.3}}}},
+                   {{"KHR_materials_sheen", {{"sheenRoughnessFactor", 0.3}}}});
   const Scene s = readExtended(b);
-  // One warning per kind: the sheen's (in extensionsUsed, so not again for the materials) and
-  // the clear coat's normal texture's (not again for the second material; the extensions' other
-  // textures are read: gltf_extension_textures_test.cpp).
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+  ASSERT_EQ(s.materials.size(), 2u);
+  const Material& m = s.materials[0];
+  EXPECT_EQ(m.nSamples & 0xFFFFu, kGltfSheen);
+  EXPECT_EQ(gltfSheenColour(m), vec3(0.9f, 0.5f, 0.25f));
+  EXPECT_NEAR(gltfSheenRoughness(m), 0.3f, 1e-5f);
+  EXPECT_EQ(s.materials[1].nSamples, 0u);  // no colour: no sheen, the plain material
+}
+
+TEST(GltfMaterialExtensions, UnsimulatedExtensionsWarnOnceAndAreErrorsWithStrict) {
+  GltfBuilder b = twoTriangles({{"KHR_materials_clearcoat", {{"clearcoatFactor", 1.0}}},
+                                {"KHR_materials_iridescence", {{"iridescenceFactor", 1}}},
+                                {"KHR_materials_anisotropy", {{"anisotropyStrength", 1}}}},
+                               {{"KHR_materials_anisotropy", {{"anisotropyStrength", 1}}}});
+  b.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_materials_iridescence"};
+  const Scene s = readExtended(b);
+  // One warning per kind: the iridescence's (in extensionsUsed, so not again for the material)
+  // and the anisotropy's (not again for the second material).
   ASSERT_EQ(s.warnings.size(), 2u);
   EXPECT_EQ(s.warnings[0],
-            "test.gltf: extensionsUsed[1]: KHR_materials_sheen is not simulated (rendered without "
-            "it)");
-  EXPECT_EQ(
-      s.warnings[1],
-      "test.gltf: materials[0].extensions.KHR_materials_clearcoat.clearcoatNormalTexture: not "
-      "read (the shading normal of the layers below is used)");
+            "test.gltf: extensionsUsed[1]: KHR_materials_iridescence is not simulated (rendered "
+            "without it)");
+  EXPECT_EQ(s.warnings[1],
+            "test.gltf: materials[0].extensions.KHR_materials_anisotropy: not simulated (the "
+            "material renders without it)");
   EXPECT_EQ(s.materials[0].transmittance.y, 1.0f);  // the factor is read
   EXPECT_EQ(extendedErrorOf(b, true),
-            "test.gltf: extensionsUsed[1]: KHR_materials_sheen is not simulated (rendered without "
-            "it) (an error with --strict)");
+            "test.gltf: extensionsUsed[1]: KHR_materials_iridescence is not simulated (rendered "
+            "without it) (an error with --strict)");
 }
 
 TEST(GltfMaterialExtensions, BadValuesNameTheirJsonPath) {
@@ -189,6 +202,15 @@ TEST(GltfMaterialExtensions, BadValuesNameTheirJsonPath) {
          {{"clearcoatFactor", 1}, {"clearcoatTexture", {{"index", 3}}}}}},
        "materials[0].extensions.KHR_materials_clearcoat.clearcoatTexture.index: texture 3 out of "
        "range (the file has 0)"},
+      {{{"KHR_materials_clearcoat",
+         {{"clearcoatFactor", 1}, {"clearcoatNormalTexture", {{"index", 0}, {"scale", "x"}}}}}},
+       "materials[0].extensions.KHR_materials_clearcoat.clearcoatNormalTexture.scale: expected a "
+       "finite number"},
+      {{{"KHR_materials_sheen", {{"sheenColorFactor", {1, 2, 0}}}}},
+       "materials[0].extensions.KHR_materials_sheen.sheenColorFactor[1]: expected a number in "
+       "[0, 1]"},
+      {{{"KHR_materials_sheen", {{"sheenRoughnessFactor", -0.5}}}},
+       "materials[0].extensions.KHR_materials_sheen.sheenRoughnessFactor: -0.5 is not in [0, 1]"},
   };
   for (const auto& [extensions, expected] : cases) {
     EXPECT_EQ(extendedErrorOf(twoTriangles(extensions)), "test.gltf: " + expected);

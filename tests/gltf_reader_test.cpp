@@ -381,14 +381,14 @@ TEST(GltfReader, UnsimulatedFeaturesWarnOnceAndAreErrorsWithStrict) {
   GltfBuilder b = oneTriangle();
   b.doc["meshes"][0]["primitives"].push_back(
       {{"attributes", {{"POSITION", 0}}}, {"mode", 0}});  // points
-  b.doc["extensionsUsed"] = {"KHR_materials_sheen"};
+  b.doc["extensionsUsed"] = {"KHR_materials_iridescence"};
   b.doc["animations"] = json::array({{{"channels", json::array()}, {"samplers", json::array()}}});
   b.node({{"mesh", 0}});
   const Scene s = read(b.gltf());
   EXPECT_EQ(s.triangles.size(), 1u);
   ASSERT_EQ(s.warnings.size(), 3u);
   EXPECT_EQ(s.warnings[0],
-            "test.gltf: extensionsUsed[0]: KHR_materials_sheen is not simulated (rendered "
+            "test.gltf: extensionsUsed[0]: KHR_materials_iridescence is not simulated (rendered "
             "without it)");
   EXPECT_EQ(s.warnings[1],
             "test.gltf: animations: animations are not simulated: the rest pose is rendered");
@@ -396,7 +396,7 @@ TEST(GltfReader, UnsimulatedFeaturesWarnOnceAndAreErrorsWithStrict) {
             "test.gltf: meshes[0].primitives[1].mode: points and lines have no "
             "area and are not rendered");
   EXPECT_EQ(gltfErrorOf(b.gltf(), SceneLoadOptions{.strict = true}),
-            "test.gltf: extensionsUsed[0]: KHR_materials_sheen is not simulated (rendered "
+            "test.gltf: extensionsUsed[0]: KHR_materials_iridescence is not simulated (rendered "
             "without it) (an error with --strict)");
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "common/shared.h"
+#include "gltf_material_fields.h"
 #include "sanitizer_build.h"
 
 // Sanitized builds (ASan + UBSan at -O1) and unoptimized ones run the sampling tests
@@ -60,7 +61,7 @@ inline Material gltfMaterial(vec3 baseColor, float metallic, float roughness, fl
   return m;
 }
 // glTF's material with its extensions (KHR_materials_transmission, _volume, _clearcoat,
-// _specular) as the glTF reader fills them.
+// _specular, _sheen) as the glTF reader fills them, and the coat's own normal as a hit gives it.
 struct GltfLayerParams {
   vec3 base = vec3(0.8f, 0.4f, 0.1f);
   float metallic = 0.0f;
@@ -72,6 +73,9 @@ struct GltfLayerParams {
   float clearcoatRoughness = 0.0f;
   float specular = 1.0f;
   vec3 specularColour = vec3(1.0f);
+  vec3 sheenColour = vec3(0.0f);  // 0: no sheen
+  float sheenRoughness = 0.0f;
+  vec3 coatNormal = vec3(0.0f);  // 0: none (the base's); else in the base's local frame
 };
 inline Material gltfLayered(const GltfLayerParams& p) {
   Material m = gltfMaterial(p.base, p.metallic, p.roughness, p.ior);
@@ -80,6 +84,11 @@ inline Material gltfLayered(const GltfLayerParams& p) {
   m.transmittance = vec3(p.transmission, p.clearcoat, p.clearcoatRoughness * p.clearcoatRoughness);
   m.k = p.specularColour;
   m.eta.y = p.specular;
+  if (p.sheenColour != vec3(0.0f)) {
+    m.nSamples |= kGltfSheen;
+    m = gltfWithSheenRoughness(gltfWithSheenColour(m, p.sheenColour), p.sheenRoughness);
+  }
+  if (p.coatNormal != vec3(0.0f)) m = gltfWithCoatNormal(m, normalize(p.coatNormal));
   return m;
 }
 }  // namespace pt::test

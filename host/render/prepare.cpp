@@ -58,6 +58,7 @@ std::string EffectSet::toString() const {
   add(coatedDiffuse, "coateddiffuse");
   add(gltf, "gltf");
   add(gltfLayers, "gltf-layers");
+  add(gltfSheen, "gltf-sheen");
   add(shadingNormals, "shading-normals");
   add(deltaLights, "delta-lights");
   add(environment, "environment");
@@ -429,6 +430,14 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
       uses(t->clearcoatRoughness, kTextureUsesGltfLayers);
       uses(t->specular, kTextureUsesGltfLayers);
       uses(t->specularColour, kTextureUsesGltfLayers);
+      uses(t->sheenColour, kTextureUsesGltfSheen);
+      uses(t->sheenRoughness, kTextureUsesGltfSheen);
+      uses(t->clearcoatNormal, kTextureUsesCoatNormal);
+      // A clear coat over a normal-mapped base has a normal of its own, the unmapped one.
+      if (m.type == kMaterialGltf && (m.nSamples & kGltfClearcoat) != 0u &&
+          t->normalMap != kNoTexture) {
+        fx.textureFeatures |= kTextureUsesCoatNormal;
+      }
       // A bump map steps by the footprint; alpha is tested in the traversal, at a point.
       uses(t->displacement, kTextureUsesFootprints);
       if (t->alpha != kNoTexture) {
@@ -451,6 +460,7 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
     if (m.type == kMaterialCoatedDiffuse) fx.coatedDiffuse = true;
     if (m.type == kMaterialGltf) fx.gltf = true;
     if (m.type == kMaterialGltf && m.nSamples != 0u) fx.gltfLayers = true;
+    if (m.type == kMaterialGltf && (m.nSamples & kGltfSheen) != 0u) fx.gltfSheen = true;
     if (m.type > kMaterialMirror && bsdfHasNonSpecular(m)) lightSampled = true;
   }
   // Light is sampled from the points where a medium scatters.

@@ -68,6 +68,7 @@ struct EffectSet {
   bool coatedDiffuse = false;
   bool gltf = false;
   bool gltfLayers = false;      // some gltf material uses an extension (transmission, clearcoat...)
+  bool gltfSheen = false;       // some gltf material has KHR_materials_sheen
   bool shadingNormals = false;  // some mesh has vertex normals: shading normals interpolated
   bool deltaLights = false;     // point, spot or distant lights (sampled, never hit)
   bool environment = false;     // an infinite light: rays that leave the scene see it

@@ -47,6 +47,7 @@ inline MaterialTextures noMaterialTextures() {
   t.eta = t.k = t.displacement = t.alpha = t.thickness = t.g = kNoTexture;
   t.emission = t.normalMap = kNoTexture;
   t.transmission = t.clearcoat = t.clearcoatRoughness = t.specular = t.specularColour = kNoTexture;
+  t.sheenColour = t.sheenRoughness = t.clearcoatNormal = kNoTexture;
   t.scale = 1.0f;
   t.normalScale = 1.0f;
   return t;

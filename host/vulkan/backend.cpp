@@ -5,12 +5,14 @@
 #include "vulkan/backend.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
 
 #include "common/check.h"
+#include "sheen_albedo.h"
 #include "vulkan/bdpt.h"
 #include "vulkan/context.h"
 #include "vulkan/device_limits.h"
@@ -53,6 +55,14 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
     return v.empty() ? std::vector<T>{T{}} : v;
   };
   const std::vector<TriangleUVs> uvs = orDummy(scene.uvs);
+  // The materials, and after them the sheen's albedo table where a material has a sheen
+  // (sheenAlbedoNode in pathtrace.comp, from texel sheenAlbedoTexel(scene)).
+  std::vector<uint32_t> materials(scene.materials.size() * sizeof(Material) / sizeof(uint32_t));
+  if (!materials.empty())
+    std::memcpy(materials.data(), scene.materials.data(), materials.size() * 4);
+  if (scene.effects.gltfSheen) {
+    for (float e : kSheenAlbedo) materials.push_back(std::bit_cast<uint32_t>(e));
+  }
   const std::vector<TextureNode> textureNodes = orDummy(scene.textureNodes);
   std::vector<uint32_t> imageWords = orDummy(scene.imageWords);
   imageWords.resize((imageWords.size() + 3) / 4 * 4, 0u);
@@ -74,7 +84,7 @@ RenderBuffers uploadScene(const VulkanContext& ctx, const SceneData& scene,
       {"parameter", &scene.params, sizeof(RenderParams), false},
       {"BVH node and triangle", traversal.data(), traversal.size() * sizeof(uint32_t), true},
       {"triangle", scene.bvh.triangles.data(), scene.bvh.triangles.size() * sizeof(Triangle), true},
-      {"material", scene.materials.data(), scene.materials.size() * sizeof(Material), true},
+      {"material", materials.data(), materials.size() * sizeof(uint32_t), true},
       {"emitter", emitters.data(), emitters.size() * sizeof(Emitter), true},
       {"vertex normal", normals.data(), normals.size() * sizeof(TriangleNormals), true},
       {"light", lights.data(), lights.size() * sizeof(Light), true},
@@ -344,6 +354,7 @@ std::string pathtraceDefinitions(const SceneData& scene, const VulkanRenderOptio
   flag("PT_FX_COATED_DIFFUSE", fx.coatedDiffuse);
   flag("PT_FX_GLTF", fx.gltf);
   flag("PT_FX_GLTF_LAYERS", fx.gltfLayers);
+  flag("PT_FX_GLTF_SHEEN", fx.gltfSheen);
   flag("PT_FX_SHADING_NORMALS", fx.shadingNormals);
   flag("PT_FX_DELTA_LIGHTS", fx.deltaLights);
   flag("PT_FX_ENVIRONMENT", fx.environment);
@@ -355,6 +366,9 @@ std::string pathtraceDefinitions(const SceneData& scene, const VulkanRenderOptio
   define("PT_FX_TEXTURE_FEATURES",
          all ? "kTextureUsesAll" : std::to_string(fx.textureFeatures) + "u");
   define("PT_FX_MEDIUM_KINDS", all ? "0xFFFFFFFFu" : std::to_string(fx.mediumKinds) + "u");
+  if (fx.gltfSheen) {
+    define("PT_SHEEN_ALBEDO_TEXEL", std::to_string(scene.materials.size() * kMaterialTexels));
+  }
   flag("PT_FX_ENVIRONMENT_IMAGE", fx.environmentImage);
   // Scenes with media take the volume integrator (also under --debug-pixel, whose printing it
   // leaves out). Scenes of diffuse and mirror surfaces without any of bsdf.h's materials, the

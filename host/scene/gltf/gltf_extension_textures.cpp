@@ -30,6 +30,13 @@ ExtensionTextureInfo textureInfoOf(const tinygltf::Value& extension, const char*
   if (!object.Has("index")) context.fail(info.where + ".index", "required");
   info.index = textureInfoInteger(object, "index", -1, info.where, context);
   info.texCoord = textureInfoInteger(object, "texCoord", 0, info.where, context);
+  if (object.Has("scale")) {
+    const tinygltf::Value& scale = object.Get("scale");
+    if (!scale.IsNumber() || !std::isfinite(scale.GetNumberAsDouble())) {
+      context.fail(info.where + ".scale", "expected a finite number");
+    }
+    info.scale = scale.GetNumberAsDouble();
+  }
   if (object.Has("extensions")) {
     const tinygltf::Value& extensions = object.Get("extensions");
     if (!extensions.IsObject()) context.fail(info.where + ".extensions", "expected an object");
@@ -50,9 +57,13 @@ ExtensionTextureInfos readExtensionTextureInfos(const tinygltf::Material& m,
     } else if (name == "KHR_materials_clearcoat") {
       infos.clearcoat = textureInfoOf(value, "clearcoatTexture", where, context);
       infos.clearcoatRoughness = textureInfoOf(value, "clearcoatRoughnessTexture", where, context);
+      infos.clearcoatNormal = textureInfoOf(value, "clearcoatNormalTexture", where, context);
     } else if (name == "KHR_materials_specular") {
       infos.specular = textureInfoOf(value, "specularTexture", where, context);
       infos.specularColour = textureInfoOf(value, "specularColorTexture", where, context);
+    } else if (name == "KHR_materials_sheen") {
+      infos.sheenColour = textureInfoOf(value, "sheenColorTexture", where, context);
+      infos.sheenRoughness = textureInfoOf(value, "sheenRoughnessTexture", where, context);
     }
   }
   return infos;
@@ -68,13 +79,17 @@ struct ExtensionTextureUse {
 std::vector<ExtensionTextureUse> extensionTextureUses(const ExtensionTextureInfos& infos,
                                                       const MaterialExtensions& f) {
   const bool coated = f.clearcoat > 0.0;
+  const bool sheen = (f.flags & kGltfSheen) != 0u;
   return {
       {&infos.transmission, infos.transmission.index >= 0 && f.transmission > 0.0},
       {&infos.clearcoat, infos.clearcoat.index >= 0 && coated},
       {&infos.clearcoatRoughness,
        infos.clearcoatRoughness.index >= 0 && coated && f.clearcoatRoughness > 0.0},
       {&infos.specular, infos.specular.index >= 0 && f.specular > 0.0},
-      {&infos.specularColour, infos.specularColour.index >= 0 && f.specularColour != vec3(0.0f)}};
+      {&infos.specularColour, infos.specularColour.index >= 0 && f.specularColour != vec3(0.0f)},
+      {&infos.sheenColour, infos.sheenColour.index >= 0 && sheen},
+      {&infos.sheenRoughness, infos.sheenRoughness.index >= 0 && sheen && f.sheenRoughness > 0.0},
+      {&infos.clearcoatNormal, infos.clearcoatNormal.index >= 0 && coated}};
 }
 
 }  // namespace
@@ -103,6 +118,12 @@ void bindExtensionTextures(const ExtensionTextureInfos& infos, const MaterialExt
   t.clearcoatRoughness = bind(uses[2], TextureChannels::kGreen, vec3(float(f.clearcoatRoughness)));
   t.specular = bind(uses[3], TextureChannels::kAlpha, vec3(float(f.specular)));
   t.specularColour = bind(uses[4], TextureChannels::kSrgb, f.specularColour);
+  // sheenColorFactor x RGB (sRGB), sheenRoughnessFactor x A, the coat's normal map as the core
+  // normalTexture is read (RGB, linear; texture.h's normalMappedNormal, its scale in t.scale).
+  t.sheenColour = bind(uses[5], TextureChannels::kSrgb, f.sheenColour);
+  t.sheenRoughness = bind(uses[6], TextureChannels::kAlpha, vec3(float(f.sheenRoughness)));
+  t.clearcoatNormal = bind(uses[7], TextureChannels::kLinear, vec3(1.0f));
+  if (t.clearcoatNormal != kNoTexture) t.scale = float(infos.clearcoatNormal.scale);
 }
 
 }  // namespace pt::gltf

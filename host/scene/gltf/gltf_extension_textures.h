@@ -1,12 +1,12 @@
 // The textures of glTF's material extensions, bound as the renderer's MaterialTextures (one
 // texture per layer parameter, each times its factor, evaluated at the hit by texture.h as the
 // core textures are): KHR_materials_transmission's transmissionTexture (R),
-// KHR_materials_clearcoat's clearcoatTexture (R) and clearcoatRoughnessTexture (G),
-// KHR_materials_specular's specularTexture (A) and specularColorTexture (RGB, sRGB). Their
-// textureInfo objects are plain JSON values in tinygltf (it has no structure for them): read and
-// checked here. clearcoatNormalTexture is not read (the layered BSDF has one shading frame:
-// warned by readMaterialExtensions); KHR_materials_volume's thicknessTexture is ignored by design
-// (the mesh is the volume).
+// KHR_materials_clearcoat's clearcoatTexture (R), clearcoatRoughnessTexture (G) and
+// clearcoatNormalTexture (RGB, linear, with its scale), KHR_materials_specular's specularTexture
+// (A) and specularColorTexture (RGB, sRGB), KHR_materials_sheen's sheenColorTexture (RGB, sRGB)
+// and sheenRoughnessTexture (A). Their textureInfo objects are plain JSON values in tinygltf (it
+// has no structure for them): read and checked here. KHR_materials_volume's thicknessTexture is
+// ignored by design (the mesh is the volume).
 #pragma once
 
 #include <string>
@@ -26,7 +26,8 @@ struct ExtensionTextureInfo {
   int index = -1;  // -1: absent
   int texCoord = 0;
   tinygltf::ExtensionMap extensions;
-  std::string where;  // its JSON path
+  double scale = 1.0;  // a normal map's (normalTextureInfo's) scale of x and y
+  std::string where;   // its JSON path
   TextureRef ref() const { return TextureRef{index, texCoord, &extensions}; }
 };
 
@@ -37,6 +38,9 @@ struct ExtensionTextureInfos {
   ExtensionTextureInfo clearcoatRoughness;  // KHR_materials_clearcoat.clearcoatRoughnessTexture
   ExtensionTextureInfo specular;            // KHR_materials_specular.specularTexture
   ExtensionTextureInfo specularColour;      // KHR_materials_specular.specularColorTexture
+  ExtensionTextureInfo sheenColour;         // KHR_materials_sheen.sheenColorTexture
+  ExtensionTextureInfo sheenRoughness;      // KHR_materials_sheen.sheenRoughnessTexture
+  ExtensionTextureInfo clearcoatNormal;     // KHR_materials_clearcoat.clearcoatNormalTexture
 };
 
 // The textureInfo objects of m's extensions (materials[...] at `path`), checked: an index and a
@@ -50,7 +54,8 @@ std::vector<TextureRef> readExtensionTextureRefs(const ExtensionTextureInfos& in
                                                  const MaterialExtensions& factors);
 
 // Binds the textures that are read into t (t.transmission, t.clearcoat, ...), each times its
-// factor; a texture left out (warned by the reader) leaves the factor alone.
+// factor; a texture left out (warned by the reader) leaves the factor alone. The coat's normal
+// map's scale goes to t.scale.
 void bindExtensionTextures(const ExtensionTextureInfos& infos, const MaterialExtensions& factors,
                            TextureReader& textures, MaterialTextures& t);
 

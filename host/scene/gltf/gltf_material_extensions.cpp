@@ -49,17 +49,6 @@ vec3 extensionColour(const tinygltf::Value& object, const char* key, vec3 fallba
   return c;
 }
 
-// Textures of an extension that are left out: warned once per texture kind.
-void warnTextures(const tinygltf::Value& object, const std::string& extension,
-                  const std::vector<const char*>& keys, const std::string& where,
-                  Context& context) {
-  for (const char* key : keys) {
-    if (!object.Has(key)) continue;
-    context.warnOnce("texture " + extension + "." + key, where + "." + key,
-                     "not read (the shading normal of the layers below is used)");
-  }
-}
-
 }  // namespace
 
 double unitFactor(double value, const std::string& where, const Context& context) {
@@ -126,9 +115,7 @@ MaterialExtensions readMaterialExtensions(const tinygltf::Material& m, const std
       e.clearcoatRoughness =
           unitFactor(extensionNumber(o, "clearcoatRoughnessFactor", 0.0, where, context),
                      where + ".clearcoatRoughnessFactor", context);
-      // Its textures: gltf_extension_textures.h, but for the coat's normal map: the layered
-      // BSDF has one shading frame, the base's.
-      warnTextures(o, name, {"clearcoatNormalTexture"}, where, context);
+      // Its textures, the coat's normal map among them: gltf_extension_textures.h.
       if (e.clearcoat > 0.0) e.flags |= kGltfClearcoat;
     } else if (name == "KHR_materials_specular") {
       const tinygltf::Value& o = extensionObject(value, where, context);
@@ -137,6 +124,13 @@ MaterialExtensions readMaterialExtensions(const tinygltf::Material& m, const std
       e.specularColour =
           extensionColour(o, "specularColorFactor", vec3(1.0f), false, where, context);
       e.flags |= kGltfSpecular;
+    } else if (name == "KHR_materials_sheen") {
+      const tinygltf::Value& o = extensionObject(value, where, context);
+      e.sheenColour = extensionColour(o, "sheenColorFactor", vec3(0.0f), true, where, context);
+      e.sheenRoughness = unitFactor(extensionNumber(o, "sheenRoughnessFactor", 0.0, where, context),
+                                    where + ".sheenRoughnessFactor", context);
+      // A colour of 0 (the default) is no sheen, whatever its texture holds.
+      if (e.sheenColour != vec3(0.0f)) e.flags |= kGltfSheen;
     } else {
       context.warnOnce("extension " + name, where,
                        "not simulated (the material renders without it)");

@@ -1,8 +1,7 @@
 // The KHR_materials_* extensions of a glTF material that the renderer simulates: _ior,
-// _emissive_strength, _transmission, _volume, _clearcoat and _specular (their factors; their
-// textures: gltf_extension_textures.h, but clearcoatNormalTexture, warned and left out), each
-// checked and read into MaterialExtensions. Any other extension of the material is warned, once
-// per kind.
+// _emissive_strength, _transmission, _volume, _clearcoat, _specular and _sheen (their factors;
+// their textures: gltf_extension_textures.h), each checked and read into MaterialExtensions. Any
+// other extension of the material is warned, once per kind.
 #pragma once
 
 #include <limits>
@@ -29,6 +28,8 @@ struct MaterialExtensions {
   double clearcoatRoughness = 0.0;
   double specular = 1.0;
   vec3 specularColour = vec3(1.0f);
+  vec3 sheenColour = vec3(0.0f);  // KHR_materials_sheen: a colour of 0 is no sheen
+  double sheenRoughness = 0.0;
   uint flags = 0;
   // The volume absorbs (attenuationDistance finite and attenuationColor below 1).
   bool absorbs() const;

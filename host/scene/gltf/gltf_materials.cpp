@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "gltf_material_fields.h"
 #include "scene/reader_helpers.h"
 
 namespace pt::gltf {
@@ -54,6 +55,10 @@ Material readMaterial(const tinygltf::Model& model, int index, Context& context,
                              float(ext.clearcoatRoughness * ext.clearcoatRoughness));
     out.k = ext.specularColour;
     out.eta.y = float(ext.specular);
+    if ((ext.flags & kGltfSheen) != 0u) {
+      out = gltfWithSheenRoughness(gltfWithSheenColour(out, ext.sheenColour),
+                                   float(ext.sheenRoughness));
+    }
   }
   if (extensions) *extensions = ext;
   return out;

@@ -45,7 +45,8 @@ bool isReadExtension(const std::string& name) {
   return name == "KHR_materials_emissive_strength" || name == "KHR_materials_ior" ||
          name == "KHR_materials_transmission" || name == "KHR_materials_volume" ||
          name == "KHR_materials_clearcoat" || name == "KHR_materials_specular" ||
-         name == "KHR_lights_punctual" || name == "KHR_texture_transform";
+         name == "KHR_materials_sheen" || name == "KHR_lights_punctual" ||
+         name == "KHR_texture_transform";
 }
 
 void warnUnsimulated(const tinygltf::Model& model, Context& context) {
