@@ -50,8 +50,7 @@ bool bdptTrace(vec3 origin, vec3 direction, float tMax, bool anyHit, out HitData
 // The random walk of the camera subpath (radiance) or the light subpath from its first vertex,
 // until it has maxVertices vertices (host/cpu/bdpt.cpp's bdptRandomWalk, its steps
 // bdptWalkStep's).
-void bdptRandomWalk(bool radiance, BdptWalk walk, uint maxVertices, uvec2 pixel,
-                    uint sampleIndex) {
+void bdptRandomWalk(bool radiance, BdptWalk walk, uint maxVertices, uvec2 pixel, uint sampleIndex) {
   bool sobol = PT_SOBOL;
   uint seed = params.seed;
   BdptVertex prev = radiance ? cameraPath.v[0] : lightPath.v[0];
@@ -136,8 +135,8 @@ void bdptMain() {
     for (uint s = 0u; s <= lightPath.count; ++s) {
       gLoopIterations++;
       if (!bdptTakesStrategy(s, t, maxDepth, strategyS, strategyT)) continue;
-      BdptStrategyRandom u = bdptStrategyRandom(sobol, filmPixel, sampleIndex, seed,
-                                                params.camera.lensRadius, s, t);
+      BdptStrategyRandom u =
+          bdptStrategyRandom(sobol, filmPixel, sampleIndex, seed, params.camera.lensRadius, s, t);
       BdptConnection c = bdptConnect(s, t, u.uChoose, u.uLight);
       if (!c.found) continue;
       if (c.visibility) {
@@ -146,8 +145,7 @@ void bdptMain() {
         HitData blocker;
         if (bdptTrace(c.from, c.to - c.from, 1.0, /*anyHit=*/true, blocker)) continue;
       }
-      vec3 value =
-          bdptStrategyL(c, t, starts.camera.weight) * bdptStrategyWeight(c, s, t, weighed);
+      vec3 value = bdptStrategyL(c, t, starts.camera.weight) * bdptStrategyWeight(c, s, t, weighed);
       if (t != 1u) {
         L += value;
         continue;

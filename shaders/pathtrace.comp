@@ -207,8 +207,8 @@ MaterialTextures materialTexturesAt(uint i) {
   uvec4 c = texelFetch(materialTextureTexels, at + 2);
   uvec4 d = texelFetch(materialTextureTexels, at + 3);
   // glTF's extension textures: read only in the shaders of scenes that have one.
-  bool layers = (kTextureFeatures & (kTextureUsesGltfLayers | kTextureUsesGltfSheen |
-                                     kTextureUsesCoatNormal)) != 0u;
+  bool layers = (kTextureFeatures &
+                 (kTextureUsesGltfLayers | kTextureUsesGltfSheen | kTextureUsesCoatNormal)) != 0u;
   uvec4 e = layers ? texelFetch(materialTextureTexels, at + 4) : uvec4(kNoTexture);
   uvec4 f = layers ? texelFetch(materialTextureTexels, at + 5) : uvec4(kNoTexture);
   return MaterialTextures(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, uintBitsToFloat(c.y), c.z,
@@ -411,6 +411,8 @@ MediumInterface loadMediumInterface(uint primitive) {
 #include "bdpt_sample.h"
 #include "bdpt_splat.h"
 #include "bdpt_vertex.h"
+
+// After the headers it calls (a block of its own, so that include sorting keeps it last).
 #include "bdpt.glsl"
 #endif
 
