@@ -67,6 +67,8 @@ cmake --build build-asan --target pt_tests -j "$(nproc)"
 # keeps each test in a process of its own, so a test that passes only after another is caught
 # there. A shard that fails prints its whole log (the failing test's name, the report).
 # ray_bench and the Slurm test (ctest labels bench, slurm) are not run here.
+# The same names as CMakeLists.txt's PT_LAVAPIPE_TEST_NAME (files of such tests only are not
+# compiled into this build).
 lavapipeTests='*Vulkan*:*GpuTraversal*:*BothBackends*:*OnVulkan*'
 shards=$((2 * $(nproc)))
 logs=$(mktemp -d)
