@@ -4,6 +4,7 @@
 // suite's name keeps it out of the sanitized run.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -188,6 +189,55 @@ TEST(BdptCli, SplitMergedAndResumedOnVulkan) {
     EXPECT_EQ(std::memcmp(x.pixels.data(), y.pixels.data(), x.pixels.size() * sizeof(vec3)), 0)
         << name;
   }
+}
+
+// Lavapipe's silent loop cap (65,535 iterations an invocation) against one invocation's whole
+// pixel sample: a closed box of white diffuse walls (reflectance 1, so Russian roulette ends no
+// subpath early) to depth 32, under a gaussian filter 12 pixels wide (each light vertex splats
+// over hundreds of pixels). There every sample runs into the cap: the render is given up in one
+// line, exit status 2, and no image is written, since the cut samples' splats may be in the sums
+// already. A device without the cap renders it; at depth 3 lavapipe does too.
+TEST(BdptCli, SamplesPastTheLoopCapAreRefusedOnVulkan) {
+  test::TempDir dir;
+  const std::string box = R"(
+Integrator "bdpt" "integer maxdepth" [ 32 ]
+LookAt 0 0 -0.8  0 0 1  0 1 0
+Camera "perspective" "float fov" [ 60 ]
+Sampler "independent" "integer pixelsamples" [ 1 ]
+PixelFilter "gaussian" "float xradius" [ 12 ] "float yradius" [ 12 ]
+Film "rgb" "integer xresolution" [ 16 ] "integer yresolution" [ 16 ]
+WorldBegin
+Material "diffuse" "rgb reflectance" [ 1 1 1 ]
+Shape "trianglemesh" "point3 P" [ -1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1  1 1 1  -1 1 1 ]
+  "integer indices" [ 0 1 2 0 2 3  4 6 5 4 7 6  0 4 5 0 5 1  3 2 6 3 6 7  0 3 7 0 7 4  1 5 6 1 6 2 ]
+AttributeBegin
+AreaLightSource "diffuse" "rgb L" [ 1 1 1 ]
+Shape "trianglemesh" "point3 P" [ -0.1 0.99 -0.1  0.1 0.99 -0.1  0.1 0.99 0.1  -0.1 0.99 0.1 ]
+  "integer indices" [ 0 2 1 0 3 2 ]
+AttributeEnd
+)";
+  const std::string scene = dir.write("box.pbrt", box).string();
+  const test::PtResult deep =
+      test::runPt("render " + scene + " --backend vulkan --out " + (dir / "deep.exr").string());
+  if (deep.status == 0) {
+    EXPECT_EQ(deep.out.find("llvmpipe"), std::string::npos) << deep.out;
+  } else {
+    EXPECT_EQ(deep.status, 2) << deep.err;
+    EXPECT_NE(deep.err.find("256 pixel samples ran into the device's loop-iteration cap"),
+              std::string::npos)
+        << deep.err;
+    // One line from the error on (a progress line may come before it).
+    const size_t error = deep.err.find("bdpt on ");
+    ASSERT_NE(error, std::string::npos) << deep.err;
+    EXPECT_EQ(std::count(deep.err.begin() + std::ptrdiff_t(error), deep.err.end(), '\n'), 1)
+        << deep.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "deep.exr"));
+  }
+  const test::PtResult shallow =
+      test::runPt("render " + scene + " --backend vulkan --max-depth 3 --out " +
+                  (dir / "shallow.exr").string());
+  EXPECT_EQ(shallow.status, 0) << shallow.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "shallow.exr"));
 }
 
 }  // namespace
