@@ -31,7 +31,6 @@ bool sppmKeepVisiblePoint(SurfacePoint s, VertexKey key, uint depth, vec3 beta) 
   vp.s = s;
   vp.key = key;
   vp.beta = beta;
-  vp.depth = depth;
   sppmPoints[gSppmPixel] = vp;
   // (Only a point that carries light to its pixel goes into the grid.)
   sppmFound[gSppmPixel] = vec4(s.p, beta != vec3(0.0) ? 1.0 : 0.0);
@@ -82,7 +81,7 @@ void sppmGather(SppmGridShape grid, vec3 p, uint hit, vec3 beta, vec3 wi) {
     vec3 d = point.xyz - p;
     if (dot(d, d) <= point.w * point.w) {
       SppmVisiblePoint vp = sppmPoints[i];
-      if (sppmPhotonCounts(vp, hit, params.maxDepth)) {
+      if (sppmPhotonCounts(hit, params.maxDepth)) {
         sppmAddPhoton(i, sppmPhotonFlux(vp, beta, wi));
       }
     }

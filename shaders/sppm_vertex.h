@@ -38,24 +38,22 @@ PT_INLINE VertexKey sppmPhotonKey(uint photon, uint iteration, uint vertex) {
 }
 
 // The point a camera path keeps for the photons of one iteration (pbrt-v4's VisiblePoint): the
-// shading point (its BSDF, position and wo), its random streams' key, the camera path's
-// throughput up to it, the camera sample's weight included, and the scattering events of the
-// camera path counting the one at the point.
+// shading point (its BSDF, position and wo), its random streams' key, and the camera path's
+// throughput up to it, the camera sample's weight included.
 struct SppmVisiblePoint {
   SurfacePoint s;
   VertexKey key;
   vec3 beta;
-  uint depth;
 };
 
-// Whether a photon at its surface hit `hit` (0: the first after the light) adds to visible point
-// vp: not its first hit (direct light, which the camera paths' light samples count), and only
-// while the whole path, light to camera, has at most maxDepth scattering events (vp.depth + hit),
-// as the path tracer's paths have. pbrt-v4 limits the photon alone (hit < maxDepth), which
-// takes paths of up to maxDepth + vp.depth - 1 events, more than its path tracer of the same
-// maxdepth where the camera sees the visible point through glass or water.
-PT_INLINE bool sppmPhotonCounts(PT_IN(SppmVisiblePoint) vp, uint hit, uint maxDepth) {
-  return hit > 0u && vp.depth + hit <= maxDepth;
+// Whether a photon at its surface hit `hit` (0: the first after the light) adds to the visible
+// points near it: not at its first hit (direct light, which the camera paths' light samples
+// count), and at most maxDepth - 1 hits after it, whatever the camera path's depth (pbrt-v4's
+// definition). Where the camera sees a visible point through glass or water, the paths so
+// gathered have up to maxDepth + (camera scattering events before the point) - 1 events: more
+// than the path tracer of the same maxdepth takes, as in pbrt-v4.
+PT_INLINE bool sppmPhotonCounts(uint hit, uint maxDepth) {
+  return hit > 0u && hit < maxDepth;
 }
 
 // Whether the BSDF of shading point s has a diffuse lobe (pbrt-v4's IsDiffuse of its flags):

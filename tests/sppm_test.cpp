@@ -161,18 +161,14 @@ TEST(SppmPixelUpdate, MatchesTheFormula) {
   EXPECT_NEAR(L.x, 2.0 + tau.x / (4.0 * 100.0 * M_PI * r * r), 1e-5);
 }
 
-TEST(SppmPhotons, CountOnlyPathsTheDepthAllows) {
-  // A photon's first hit is direct light; later hits count where the camera path's events up
-  // to the visible point and the photon's hits make at most maxDepth scattering events.
-  SppmVisiblePoint vp{};
-  vp.depth = 1;  // seen directly
-  EXPECT_FALSE(sppmPhotonCounts(vp, 0, 5));
-  EXPECT_TRUE(sppmPhotonCounts(vp, 1, 5));
-  EXPECT_TRUE(sppmPhotonCounts(vp, 4, 5));
-  EXPECT_FALSE(sppmPhotonCounts(vp, 5, 5));
-  vp.depth = 3;  // seen through two specular events
-  EXPECT_TRUE(sppmPhotonCounts(vp, 2, 5));
-  EXPECT_FALSE(sppmPhotonCounts(vp, 3, 5));
+TEST(SppmPhotons, CountAtTheHitsPbrtV4Counts) {
+  // pbrt-v4's rule: a photon's first hit is direct light (the camera paths' light samples count
+  // it); its hits 1 to maxDepth - 1 count, however deep the camera path's visible point is.
+  EXPECT_FALSE(sppmPhotonCounts(0, 5));
+  EXPECT_TRUE(sppmPhotonCounts(1, 5));
+  EXPECT_TRUE(sppmPhotonCounts(4, 5));
+  EXPECT_FALSE(sppmPhotonCounts(5, 5));
+  EXPECT_FALSE(sppmPhotonCounts(1, 1));
 }
 
 TEST(SppmPixelUpdate, RenderedRadiiFollowThePhotonCounts) {

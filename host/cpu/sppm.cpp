@@ -83,7 +83,7 @@ void sppmTracePhoton(const SceneData& scene, const PathScene& ps, const SppmGrid
     if (depth > 0u) {
       grid.forWithin(s.p, [&](uint32_t i) {
         SppmPixel& px = pixels[i];
-        if (sppmPhotonCounts(px.vp, depth, maxDepth)) {
+        if (sppmPhotonCounts(depth, maxDepth)) {
           px.addPhoton(sppmPhotonFlux(ps, px.vp, beta, -ray.direction));
         }
       });
@@ -204,7 +204,7 @@ CpuRenderStats renderSppm(const SceneData& scene, const CpuRenderOptions& option
         const PathEnd visiblePoint = [&px, maxDepth](const SurfacePoint& s, const VertexKey& key,
                                                      uint depth, vec3 beta) {
           if (!sppmTakesVisiblePoint(s, depth, maxDepth)) return false;
-          px.vp = SppmVisiblePoint{s, key, beta, depth};
+          px.vp = SppmVisiblePoint{s, key, beta};
           px.hasVp = true;
           return true;
         };
