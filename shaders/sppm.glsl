@@ -66,10 +66,9 @@ void sppmAddPhoton(uint i, vec3 flux) {
             valid ? 1ul : 1ul + (1ul << PT_SPPM_INVALID_SHIFT));
 }
 
-// The photon at shading point p, its `hit`-th surface hit, with throughput beta, arrived along
-// -wi: adds its flux to every visible point within its radius listed in the bucket of p's cell
-// (SppmGrid::forWithin).
-void sppmGather(SppmGridShape grid, vec3 p, uint hit, vec3 beta, vec3 wi) {
+// The photon at shading point p, with throughput beta, arrived along -wi: adds its flux to every
+// visible point within its radius listed in the bucket of p's cell (SppmGrid::forWithin).
+void sppmGather(SppmGridShape grid, vec3 p, vec3 beta, vec3 wi) {
   ivec3 cell;
   if (grid.entries == 0u || !sppmGridCell(grid, p, cell)) return;
   uint h = sppmGridBucket(grid, cell);
@@ -80,10 +79,7 @@ void sppmGather(SppmGridShape grid, vec3 p, uint hit, vec3 beta, vec3 wi) {
     vec4 point = sppmGridPoints[i];
     vec3 d = point.xyz - p;
     if (dot(d, d) <= point.w * point.w) {
-      SppmVisiblePoint vp = sppmPoints[i];
-      if (sppmPhotonCounts(hit, params.maxDepth)) {
-        sppmAddPhoton(i, sppmPhotonFlux(vp, beta, wi));
-      }
+      sppmAddPhoton(i, sppmPhotonFlux(sppmPoints[i], beta, wi));
     }
   }
 }
@@ -131,9 +127,9 @@ void sppmTracePhotons() {
       Triangle tri = loadTriangle(hit.triangle);
       SurfacePoint s = surfacePointAt(hit.triangle, tri, hitBarycentrics(origin, direction, tri),
                                       -direction, noRayDifferential());
-      // The first hit is direct light, which the camera paths' light samples count.
-      if (depth > 0u && (pass.debugPixel == ~0u || depth == pass.debugPixel)) {
-        sppmGather(grid, s.p, depth, beta, -direction);
+      if (sppmPhotonCounts(depth, params.maxDepth) &&
+          (pass.debugPixel == ~0u || depth == pass.debugPixel)) {
+        sppmGather(grid, s.p, beta, -direction);
       }
       if (depth == pass.debugPixel) break;
       BdptVertex v = bdptSurfaceVertex(s, tri.emitter, key, beta, 0.0, prev);

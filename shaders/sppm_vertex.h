@@ -47,11 +47,12 @@ struct SppmVisiblePoint {
 };
 
 // Whether a photon at its surface hit `hit` (0: the first after the light) adds to the visible
-// points near it: not at its first hit (direct light, which the camera paths' light samples
-// count), and at most maxDepth - 1 hits after it, whatever the camera path's depth (pbrt-v4's
-// definition). Where the camera sees a visible point through glass or water, the paths so
-// gathered have up to maxDepth + (camera scattering events before the point) - 1 events: more
-// than the path tracer of the same maxdepth takes, as in pbrt-v4.
+// points near it (the same for all of them, so asked once a hit): not at its first hit (direct
+// light, which the camera paths' light samples count), and at most maxDepth - 1 hits after it,
+// whatever the camera path's depth (pbrt-v4's definition). Where the camera sees a visible point
+// through glass or water, the paths so gathered have up to maxDepth + (camera scattering events
+// before the point) - 1 events: more than the path tracer of the same maxdepth takes, as in
+// pbrt-v4.
 PT_INLINE bool sppmPhotonCounts(uint hit, uint maxDepth) {
   return hit > 0u && hit < maxDepth;
 }

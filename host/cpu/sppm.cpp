@@ -79,13 +79,10 @@ void sppmTracePhoton(const SceneData& scene, const PathScene& ps, const SppmGrid
     const Triangle& tri = scene.bvh.triangles[hit->triangle];
     const SurfacePoint s = surfacePointAt(ps, hit->triangle, tri, hit->barycentrics, -ray.direction,
                                           noRayDifferential());
-    // The first hit is direct light, which the camera paths' light samples count.
-    if (depth > 0u) {
+    if (sppmPhotonCounts(depth, maxDepth)) {
       grid.forWithin(s.p, [&](uint32_t i) {
         SppmPixel& px = pixels[i];
-        if (sppmPhotonCounts(depth, maxDepth)) {
-          px.addPhoton(sppmPhotonFlux(ps, px.vp, beta, -ray.direction));
-        }
+        px.addPhoton(sppmPhotonFlux(ps, px.vp, beta, -ray.direction));
       });
     }
     BdptVertex v = bdptSurfaceVertex(s, tri.emitter, key, beta, 0.0f, prev);
