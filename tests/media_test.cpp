@@ -118,6 +118,45 @@ TEST(MediaBothBackends, CameraInsideAMediumWithoutBoundary) {
   }
 }
 
+// A diffuse wall lit by a point light, the camera and the light inside an absorbing medium
+// without boundary: only light samples reach the light, and their shadow rays carry
+// exp(-sigma_a r) over their length r, the camera ray exp(-sigma_a d) over its own. Every
+// pixel is the closed form up to its sampling of the pixel's area.
+TEST(MediaBothBackends, LightSamplesThroughAMediumWithoutBoundary) {
+  const vec3 sigma(0.1f, 0.3f, 0.6f);
+  const vec3 light(0.1f, 0.2f, -1.0f);
+  const float intensity = 2.0f, albedo = 0.5f;
+  Scene scene;
+  scene.camera = camera(vec3(0, 0, -3), vec3(0, 0, 0), 20.0f, 8);
+  scene.materials = {Material{vec3(albedo), kMaterialDiffuse, vec3(0.0f), 0}};
+  scene.media = {homogeneous(sigma, vec3(0.0f))};
+  scene.cameraMedium = 0;
+  Light point{};
+  point.type = kLightPoint;
+  point.position = light;
+  point.radiance = vec3(intensity);
+  scene.lights = {point};
+  addShape(scene, quad(vec3(0, 0, 0), vec3(0, 3, 0), vec3(3, 0, 0)), 0,
+           MediumInterface{kVacuum, kVacuum});
+  const SceneData data = prepare(scene, 5);
+  ASSERT_FALSE(data.effects.interfaceSurfaces);
+  const Comparison cmp = renderBoth(data, 64);
+  expectAgreement(cmp);
+  const Image expected = pixelAverages(data.params.camera, [&](const Ray& r) {
+    const glm::dvec3 o(r.origin), d = glm::normalize(glm::dvec3(r.direction));
+    const double t = -o.z / d.z;  // the wall at z = 0, t along the unit ray
+    const glm::dvec3 x = o + t * d, toLight = glm::dvec3(light) - x;
+    const double r2 = glm::dot(toLight, toLight), dist = std::sqrt(r2);
+    const double cosine = -toLight.z / dist;  // the wall faces -z
+    glm::dvec3 L;
+    for (int c = 0; c < 3; ++c) {
+      L[c] = albedo / kPi * intensity * cosine / r2 * std::exp(-double(sigma[c]) * (dist + t));
+    }
+    return L;
+  });
+  expectNearClosedForm(cmp, expected, 0.0, 0.01);
+}
+
 TEST(MediaBothBackends, WhiteFurnaceOfAScatteringMediumRendersTheEnvironment) {
   expectTheEnvironment(furnace(vec3(0.0f), vec3(0.5f, 1.0f, 2.0f), 0.6f, 160));
 }

@@ -22,6 +22,16 @@ namespace {
 bool traceShadowThroughMedia(const SceneData& scene, const PathScene& ps, const LightSample& ls,
                              uint medium, uint hero, vec2 uLight, ShadowTransmittance& tr,
                              uint64_t& rays) {
+  // Without interface surfaces every surface on the way blocks the ray: an any-hit query
+  // answers that (cheaper than the closest hit, which the loop below needs to cross
+  // interfaces), and the whole segment lies in `medium`.
+  if (!scene.effects.interfaceSurfaces) {
+    if (!traceShadowRay(scene, ls, uLight, rays)) return false;
+    if (medium == kNoMedium) return true;
+    const vec3 d = ls.to - ls.from;
+    const float length = glm::length(d);
+    return trackShadowSegment(ps, tr, medium, hero, ls.from, d / length, length);
+  }
   const Intersection test =
       scene.params.fastIntersection != 0u ? Intersection::kFast : Intersection::kWatertight;
   vec3 from = ls.from;
