@@ -48,12 +48,29 @@ int availableCpus() {
   return int(std::max(1u, std::thread::hardware_concurrency()));
 }
 
+void prefetchHitRecords(const SceneData& scene, const Hit& hit) {
+  const auto prefetch = [](const auto* record) {
+    __builtin_prefetch(record);
+    __builtin_prefetch(reinterpret_cast<const char*>(record) + sizeof(*record) - 1);
+  };
+  prefetch(&scene.bvh.triangles[hit.triangle]);
+  prefetch(&scene.cpuCopies().shading[hit.triangle]);
+  if (!scene.normals.empty()) prefetch(&scene.normals[hit.primitive]);
+  if (!scene.uvs.empty()) prefetch(&scene.uvs[hit.primitive]);
+}
+
 std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Intersection test,
                                   uvec2 pixel, uint32_t sampleIndex, uint depth, float tMax) {
-  if (!scene.effects.alphaCutouts) return closestHit(scene.wideBvh(), ray, tMax, test);
-  const AlphaCutouts cutouts = AlphaCutouts::ofPathRay(scene, pixel, sampleIndex, depth);
-  const HitFilter filter = cutouts.filter();
-  return closestHit(scene.wideBvh(), ray, tMax, test, &filter);
+  std::optional<Hit> hit;
+  if (!scene.effects.alphaCutouts) {
+    hit = closestHit(scene.wideBvh(), ray, tMax, test);
+  } else {
+    const AlphaCutouts cutouts = AlphaCutouts::ofPathRay(scene, pixel, sampleIndex, depth);
+    const HitFilter filter = cutouts.filter();
+    hit = closestHit(scene.wideBvh(), ray, tMax, test, &filter);
+  }
+  if (hit) prefetchHitRecords(scene, *hit);
+  return hit;
 }
 
 std::optional<Hit> closestShadowHit(const SceneData& scene, const Ray& ray, Intersection test,

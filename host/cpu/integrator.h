@@ -68,6 +68,12 @@ std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Inters
 std::optional<Hit> closestShadowHit(const SceneData& scene, const Ray& ray, Intersection test,
                                     vec2 uLight);
 
+// Asks the cache for what the shading point of `hit` reads (its triangle, shading constants,
+// vertex normals and texture coordinates) all at once: on a large mesh each is a cache miss,
+// and read where the shading needs them, one after another, their latencies add up.
+// closestSurface does it for the hits it returns.
+void prefetchHitRecords(const SceneData& scene, const Hit& hit);
+
 // Alpha cut-outs (texture.h's alphaKeepsHit) as the traversal's filter of one ray's hits; u is
 // the ray's number (texture.h's pathAlphaRandom, shadowAlphaRandom).
 struct AlphaCutouts {

@@ -386,6 +386,7 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
   LightSample light[kMaxLanes];
   Lanes3 shadowFrom, shadowDir;
   RayPrecomputed prepared[kMaxLanes];
+  Hit laneHit[kMaxLanes];
   // The ray's closest hit with cut-outs passed by, where the scene has them (integrator.cpp's
   // closestSurface and occluded).
   auto closest = [&](size_t i, bool degenerate, bool enters, Hit& found) {
@@ -496,14 +497,21 @@ void sampleRadianceLanesImpl(const SceneData& scene, const uvec2* pixels, size_t
     uint32_t degenerate = 0;
     const uint32_t enters =
         setUpRays(copies.wide, path.origin, path.direction, INFINITY, active, prepared, degenerate);
+    // Every lane's hit first, its records asked of the cache at once (prefetchHitRecords), so
+    // that the lanes' cache misses overlap; then their shading points.
+    uint32_t hits = 0;
     forEachLane(active, [&](size_t i) {
       ++rays;
-      Hit hit;
-      if (!closest(i, (degenerate >> i & 1u) != 0u, (enters >> i & 1u) != 0u, hit)) {
+      if (!closest(i, (degenerate >> i & 1u) != 0u, (enters >> i & 1u) != 0u, laneHit[i])) {
         // The ray leaves the scene: the infinite light's radiance, weighed as an emitter's.
         addEnvironmentFound(ps, path.state[i], path.direction.get(i));
         return;
       }
+      prefetchHitRecords(scene, laneHit[i]);
+      hits |= 1u << i;
+    });
+    forEachLane(hits, [&](size_t i) {
+      const Hit& hit = laneHit[i];
       const Triangle& tri = scene.bvh.triangles[hit.triangle];
       surface[i] = surfacePointAt(ps, hit.triangle, tri, hit.barycentrics, -path.direction.get(i),
                                   path.state[i].rd);
