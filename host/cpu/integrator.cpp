@@ -57,6 +57,7 @@ void prefetchHitRecords(const SceneData& scene, const Hit& hit) {
   prefetch(&scene.cpuCopies().shading[hit.triangle]);
   if (!scene.normals.empty()) prefetch(&scene.normals[hit.primitive]);
   if (!scene.uvs.empty()) prefetch(&scene.uvs[hit.primitive]);
+  if (!scene.mediumInterfaces.empty()) prefetch(&scene.mediumInterfaces[hit.primitive]);
 }
 
 std::optional<Hit> closestSurface(const SceneData& scene, const Ray& ray, Intersection test,

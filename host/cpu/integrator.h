@@ -69,8 +69,8 @@ std::optional<Hit> closestShadowHit(const SceneData& scene, const Ray& ray, Inte
                                     vec2 uLight);
 
 // Asks the cache for what the shading point of `hit` reads (its triangle, shading constants,
-// vertex normals and texture coordinates) all at once: on a large mesh each is a cache miss,
-// and read where the shading needs them, one after another, their latencies add up.
+// vertex normals, texture coordinates and medium interface) all at once: on a large mesh each is a
+// cache miss, and read where the shading needs them, one after another, their latencies add up.
 // closestSurface does it for the hits it returns.
 void prefetchHitRecords(const SceneData& scene, const Hit& hit);
 
