@@ -57,7 +57,8 @@ PT_CONST uint kDimLightSubpath = 0x40000000u;
 
 struct BdptVertex {
   SurfacePoint s;  // kBdptSurface: the shading point (material, normals, frame, wo); a light
-                   // vertex on a triangle: the light's material and offset scale
+                   // vertex on a triangle or a sphere: the light's material, offset scale and
+                   // area
   vec3 p;          // its position (an infinite light's: where its ray starts)
   uint type;       // kBdptCamera, kBdptLight, kBdptSurface
   vec3 ng;         // unit geometric normal on a surface (a triangle light's emitting side, a
