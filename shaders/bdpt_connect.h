@@ -76,7 +76,8 @@ PT_INLINE BdptConnection noBdptConnection(PT_IN(BdptVertex) any) {
 
 // Samples a light for strategy (1, t) from camera vertex pt (pbrt-v4's SampleLi after the
 // light sampler's choice): the emitter from the alias table with uChoose, the point or
-// direction on it with uLight. found false where it sends nothing towards pt.
+// direction on it with uLight (a sphere light's: uniform in the cone it subtends, lights.h).
+// found false where it sends nothing towards pt.
 PT_INLINE BdptConnection bdptSampleLightFrom(PT_SCENE_PARAM PT_IN(BdptVertex) pt, vec2 uChoose,
                                              vec2 uLight) {
   BdptConnection c = noBdptConnection(pt);
@@ -96,10 +97,18 @@ PT_INLINE BdptConnection bdptSampleLightFrom(PT_SCENE_PARAM PT_IN(BdptVertex) pt
     } else {
       a = sampleAnalyticLight(light, pt.p, uLight, PT_PARAMS.sceneRadius);
     }
-    c.sampled = bdptEmptyVertex(kBdptLight, a.target, vec3(0.0f), pt.key);
-    c.sampled.lightType = light.type;
-    c.sampled.emitter = index;
-    c.sampled.w = -a.wi;
+    if (PT_HAS_SPHERE_LIGHTS && light.type == kLightSphere) {
+      // The cone's sample is a point of the sphere: an area light's vertex there, with its
+      // outward normal (the shadow ray's end, a.target, lies just outside along it), so that
+      // the MIS densities are an area light's (pbrt-v4 weighs its sphere's cone sample so).
+      vec3 n = normalize(a.target - light.position);
+      c.sampled = bdptSphereLightVertex(PT_SCENE_ARG index, light, n, vec3(0.0f), pt.key);
+    } else {
+      c.sampled = bdptEmptyVertex(kBdptLight, a.target, vec3(0.0f), pt.key);
+      c.sampled.lightType = light.type;
+      c.sampled.emitter = index;
+      c.sampled.w = -a.wi;
+    }
     wi = a.wi;
     Li = a.Li;
     pdf = a.pdf;

@@ -12,7 +12,9 @@
 // for that light sampler); a spot light's emission directions are uniform in its outer cone
 // (pbrt-v4 samples its smoothstep falloff); an infinite light's vertex stores the direction
 // light travels (pbrt-v4 places it a unit along the ray). Lambertian and mirror surfaces are
-// path_vertex.h's two-sided ones.
+// path_vertex.h's two-sided ones. A sphere light is an area light, as pbrt-v4's BDPT takes it:
+// its points are drawn on the analytic sphere (uniform by area, outward normals) while rays
+// find the triangles that stand for it, as the path tracer's light sampling already does.
 #ifndef PT_BDPT_VERTEX_H
 #define PT_BDPT_VERTEX_H
 
@@ -44,8 +46,8 @@ PT_CONST uint kBdptCamera = 0u;   // the camera's lens point (the pinhole)
 PT_CONST uint kBdptLight = 1u;    // a light's point, or a direction at infinity
 PT_CONST uint kBdptSurface = 2u;  // a surface hit, which may emit (an area light)
 
-// What a light vertex lies on: the analytic lights' kLight* (point, spot, distant, infinite),
-// or an emissive triangle.
+// What a light vertex lies on: the analytic lights' kLight* (point, spot, distant, infinite,
+// sphere), or an emissive triangle.
 PT_CONST uint kBdptLightTriangle = kLightTypeCount;
 
 // The first dimension of a light subpath's random numbers (sampling.h): vertex j draws
@@ -55,11 +57,13 @@ PT_CONST uint kDimLightSubpath = 0x40000000u;
 
 struct BdptVertex {
   SurfacePoint s;  // kBdptSurface: the shading point (material, normals, frame, wo); a light
-                   // vertex on a triangle: the light's material and offset scale
+                   // vertex on a triangle or a sphere: the light's material, offset scale and
+                   // area
   vec3 p;          // its position (an infinite light's: where its ray starts)
   uint type;       // kBdptCamera, kBdptLight, kBdptSurface
-  vec3 ng;         // unit geometric normal on a surface (a triangle light's emitting side);
-                   // zero elsewhere (camera, point, spot, and lights at infinity)
+  vec3 ng;         // unit geometric normal on a surface (a triangle light's emitting side, a
+                   // sphere light's outward normal); zero elsewhere (camera, point, spot, and
+                   // lights at infinity)
   uint lightType;  // kBdptLight: kLight* or kBdptLightTriangle
   vec3 ns;         // shading normal (ng without one)
   uint emitter;    // the Emitter it emits by (a light vertex, an emissive surface), or none
@@ -220,6 +224,29 @@ PT_INLINE BdptVertex bdptTriangleLightVertex(PT_SCENE_PARAM uint emitter, vec3 p
   return v;
 }
 
+// The area of sphere light `light`: its points' density by area is the inverse.
+PT_INLINE float bdptSphereLightArea(Light light) {
+  return 4.0f * kPi * light.radius * light.radius;
+}
+
+// The point of sphere light `light` (Emitter index `emitter`) with unit outward normal n, for a
+// light subpath or a light sample: an area emitter on the analytic sphere (its material, the
+// triangles', emits its radiance outwards), whose points have the density 1 / area by area.
+PT_INLINE BdptVertex bdptSphereLightVertex(PT_SCENE_PARAM uint emitter, Light light, vec3 n,
+                                           vec3 beta, VertexKey key) {
+  BdptVertex v = bdptEmptyVertex(kBdptLight, light.position + light.radius * n, beta, key);
+  v.lightType = kLightSphere;
+  v.emitter = emitter;
+  v.ng = n;
+  v.ns = n;
+  v.s.material = loadMaterial(PT_SCENE_ARG light.material);
+  v.s.material.emission = light.radiance;
+  vec3 ap = abs(v.p);
+  v.s.magnitude = max(ap.x, max(ap.y, ap.z));
+  v.s.area = bdptSphereLightArea(light);
+  return v;
+}
+
 // ---- What a vertex does to light -------------------------------------------------------------
 
 // Whether a light vertex or emissive surface v emits on both sides.
@@ -276,7 +303,9 @@ PT_INLINE vec3 bdptLe(PT_SCENE_PARAM PT_IN(BdptVertex) v, PT_IN(BdptVertex) towa
   if (v.type == kBdptLight && v.lightType == kLightInfinite) {
     return environmentFound(PT_SCENE_ARG - w).Le;
   }
-  if (v.type == kBdptLight && v.lightType != kBdptLightTriangle) return vec3(0.0f);
+  if (v.type == kBdptLight && v.lightType != kBdptLightTriangle && v.lightType != kLightSphere) {
+    return vec3(0.0f);  // a point or spot light: no ray finds it
+  }
   float cosEmit = dot(v.ng, w);
   if (bdptTwoSided(v)) cosEmit = abs(cosEmit);
   return cosEmit > 0.0f ? v.s.material.emission : vec3(0.0f);
@@ -300,8 +329,8 @@ PT_INLINE float bdptPdfLight(PT_SCENE_PARAM PT_IN(BdptVertex) v, PT_IN(BdptVerte
     float invDist2 = 1.0f / dot(d, d);
     float pdfDir;
     if (bdptOnSurface(v)) {
-      // An emissive triangle: cosine-weighted on the emitting side (either side, half each,
-      // where it emits on both).
+      // An emissive triangle or a sphere light: cosine-weighted on the emitting side (either
+      // side, half each, where it emits on both).
       pdfDir =
           bdptTwoSided(v) ? abs(dot(v.ng, w)) * (0.5f * kInvPi) : max(dot(v.ng, w), 0.0f) * kInvPi;
     } else if (v.lightType == kLightSpot) {
@@ -320,15 +349,20 @@ PT_INLINE float bdptPdfLight(PT_SCENE_PARAM PT_IN(BdptVertex) v, PT_IN(BdptVerte
 // The density with which a light subpath starts at light vertex (or emissive surface) v, seen
 // from vertex `next` (pbrt-v4's PDFLightOrigin): the light's probability times the density of
 // the point on it; for the infinite light, the solid-angle density of the direction from next.
+// A surface vertex on a sphere light's triangle takes the analytic sphere's density by area,
+// with which the light's points are drawn (sampleBdptLightStart, strategy s = 1).
 PT_INLINE float bdptPdfLightOrigin(PT_SCENE_PARAM PT_IN(BdptVertex) v, PT_IN(BdptVertex) next) {
   vec3 w = bdptDirection(v, next);
   if (w == vec3(0.0f)) return 0.0f;
   if (bdptIsInfiniteLight(v)) {
     return v.lightType == kLightInfinite ? environmentFound(PT_SCENE_ARG - w).lightPdf : 0.0f;
   }
-  float pmf = loadEmitter(PT_SCENE_ARG v.emitter).pmf;
-  if (bdptOnSurface(v)) return pmf / v.s.area;
-  return pmf;  // a point or spot light: a delta in position
+  Emitter e = loadEmitter(PT_SCENE_ARG v.emitter);
+  if (PT_HAS_SPHERE_LIGHTS && v.type == kBdptSurface && (e.triangle & kEmitterLight) != 0u) {
+    return e.pmf / bdptSphereLightArea(loadLight(PT_SCENE_ARG e.triangle & ~kEmitterLight));
+  }
+  if (bdptOnSurface(v)) return e.pmf / v.s.area;
+  return e.pmf;  // a point or spot light: a delta in position
 }
 
 // The density with which vertex v, reached from prev (the camera has none), samples vertex
@@ -393,7 +427,19 @@ PT_INLINE BdptLightStart sampleBdptLightStart(PT_SCENE_PARAM vec2 uChoose, vec2 
     ls.vertex.lightType = light.type;
     ls.vertex.emitter = index;
     Le = light.radiance;
-    if (light.type == kLightPoint || light.type == kLightSpot) {
+    if (PT_HAS_SPHERE_LIGHTS && light.type == kLightSphere) {
+      // A uniform point of the sphere (by area), a cosine-weighted direction about its outward
+      // normal (pbrt-v4's diffuse area light's SampleLe); the ray leaves from just outside it,
+      // where the triangles that stand for it, inside the sphere, are not in its way.
+      vec3 n = sampleUniformSphere(uPos);
+      ls.vertex = bdptSphereLightVertex(PT_SCENE_ARG index, light, n, vec3(0.0f), key);
+      vec3 local = sampleCosineHemisphere(uDir);
+      cosTheta = local.z;
+      ls.direction = localToWorld(local, n);
+      ls.pdfDir = cosTheta * kInvPi;
+      ls.pdfPos = 1.0f / ls.vertex.s.area;
+      ls.origin = offsetRayOrigin(ls.vertex.p, n, ls.vertex.s.magnitude);
+    } else if (light.type == kLightPoint || light.type == kLightSpot) {
       ls.origin = light.position;
       ls.pdfPos = 1.0f;
       if (light.type == kLightPoint) {

@@ -41,6 +41,19 @@ SceneData bdptTestScene(const std::string& config, int size, int maxDepth, uint 
   return prepareScene(std::move(scene), settings);
 }
 
+// tests/data/sphere-lights.pbrt (two sphere lights over a diffuse floor) at size x size pixels,
+// rendered with the given integrator and depth.
+SceneData sphereLightsScene(int size, int maxDepth, uint integrator) {
+  RenderSettings settings;
+  settings.width = size;
+  settings.height = size;
+  settings.maxDepth = maxDepth;
+  settings.integrator = integrator;
+  SceneData data = prepareScene(loadScene(test::kSphereLightsScene), settings);
+  EXPECT_TRUE(data.effects.sphereLights);
+  return data;
+}
+
 // The image cut into square blocks, each estimate the block's summed pixel values: per pixel
 // sample (every one an independent draw of the whole estimator), the sum of what it adds to
 // each block, and over the samples the mean and variance of those sums. With `stripes`, each
@@ -150,14 +163,11 @@ void expectBlocksAgree(const BdptBlockStats& a, const BdptBlockStats& b, double 
   EXPECT_EQ(blocksThatDisagree(a, b, pixels, what, /*report=*/true), 0) << what;
 }
 
-// The path tracer's and BDPT's block estimates of a scene (with pixel filter `filter`, where
-// one is given; BDPT's splats spread by `splats`).
-void renderBothWays(const std::string& config, int size, int maxDepth, int sppPath, int sppBdpt,
+// The path tracer's and BDPT's block estimates of a scene of size x size pixels, prepared for
+// each (pt, bd); BDPT's splats spread by `splats`.
+void renderBothWays(const SceneData& pt, const SceneData& bd, int size, int sppPath, int sppBdpt,
                     BdptBlockStats& path, BdptBlockStats& bdpt,
-                    const std::optional<PixelFilterDesc>& filter = std::nullopt,
                     BdptSplats splats = BdptSplats::kFilter) {
-  const SceneData pt = bdptTestScene(config, size, maxDepth, kIntegratorPath, filter);
-  const SceneData bd = bdptTestScene(config, size, maxDepth, kIntegratorBdpt, filter);
   uint64_t rays = 0;
   for (int s = 0; s < sppPath; ++s) {
     for (int y = 0; y < size; ++y) {
@@ -181,6 +191,16 @@ void renderBothWays(const std::string& config, int size, int maxDepth, int sppPa
   }
 }
 
+// The same for a scene of configs/ (with pixel filter `filter`, where one is given).
+void renderBothWays(const std::string& config, int size, int maxDepth, int sppPath, int sppBdpt,
+                    BdptBlockStats& path, BdptBlockStats& bdpt,
+                    const std::optional<PixelFilterDesc>& filter = std::nullopt,
+                    BdptSplats splats = BdptSplats::kFilter) {
+  renderBothWays(bdptTestScene(config, size, maxDepth, kIntegratorPath, filter),
+                 bdptTestScene(config, size, maxDepth, kIntegratorBdpt, filter), size, sppPath,
+                 sppBdpt, path, bdpt, splats);
+}
+
 TEST(BdptConverges, CornellBoxMatchesThePathTracer) {
   constexpr int kSize = 24;
   BdptBlockStats path(kSize, kSize, 8), bdpt(kSize, kSize, 8);
@@ -196,16 +216,25 @@ TEST(BdptConverges, GlossyMaterialsMatchThePathTracer) {
   expectBlocksAgree(path, bdpt, kSize * kSize, "cornell-materials");
 }
 
+// Sphere lights: light subpaths start on the analytic sphere, strategy s = 1 samples its cone,
+// camera subpaths find its triangles; all weighed with the sphere's density by area.
+TEST(BdptConverges, SphereLightsMatchThePathTracer) {
+  constexpr int kSize = 24;
+  BdptBlockStats path(kSize, kSize, 8), bdpt(kSize, kSize, 8);
+  renderBothWays(sphereLightsScene(kSize, 4, kIntegratorPath),
+                 sphereLightsScene(kSize, 4, kIntegratorBdpt), kSize, 256, 128, path, bdpt);
+  expectBlocksAgree(path, bdpt, kSize * kSize, "sphere-lights");
+}
+
 // pbrt's check: each strategy alone, without its weight, estimates the light of its depth,
 // which all strategies of that depth together estimate weighed (a diffuse scene: every strategy
 // samples every path). Both come of the same samples: the bound is the spread of their
 // difference. Returns the number of blocks (and images) that fail it, each reported where
 // `report`.
-int strategiesThatDisagree(const std::optional<PixelFilterDesc>& filter, BdptSplats splats, int spp,
-                           bool stripes, bool report) {
+int strategiesThatDisagree(const SceneData& data, BdptSplats splats, int spp, bool stripes,
+                           bool report) {
   constexpr int blockSize = 8;
-  constexpr int kSize = 16;
-  const SceneData data = bdptTestScene("cornell-box.json", kSize, 3, kIntegratorBdpt, filter);
+  const int kSize = int(data.params.camera.width);
   const BdptSplatter splatter(data.params.camera);
   const int strategies[][2] = {{0, 3}, {1, 2}, {2, 1}, {0, 4}, {1, 3}, {2, 2}, {3, 1}};
   std::vector<BdptBlockStats> diffs(std::size(strategies),
@@ -255,8 +284,25 @@ int strategiesThatDisagree(const std::optional<PixelFilterDesc>& filter, BdptSpl
   return failed;
 }
 
+// The same on the Cornell box at 16x16 and depth 3 (with pixel filter `filter`, where one is
+// given).
+int strategiesThatDisagree(const std::optional<PixelFilterDesc>& filter, BdptSplats splats, int spp,
+                           bool stripes, bool report) {
+  return strategiesThatDisagree(bdptTestScene("cornell-box.json", 16, 3, kIntegratorBdpt, filter),
+                                splats, spp, stripes, report);
+}
+
 TEST(BdptStrategies, EachAloneMatchesItsDepthWeighed) {
   EXPECT_EQ(strategiesThatDisagree(std::nullopt, BdptSplats::kFilter, 96, false, /*report=*/true),
+            0);
+}
+
+// The same with sphere lights: s = 1 alone (the cone's samples), s = 0 alone (the triangles a
+// camera subpath finds), light tracing alone (the sphere's points and cosine-weighted
+// directions) each estimate their depth's light.
+TEST(BdptStrategies, EachAloneMatchesItsDepthWeighedWithSphereLights) {
+  EXPECT_EQ(strategiesThatDisagree(sphereLightsScene(16, 3, kIntegratorBdpt), BdptSplats::kFilter,
+                                   96, false, /*report=*/true),
             0);
 }
 
@@ -276,8 +322,16 @@ BdptFullPath bdptFullPath(const PathScene& ps, const BdptPath& camera, uint n, i
   BdptFullPath f;
   f.x.assign(camera.v, camera.v + n);
   const BdptVertex& end = f.x[n - 1];
-  f.light = bdptTriangleLightVertex(ps, end.emitter, end.p, vec2(0.0f), vec3(1.0f),
-                                    end.key);  // untextured: b unread
+  const Emitter e = loadEmitter(ps, end.emitter);
+  if ((e.triangle & kEmitterLight) != 0u) {
+    // A sphere light's triangle: the light's vertex at the same point, with its normal.
+    const Light light = loadLight(ps, e.triangle & ~kEmitterLight);
+    f.light = bdptSphereLightVertex(ps, end.emitter, light, end.ng, vec3(1.0f), end.key);
+    f.light.p = end.p;
+  } else {
+    f.light = bdptTriangleLightVertex(ps, end.emitter, end.p, vec2(0.0f), vec3(1.0f),
+                                      end.key);  // untextured: b unread
+  }
   f.fromCamera.assign(n, 0.0f);
   f.fromLight.assign(n, 0.0f);
   for (uint i = 1; i < n; ++i) {
@@ -336,16 +390,16 @@ float bdptWeightSum(const PathScene& ps, const BdptFullPath& f, bool uniform) {
   return sum;
 }
 
-// For the complete paths that camera subpaths of cornell-mirror find (diffuse and mirror
-// surfaces, the area light), the largest |sum of weights - 1|, and how many paths had a delta
-// vertex.
+// For the complete paths that camera subpaths of a scene find (cornell-mirror's: diffuse and
+// mirror surfaces, the area light), the largest |sum of weights - 1|, how many paths had a delta
+// vertex and how many ended on a sphere light.
 struct BdptWeightCheck {
   float worst = 0.0f;
   int paths = 0;
   int withMirror = 0;
+  int onSphere = 0;
 };
-BdptWeightCheck checkBdptWeights(bool uniform, int wrongVertex) {
-  const SceneData data = bdptTestScene("cornell-mirror.json", 16, 6, kIntegratorBdpt);
+BdptWeightCheck checkBdptWeights(bool uniform, int wrongVertex, const SceneData& data) {
   const PathScene ps = data.pathScene();
   BdptWeightCheck check;
   uint64_t rays = 0;
@@ -363,6 +417,7 @@ BdptWeightCheck checkBdptWeights(bool uniform, int wrongVertex) {
           bool mirror = false;
           for (uint i = 1; i + 1 < n; ++i) mirror = mirror || f.x[i].s.scatter == kScatterMirror;
           check.withMirror += mirror ? 1 : 0;
+          check.onSphere += (loadEmitter(ps, f.x.back().emitter).triangle & kEmitterLight) != 0u;
           ++check.paths;
           check.worst = std::max(check.worst, std::abs(bdptWeightSum(ps, f, uniform) - 1.0f));
         }
@@ -370,6 +425,10 @@ BdptWeightCheck checkBdptWeights(bool uniform, int wrongVertex) {
     }
   }
   return check;
+}
+BdptWeightCheck checkBdptWeights(bool uniform, int wrongVertex) {
+  return checkBdptWeights(uniform, wrongVertex,
+                          bdptTestScene("cornell-mirror.json", 16, 6, kIntegratorBdpt));
 }
 
 TEST(BdptMisWeights, SumToOneOverTheStrategiesOfAPath) {
@@ -386,6 +445,16 @@ TEST(BdptMisWeights, TheCheckCatchesWrongWeights) {
   const BdptWeightCheck wrongPdf = checkBdptWeights(/*uniform=*/false, /*wrongVertex=*/1);
   EXPECT_GT(wrongPdf.paths, 50);
   EXPECT_GT(wrongPdf.worst, 1e-2f);
+}
+
+// Paths that end on a sphere light's triangles: every strategy takes the analytic sphere's
+// density by area for the light's point (s = 0 as the light subpath's start and s = 1 do).
+TEST(BdptMisWeights, SumToOneWithSphereLights) {
+  const BdptWeightCheck check = checkBdptWeights(/*uniform=*/false, /*wrongVertex=*/-1,
+                                                 sphereLightsScene(16, 5, kIntegratorBdpt));
+  EXPECT_GT(check.paths, 200);
+  EXPECT_EQ(check.onSphere, check.paths);
+  EXPECT_LT(check.worst, 1e-4f);
 }
 
 // The same seed gives the same bits, on one thread or two (splats summed exactly).

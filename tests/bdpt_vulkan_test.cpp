@@ -116,10 +116,11 @@ TEST(BdptVulkan, SplatsUnderAWideFilterAgree) {
   expectAgreement(renderBoth(mitchell, 2));
 }
 
-// One strategy alone agrees with the CPU's and lights the image.
-void expectStrategyAgrees(int s, int t) {
-  const SceneData box = bdptSceneOf(loadScene(test::kConfigs / "cornell-box.json"));
-  const StrategyImages r = renderStrategy(box, s, t, 2);
+// One strategy alone agrees with the CPU's and lights the image (the Cornell box's, or
+// `scene`'s).
+void expectStrategyAgrees(int s, int t, const std::filesystem::path& scene) {
+  const SceneData data = bdptSceneOf(loadScene(scene));
+  const StrategyImages r = renderStrategy(data, s, t, 2);
   EXPECT_EQ(r.stats.invalidSamples, 0u);
   EXPECT_EQ(r.stats.validationErrors, 0u);
   EXPECT_GT(r.cpuMean, 0.0);
@@ -127,6 +128,19 @@ void expectStrategyAgrees(int s, int t) {
   const DiffStats diff = diffImages(r.gpu, r.cpu, 1e-3);
   EXPECT_LE(double(diff.pixelsOverThreshold), 0.005 * double(diff.pixelCount))
       << "rmse " << diff.rmse;
+}
+void expectStrategyAgrees(int s, int t) {
+  expectStrategyAgrees(s, t, test::kConfigs / "cornell-box.json");
+}
+
+// Two sphere lights (tests/data/sphere-lights.pbrt): light subpaths that start on the analytic
+// sphere, strategy s = 1's samples of its cone, camera subpaths that find its triangles. Light
+// tracing (2, 1) alone: only the light subpaths' starts and their splats.
+TEST(BdptVulkan, SphereLightsAgreeWithTheCpuReference) {
+  const SceneData spheres = bdptSceneOf(loadScene(test::kSphereLightsScene));
+  ASSERT_TRUE(spheres.effects.sphereLights);
+  expectAgreement(renderBoth(spheres, 2));
+  expectStrategyAgrees(2, 1, test::kSphereLightsScene);
 }
 
 // Light tracing (2, 1): every bit of it splats (a device that dropped its splats would leave

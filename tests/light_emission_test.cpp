@@ -72,9 +72,21 @@ vec3 regionCentroid(const Triangle& t, int r) {
   return r == 3 ? c : 0.5f * (corners[r] + c);  // a corner triangle's centroid
 }
 
+// The octant of the unit sphere that unit n lies in (by the signs of its components), and the
+// octant's centre direction: the regions of a sphere light, each an eighth of its area.
+int octantOf(vec3 n) {
+  return (n.x < 0.0f ? 1 : 0) + (n.y < 0.0f ? 2 : 0) + (n.z < 0.0f ? 4 : 0);
+}
+vec3 octantCentre(int r) {
+  return normalize(
+      vec3((r & 1) != 0 ? -1.0f : 1.0f, (r & 2) != 0 ? -1.0f : 1.0f, (r & 4) != 0 ? -1.0f : 1.0f));
+}
+
 struct EmitterCells {
   uint emitter = 0;
   bool onTriangle = false;
+  bool onSphere = false;  // a sphere light: its directions in each point's own normal frame
+  Light sphere{};
   Triangle tri{};
   Frame frame{vec3(0, 0, 1)};
   BdptVertex vertex{};  // a sample's vertex: its light's record
@@ -84,7 +96,8 @@ struct EmitterCells {
 
 // Draws `samples` light starts and compares the histogram of (emitter, region of its surface,
 // direction cell in its frame) with the densities' integrals; with `wrongDirection` a triangle's
-// direction density is taken uniform over its emitting side instead of cosine-weighted.
+// or sphere's direction density is taken uniform over its emitting side instead of
+// cosine-weighted.
 test::Chi2Result emissionChi2(const SceneData& scene, int samples, bool wrongDirection,
                               uint32_t seed) {
   const PathScene ps = scene.pathScene();
@@ -113,6 +126,10 @@ test::Chi2Result emissionChi2(const SceneData& scene, int samples, bool wrongDir
       e.tri = scene.bvh.triangles[ps.emitters[e.emitter].triangle];
       e.frame = Frame(s.vertex.ng);
       e.regions = 4;
+    } else if (s.vertex.lightType == kLightSphere) {
+      e.onSphere = true;
+      e.sphere = scene.lights[ps.emitters[e.emitter].triangle & ~kEmitterLight];
+      e.regions = 8;
     } else if (s.vertex.lightType == kLightSpot) {
       const Light& light = scene.lights[ps.emitters[e.emitter].triangle & ~kEmitterLight];
       e.frame = Frame(light.direction);
@@ -142,8 +159,14 @@ test::Chi2Result emissionChi2(const SceneData& scene, int samples, bool wrongDir
       const double b2 = glm::dot(glm::cross(b - a, p - a), n) / area2;
       region = regionOf(1.0 - b1 - b2, b1, b2);
     }
+    Frame frame = e.frame;
+    if (e.onSphere) {
+      EXPECT_NEAR(length(s.vertex.p - e.sphere.position), e.sphere.radius, 1e-5f);
+      region = octantOf(s.vertex.ng);
+      frame = Frame(s.vertex.ng);
+    }
     const size_t cell =
-        e.first + size_t(region) * dirCells + size_t(grid.cellOf(e.frame.toLocal(s.direction)));
+        e.first + size_t(region) * dirCells + size_t(grid.cellOf(frame.toLocal(s.direction)));
     observed[cell] += 1.0;
   }
 
@@ -155,22 +178,30 @@ test::Chi2Result emissionChi2(const SceneData& scene, int samples, bool wrongDir
     for (int r = 0; r < e.regions; ++r) {
       BdptVertex v = e.vertex;
       double regionProbability;
+      Frame frame = e.frame;
       if (e.onTriangle) {
         v.p = regionCentroid(e.tri, r);
         BdptVertex towards = bdptEmptyVertex(kBdptSurface, v.p + e.frame.n, vec3(1.0f), v.key);
         regionProbability = double(bdptPdfLightOrigin(ps, v, towards)) * double(v.s.area) / 4.0;
+      } else if (e.onSphere) {
+        // Per unit area on the sphere, times an eighth of its area.
+        v = bdptSphereLightVertex(ps, e.emitter, e.sphere, octantCentre(r), vec3(1.0f), v.key);
+        frame = Frame(v.ng);
+        BdptVertex towards = bdptEmptyVertex(kBdptSurface, v.p + v.ng, vec3(1.0f), v.key);
+        const double area = 4.0 * std::numbers::pi * double(e.sphere.radius) * e.sphere.radius;
+        regionProbability = double(bdptPdfLightOrigin(ps, v, towards)) * area / 8.0;
       } else {
         BdptVertex towards = bdptEmptyVertex(kBdptSurface, v.p + vec3(0, 0, 1), vec3(1.0f), v.key);
         regionProbability = double(bdptPdfLightOrigin(ps, v, towards));
       }
       const bool twoSided = e.onTriangle && bdptTwoSided(v);
       auto pdfDir = [&](glm::vec3 local) {
-        if (wrongDirection && e.onTriangle) {
+        if (wrongDirection && (e.onTriangle || e.onSphere)) {
           const double side = twoSided ? 0.5 : (local.z > 0.0f ? 1.0 : 0.0);
           return side / (2.0 * std::numbers::pi);
         }
         const BdptVertex next =
-            bdptEmptyVertex(kBdptSurface, v.p + e.frame.toWorld(local), vec3(1.0f), v.key);
+            bdptEmptyVertex(kBdptSurface, v.p + frame.toWorld(local), vec3(1.0f), v.key);
         return double(bdptPdfLight(ps, v, next));
       };
       const std::vector<double> dir = test::expectedCounts(grid, pdfDir, samples);
@@ -196,6 +227,19 @@ TEST(LightEmissionChi2, AWrongDirectionDensityFails) {
   const SceneData scene = emissionScene(dir);
   const test::Chi2Result r = emissionChi2(scene, 400000, true, 3u);
   EXPECT_LT(r.pValue, 1e-6) << "chi2 " << r.statistic << ", " << r.dof << " dof";
+}
+
+// The same for tests/data/sphere-lights.pbrt's two sphere lights: points uniform by area on the
+// sphere (its octants), directions cosine-weighted about each point's outward normal.
+TEST(LightEmissionChi2, SphereLightsMatchTheirDensities) {
+  const SceneData scene =
+      prepareScene(loadScene(test::kSphereLightsScene), RenderSettings{.width = 8, .height = 8});
+  ASSERT_EQ(scene.params.emitterCount, 2u);
+  const test::Chi2Result r = emissionChi2(scene, 200000, false, 5u);
+  EXPECT_GE(r.pValue, 1e-4) << "chi2 " << r.statistic << ", " << r.dof << " dof, "
+                            << r.zeroDensityHits << " samples where the density is 0";
+  const test::Chi2Result wrong = emissionChi2(scene, 200000, true, 5u);
+  EXPECT_LT(wrong.pValue, 1e-6) << "chi2 " << wrong.statistic << ", " << wrong.dof << " dof";
 }
 
 }  // namespace

@@ -45,6 +45,9 @@ void forEachHighwayTarget(const std::vector<int64_t>& targets, const Body& body)
 
 // The scene files in configs/.
 inline const std::filesystem::path kConfigs = std::filesystem::path(PT_SOURCE_DIR) / "configs";
+// Two sphere area lights over a diffuse floor (BDPT's and SPPM's tests of sphere lights).
+inline const std::filesystem::path kSphereLightsScene =
+    std::filesystem::path(PT_SOURCE_DIR) / "tests/data/sphere-lights.pbrt";
 
 // A UV sphere of 2 * rings * segments triangles (minus the pole slivers' neighbours), with
 // outward winding; vertices shared exactly between neighbouring triangles.

@@ -92,7 +92,6 @@ void checkBdptScene(const SceneData& scene, const std::string& what,
                      " yet (use the path integrator)");
   };
   if (scene.effects.media || scene.params.mediaPresent != 0u) refuse("participating media");
-  if (scene.effects.sphereLights) refuse("sphere lights");
 }
 
 uint bdptMaxDepth(const SceneData& scene) {

@@ -23,7 +23,7 @@ std::optional<BdptStrategy> parseBdptStrategy(const std::string& text);
 
 // Throws InputError naming `what` (the scene file) where the scene asks for what the
 // integrators that trace light subpaths (bdpt, and sppm's photons: `integrator`) do not do yet:
-// participating media, sphere lights.
+// participating media.
 void checkBdptScene(const SceneData& scene, const std::string& what,
                     const std::string& integrator = "bdpt");
 
