@@ -5,6 +5,7 @@
 // edges, all against hand-computed values.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -180,6 +181,62 @@ TEST(MipMap, EightBitLevelsAreEncodedAsTheImage) {
           .x;
   const double c = 188.0 / 255.0;
   EXPECT_NEAR(v, std::pow((c + 0.055) / 1.055, 2.4), 1e-6);
+}
+
+// Every byte an 8-bit level can take, for sRGB and two gammas: a 512-texel grey image of byte
+// pairs (a, b) has a level 1 of their linear means, each stored as the byte whose encoded
+// value is nearest: the number of the 255 thresholds (the linear values of the encoded
+// (k - 1/2) / 255) at or below the mean. Read back with the point filter in level 1, each
+// texel is that byte's decoded value. Means within 1e-5 of a threshold are skipped (float
+// rounding may put them on either side).
+TEST(MipMap, EightBitLevelsTakeTheNearestEncodedByte) {
+  for (const std::string encoding : {"sRGB", "gamma 2.2", "gamma 0.45"}) {
+    const double gamma = encoding == "sRGB" ? 0.0 : std::stod(encoding.substr(6));
+    const auto decode = [&](double c) {
+      if (gamma != 0.0) return std::pow(c, gamma);
+      return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+    };
+    std::vector<double> thresholds;
+    for (int k = 1; k <= 255; ++k) thresholds.push_back(double(float(decode((k - 0.5) / 255.0))));
+    TextureImage image;
+    image.width = 512;
+    image.height = 1;
+    image.channels = 1;
+    // The pairs' second bytes: spread over 0..255, and near white for the last 16 pairs.
+    const auto second = [](int i) { return i < 240 ? (i * 37 + 11) % 256 : 255 - (i - 240) / 2; };
+    for (int i = 0; i < 256; ++i) {
+      image.bytes.push_back(uint8_t(i));
+      image.bytes.push_back(uint8_t(second(i)));
+    }
+    Scene scene;
+    TextureBuilder builder(scene);
+    ImageTextureDesc desc;
+    desc.filename = "bytes";
+    desc.encoding = encoding;
+    desc.filter = kTexturePoint;
+    const uint texture = builder.image(image, desc, false);
+    const TextureTables tables{scene.textureNodes.data(), scene.imageWords.data(), nullptr,
+                               nullptr};
+    // Level 1.5 of 10 (512 texels): the point filter reads level 1.
+    const float d = 0.5f * std::exp2(1.5f - 9.0f);
+    int checked = 0;
+    for (int i = 0; i < 256; ++i) {
+      const float a = float(decode(i / 255.0)), b = float(decode(second(i) / 255.0));
+      const double mean = double((a + b + a + b) / 4.0f);
+      const auto near = [&](double t) { return std::fabs(t - mean) <= 1e-5 * std::max(t, 1e-3); };
+      if (std::any_of(thresholds.begin(), thresholds.end(), near)) continue;
+      const int byte =
+          int(std::upper_bound(thresholds.begin(), thresholds.end(), mean) - thresholds.begin());
+      const float v = evalTextureAt(tables, texture,
+                                    UVFootprint(vec2((float(i) + 0.5f) / 256.0f, 0.5f),
+                                                vec2(d, 0.0f), vec2(0.0f)))
+                          .x;
+      EXPECT_NEAR(v, decode(byte / 255.0), 1e-6 + 1e-6 * decode(byte / 255.0))
+          << encoding << ": texel " << i << " of level 1, mean " << mean << ", byte " << byte;
+      ++checked;
+    }
+    EXPECT_GT(checked, 240) << encoding;
+  }
 }
 
 // The checkerboard's filtered weight of tex2 (pbrt-v4's closed form against a triangle filter

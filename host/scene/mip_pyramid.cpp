@@ -77,45 +77,58 @@ int roundUpPowerOfTwo(int n) {
 }
 
 FloatImage resizeUp(const FloatImage& image, int newWidth, int newHeight, uint wrap) {
-  const int c = image.channels;
+  const std::size_t c = std::size_t(image.channels);
   const std::vector<ResampleWeight> xWeights = resampleWeights(image.width, newWidth);
   const std::vector<ResampleWeight> yWeights = resampleWeights(image.height, newHeight);
-  // Along x, every old row.
+  // Along x, every old row: each new texel's four old ones, wrapped once per column.
+  std::vector<std::array<int, 4>> columns(std::size_t(newWidth), std::array<int, 4>{});
+  for (int x = 0; x < newWidth; ++x) {
+    for (int j = 0; j < 4; ++j) {
+      columns[std::size_t(x)][std::size_t(j)] =
+          wrapIndex(xWeights[std::size_t(x)].firstPixel + j, image.width, wrap);
+    }
+  }
   FloatImage rows;
   rows.width = newWidth;
   rows.height = image.height;
-  rows.channels = c;
+  rows.channels = image.channels;
   rows.reserveValues();
+  rows.values.resize(std::size_t(newWidth) * std::size_t(image.height) * c);
   for (int y = 0; y < image.height; ++y) {
+    const float* from = image.values.data() + std::size_t(y) * std::size_t(image.width) * c;
+    float* to = rows.values.data() + std::size_t(y) * std::size_t(newWidth) * c;
     for (int x = 0; x < newWidth; ++x) {
       const ResampleWeight& w = xWeights[std::size_t(x)];
-      int xi[4];
-      for (int j = 0; j < 4; ++j) xi[j] = wrapIndex(w.firstPixel + j, image.width, wrap);
-      for (int ch = 0; ch < c; ++ch) {
+      const std::array<int, 4>& xi = columns[std::size_t(x)];
+      for (std::size_t ch = 0; ch < c; ++ch) {
         float v[4];
-        for (int j = 0; j < 4; ++j) v[j] = xi[j] < 0 ? 0.0f : image.at(xi[j], y, ch);
-        rows.values.push_back(w.weight[0] * v[0] + w.weight[1] * v[1] + w.weight[2] * v[2] +
-                              w.weight[3] * v[3]);
+        for (int j = 0; j < 4; ++j) v[j] = xi[j] < 0 ? 0.0f : from[std::size_t(xi[j]) * c + ch];
+        to[std::size_t(x) * c + ch] =
+            w.weight[0] * v[0] + w.weight[1] * v[1] + w.weight[2] * v[2] + w.weight[3] * v[3];
       }
     }
   }
-  // Along y, clamped to zero.
+  // Along y, clamped to zero: each new row from four whole rows (none beyond a black edge).
   FloatImage out;
   out.width = newWidth;
   out.height = newHeight;
-  out.channels = c;
+  out.channels = image.channels;
   out.reserveValues();
+  const std::size_t rowValues = std::size_t(newWidth) * c;
+  out.values.resize(rowValues * std::size_t(newHeight));
   for (int y = 0; y < newHeight; ++y) {
     const ResampleWeight& w = yWeights[std::size_t(y)];
-    int yi[4];
-    for (int j = 0; j < 4; ++j) yi[j] = wrapIndex(w.firstPixel + j, image.height, wrap);
-    for (int x = 0; x < newWidth; ++x) {
-      for (int ch = 0; ch < c; ++ch) {
-        float v[4];
-        for (int j = 0; j < 4; ++j) v[j] = yi[j] < 0 ? 0.0f : rows.at(x, yi[j], ch);
-        out.values.push_back(std::max(0.0f, w.weight[0] * v[0] + w.weight[1] * v[1] +
-                                                w.weight[2] * v[2] + w.weight[3] * v[3]));
-      }
+    const float* source[4];
+    for (int j = 0; j < 4; ++j) {
+      const int yi = wrapIndex(w.firstPixel + j, image.height, wrap);
+      source[j] = yi < 0 ? nullptr : rows.values.data() + std::size_t(yi) * rowValues;
+    }
+    float* to = out.values.data() + std::size_t(y) * rowValues;
+    for (std::size_t k = 0; k < rowValues; ++k) {
+      float v[4];
+      for (int j = 0; j < 4; ++j) v[j] = source[j] == nullptr ? 0.0f : source[j][k];
+      to[k] = std::max(
+          0.0f, w.weight[0] * v[0] + w.weight[1] * v[1] + w.weight[2] * v[2] + w.weight[3] * v[3]);
     }
   }
   return out;
@@ -138,17 +151,19 @@ std::vector<FloatImage> mipPyramid(FloatImage image, uint wrap) {
     next.height = std::max(1, from.height / 2);
     next.channels = from.channels;
     next.reserveValues();
+    const std::size_t c = std::size_t(from.channels);
+    next.values.resize(std::size_t(next.width) * std::size_t(next.height) * c);
+    float* to = next.values.data();
     for (int y = 0; y < next.height; ++y) {
       // The 2 x 2 texels; a side of 1 repeats its one texel (pbrt-v4's source offsets).
-      const int y0 = 2 * y;
-      const int y1 = std::min(2 * y + 1, from.height - 1);
+      const float* row0 = from.values.data() + std::size_t(2 * y) * std::size_t(from.width) * c;
+      const float* row1 = from.values.data() + std::size_t(std::min(2 * y + 1, from.height - 1)) *
+                                                   std::size_t(from.width) * c;
       for (int x = 0; x < next.width; ++x) {
-        const int x0 = 2 * x;
-        const int x1 = std::min(2 * x + 1, from.width - 1);
-        for (int ch = 0; ch < from.channels; ++ch) {
-          next.values.push_back((from.at(x0, y0, ch) + from.at(x1, y0, ch) + from.at(x0, y1, ch) +
-                                 from.at(x1, y1, ch)) /
-                                4.0f);
+        const std::size_t x0 = std::size_t(2 * x) * c;
+        const std::size_t x1 = std::size_t(std::min(2 * x + 1, from.width - 1)) * c;
+        for (std::size_t ch = 0; ch < c; ++ch) {
+          *to++ = (row0[x0 + ch] + row0[x1 + ch] + row1[x0 + ch] + row1[x1 + ch]) / 4.0f;
         }
       }
     }

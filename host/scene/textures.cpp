@@ -35,16 +35,32 @@ double decodeEncoded(double c, double gamma) {
 // encoded domain (sRGB, gamma 0, or the power gamma), 0 and 255 beyond [0, 1]. The byte is the
 // number of thresholds at or below v: thresholds[b - 1] is where round(255 encode(v)) reaches
 // b, the linear value of the encoded (b - 1/2) / 255.
+// Rather than search all 255 thresholds, the count starts from what it is at the smallest
+// float sharing v's top 17 bits (start, by those bits, for the floats below the last
+// threshold, which all lie below 1) and steps up from there: the same count.
 struct ByteEncoder {
+  static constexpr int kKeyShift = 15;
   std::array<float, 255> thresholds{};
+  std::vector<uint8_t> start;
   explicit ByteEncoder(double gamma) {
     for (int b = 1; b <= 255; ++b) {
       thresholds[std::size_t(b - 1)] = float(decodeEncoded((b - 0.5) / 255.0, gamma));
     }
+    const uint keys = (floatWord(thresholds[254]) >> kKeyShift) + 1u;
+    start.resize(keys);
+    std::size_t below = 0;  // thresholds at or below the key's smallest float
+    for (uint key = 0; key < keys; ++key) {
+      const float smallest = uintBitsToFloat(key << kKeyShift);
+      while (below < 255 && thresholds[below] <= smallest) ++below;
+      start[key] = uint8_t(below);
+    }
   }
   uint operator()(float v) const {
     if (!(v > 0.0f)) return 0u;
-    return uint(std::upper_bound(thresholds.begin(), thresholds.end(), v) - thresholds.begin());
+    if (v >= thresholds[254]) return 255u;
+    uint b = start[floatWord(v) >> kKeyShift];
+    while (thresholds[b] <= v) ++b;
+    return b;
   }
 };
 
