@@ -139,7 +139,7 @@ TEST(MediaBothBackends, LightSamplesThroughAMediumWithoutBoundary) {
   addShape(scene, quad(vec3(0, 0, 0), vec3(0, 3, 0), vec3(3, 0, 0)), 0,
            MediumInterface{kVacuum, kVacuum});
   const SceneData data = prepare(scene, 5);
-  ASSERT_FALSE(data.effects.interfaceSurfaces);
+  ASSERT_FALSE(data.effects.interfaces);
   const Comparison cmp = renderBoth(data, 64);
   expectAgreement(cmp);
   const Image expected = pixelAverages(data.params.camera, [&](const Ray& r) {

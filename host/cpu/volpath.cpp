@@ -25,7 +25,7 @@ bool traceShadowThroughMedia(const SceneData& scene, const PathScene& ps, const 
   // Without interface surfaces every surface on the way blocks the ray: an any-hit query
   // answers that (cheaper than the closest hit, which the loop below needs to cross
   // interfaces), and the whole segment lies in `medium`.
-  if (!scene.effects.interfaceSurfaces) {
+  if (!scene.effects.interfaces) {
     if (!traceShadowRay(scene, ls, uLight, rays)) return false;
     if (medium == kNoMedium) return true;
     const vec3 d = ls.to - ls.from;

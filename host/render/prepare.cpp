@@ -397,8 +397,11 @@ SceneData prepareScene(Scene scene, const RenderSettings& settings) {
   for (const Triangle& tri : data.bvh.triangles) used[tri.material] = 1;
   bool lightSampled = false;  // some surface has a BSDF with a non-delta lobe
   for (size_t i = 0; i < used.size(); ++i) {
-    if (used[i] && data.materials[i].type == kMaterialInterface) fx.interfaceSurfaces = true;
-    if (!used[i] || data.materials[i].type == kMaterialInterface) continue;
+    if (!used[i]) continue;
+    if (data.materials[i].type == kMaterialInterface) {
+      fx.interfaces = true;
+      continue;
+    }
     const Material& m = data.materials[i];
     // A texture's value is known only at a hit: a parameter with one counts as non-zero.
     const MaterialTextures* t = data.materialTextures.empty() ? nullptr : &data.materialTextures[i];

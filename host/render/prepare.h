@@ -80,7 +80,7 @@ struct EffectSet {
   bool alphaCutouts = false;      // some material has an alpha texture (any-hit tests)
   bool bumpMaps = false;          // some material has a displacement texture
   bool media = false;             // participating media: the volume integrator (volpath)
-  bool interfaceSurfaces = false;  // some triangle only bounds media (the `interface` material)
+  bool interfaces = false;        // some triangle only bounds media (`interface` material)
   uint mediumKinds = 0;           // bit 1 << kMedium* for each type of medium present
   uint textureFeatures = 0;       // kTextureUses*: what the used materials' textures need
   bool lightSampling = false;     // next-event estimation (needs emitters, a diffuse surface)
